@@ -1,0 +1,23 @@
+"""fractalgeo_rs: fractal geometry for geo-information processing.
+
+Fractal dimension estimators (box counting, differential box counting,
+self-affine box counting, ...), fractal transforms of SAR and optical scenes,
+fBm synthesis, DEM tools and L-systems, with the heavy kernels in Rust.
+
+The package mirrors the Rust crate's domains: :mod:`fractalgeo_rs.dimension`
+(estimators and the :class:`DimensionFit` they return), :mod:`fractalgeo_rs.io`
+(rasters), :mod:`fractalgeo_rs.synth`, :mod:`fractalgeo_rs.dem` and
+:mod:`fractalgeo_rs.lsystem`.
+"""
+from fractalgeo_rs._core import __version__
+from fractalgeo_rs.fit import DimensionFit
+from fractalgeo_rs.dimension import box_counting, dimension
+
+# -- domain exports: each issue adds its own line below --
+
+__all__ = [
+    "__version__",
+    "DimensionFit",
+    "box_counting",
+    "dimension",
+]

@@ -1,0 +1,32 @@
+//! The PyO3 layer: `fractalgeo_rs._core`. Each domain registers its functions
+//! from its own file; a binding converts arrays, releases the GIL around the
+//! kernel (`py.detach`), runs it in a pool of `n_threads` and maps the error.
+//! Nothing else lives here.
+use crate::error::CoreError;
+use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+
+mod dimension;
+mod io;
+mod lsystem;
+mod synth;
+
+impl From<CoreError> for PyErr {
+    fn from(e: CoreError) -> PyErr {
+        match e {
+            CoreError::InvalidArgument { .. } => PyValueError::new_err(e.to_string()),
+            CoreError::Io(_) => PyOSError::new_err(e.to_string()),
+            CoreError::Internal(_) => PyRuntimeError::new_err(e.to_string()),
+        }
+    }
+}
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    dimension::register(m)?;
+    io::register(m)?;
+    synth::register(m)?;
+    lsystem::register(m)?;
+    Ok(())
+}

@@ -1,0 +1,364 @@
+//! Lattice box counting of binary sets (1, 2 or 3 dimensions).
+//!
+//! The count at box size `s` is the number of boxes of the lattice that
+//! contain at least one foreground sample (definition 4 of the paper's
+//! section 2.4, Falconer 1990). Policy, the same for every size:
+//!
+//! * the lattice is anchored at the first foreground sample of each axis
+//!   (the corner of the set's bounding box) unless [`Anchor::Array`] is asked
+//!   for, so translating the set or padding the array never changes a count;
+//! * boxes that reach past the last sample are counted when they hold
+//!   foreground (samples outside the data are background), which is exactly
+//!   the lattice count of the set: no partial box is dropped or rescaled;
+//! * the lattice may be shifted by global offsets (see [`super::lattice`]) and
+//!   the counts of every shift are returned, for averaging or minimum.
+//!
+//! All sizes are counted in about one pass over the data: the occupancy of
+//! size `s` is reduced from the finest computed size that divides it.
+use super::lattice::{best_source, box_range, lattice_shifts, n_boxes, validate_box_sizes, Shape3};
+use crate::error::{CoreError, CoreResult};
+use rayon::prelude::*;
+
+/// Where the lattice starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Anchor {
+    /// At the corner of the set's bounding box (translation invariant).
+    BoundingBox,
+    /// At sample 0 of every axis.
+    Array,
+}
+
+/// A C-contiguous 3-axis view of bytes: nonzero means foreground.
+#[derive(Clone, Copy)]
+pub struct ByteVolume<'a> {
+    pub data: &'a [u8],
+    pub shape: Shape3,
+}
+
+impl<'a> ByteVolume<'a> {
+    /// Wrap a contiguous buffer of 1, 2 or 3 axes (`dims`), padding to 3 axes.
+    pub fn new(data: &'a [u8], dims: &[usize]) -> CoreResult<Self> {
+        if dims.is_empty() || dims.len() > 3 {
+            return Err(CoreError::invalid("data", format!("expected 1, 2 or 3 dimensions, got {}", dims.len())));
+        }
+        let mut shape = [1usize; 3];
+        shape[3 - dims.len()..].copy_from_slice(dims);
+        let n: usize = shape.iter().product();
+        if n != data.len() {
+            return Err(CoreError::Internal(format!("buffer of {} bytes for shape {:?}", data.len(), dims)));
+        }
+        if n == 0 {
+            return Err(CoreError::invalid("data", "array is empty"));
+        }
+        Ok(ByteVolume { data, shape })
+    }
+}
+
+/// Result of [`box_count`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoxCounts {
+    /// The box sizes, ascending, in samples.
+    pub box_sizes: Vec<usize>,
+    /// The lattice shifts used (per axis of the 3-axis padded shape).
+    pub shifts: Vec<Shape3>,
+    /// `counts[i][j]`: occupied boxes of size `box_sizes[i]` in lattice `shifts[j]`.
+    pub counts: Vec<Vec<u64>>,
+    /// Number of foreground samples.
+    pub n_foreground: u64,
+    /// First foreground sample per axis (padded to 3 axes).
+    pub bbox_min: Shape3,
+    /// One past the last foreground sample per axis.
+    pub bbox_max: Shape3,
+}
+
+/// An occupancy grid: one byte per box, C order, 3 axes.
+struct Grid {
+    data: Vec<u8>,
+    shape: Shape3,
+}
+
+/// Source of a reduction: a strided window of a byte buffer.
+struct Src<'a> {
+    data: &'a [u8],
+    start: usize,
+    strides: [usize; 2], // strides of axes 0 and 1; axis 2 is contiguous
+    shape: Shape3,
+}
+
+/// Count foreground and find the bounding box in one parallel pass.
+fn scan(vol: &ByteVolume) -> (u64, Shape3, Shape3) {
+    let [_, n1, n2] = vol.shape;
+    let init = || (0u64, [usize::MAX; 3], [0usize; 3]);
+    vol.data
+        .par_chunks(n2)
+        .enumerate()
+        .with_min_len((4096 / n2).max(1))
+        .fold(init, |(cnt, mut lo, mut hi), (r, row)| {
+            let c = count_nonzero(row);
+            if c == 0 {
+                return (cnt, lo, hi);
+            }
+            let (i0, i1) = (r / n1, r % n1);
+            let first = row.iter().position(|&v| v != 0).unwrap_or(0);
+            let last = row.iter().rposition(|&v| v != 0).unwrap_or(0);
+            lo = [lo[0].min(i0), lo[1].min(i1), lo[2].min(first)];
+            hi = [hi[0].max(i0 + 1), hi[1].max(i1 + 1), hi[2].max(last + 1)];
+            (cnt + c, lo, hi)
+        })
+        .reduce(init, |a, b| {
+            (
+                a.0 + b.0,
+                [a.1[0].min(b.1[0]), a.1[1].min(b.1[1]), a.1[2].min(b.1[2])],
+                [a.2[0].max(b.2[0]), a.2[1].max(b.2[1]), a.2[2].max(b.2[2])],
+            )
+        })
+}
+
+/// Number of nonzero bytes (vectorises: bytes are mapped to 0/1 and summed in chunks).
+#[inline]
+pub fn count_nonzero(row: &[u8]) -> u64 {
+    let mut total = 0u64;
+    for chunk in row.chunks(255 * 32) {
+        let mut acc = [0u8; 32];
+        for block in chunk.chunks(32) {
+            for (a, &b) in acc.iter_mut().zip(block) {
+                *a += (b != 0) as u8;
+            }
+        }
+        // a lane sees at most chunk.len() / 32 <= 255 values of 0 or 1: no overflow
+        total += acc.iter().map(|&x| x as u64).sum::<u64>();
+    }
+    total
+}
+
+/// Block-OR reduction of `src` by factors `m` and shifts `c` per axis.
+/// Returns the reduced grid and its number of occupied boxes.
+fn reduce_or(src: &Src, m: Shape3, c: Shape3) -> (Grid, u64) {
+    let out_shape = [
+        n_boxes(src.shape[0], m[0], c[0]),
+        n_boxes(src.shape[1], m[1], c[1]),
+        n_boxes(src.shape[2], m[2], c[2]),
+    ];
+    let n2 = src.shape[2];
+    let o2 = out_shape[2];
+    let mut out = vec![0u8; out_shape[0] * out_shape[1] * o2];
+    let count: u64 = out
+        .par_chunks_mut(o2)
+        .enumerate()
+        .with_min_len((1 << 14) / (n2 * m[0] * m[1]).max(1) + 1)
+        .map_init(
+            || vec![0u8; n2],
+            |acc, (idx, orow)| {
+                let (b0, b1) = (idx / out_shape[1], idx % out_shape[1]);
+                let (lo0, hi0) = box_range(b0, m[0], c[0], src.shape[0]);
+                let (lo1, hi1) = box_range(b1, m[1], c[1], src.shape[1]);
+                acc.iter_mut().for_each(|a| *a = 0);
+                for i in lo0..hi0 {
+                    for j in lo1..hi1 {
+                        let off = src.start + i * src.strides[0] + j * src.strides[1];
+                        let row = &src.data[off..off + n2];
+                        for (a, &v) in acc.iter_mut().zip(row) {
+                            *a |= v;
+                        }
+                    }
+                }
+                let mut cnt = 0u64;
+                if m[2] == 1 && c[2] == 0 {
+                    for (o, &a) in orow.iter_mut().zip(acc.iter()) {
+                        *o = (a != 0) as u8;
+                        cnt += *o as u64;
+                    }
+                } else if m[2] == 2 && c[2] == 0 {
+                    let (pairs, rest) = acc.split_at(n2 & !1);
+                    for (o, p) in orow.iter_mut().zip(pairs.chunks_exact(2)) {
+                        *o = ((p[0] | p[1]) != 0) as u8;
+                        cnt += *o as u64;
+                    }
+                    if let Some(&r) = rest.first() {
+                        orow[o2 - 1] = (r != 0) as u8;
+                        cnt += orow[o2 - 1] as u64;
+                    }
+                } else {
+                    for (b2, o) in orow.iter_mut().enumerate() {
+                        let (lo, hi) = box_range(b2, m[2], c[2], n2);
+                        *o = acc[lo..hi].iter().any(|&v| v != 0) as u8;
+                        cnt += *o as u64;
+                    }
+                }
+                cnt
+            },
+        )
+        .sum();
+    (Grid { data: out, shape: out_shape }, count)
+}
+
+/// Count occupied boxes of a binary set for every box size and lattice shift.
+///
+/// `box_sizes` are in samples (validated: positive, at least three distinct,
+/// none larger than the longest axis). `n_offsets` shifts per axis give
+/// `n_offsets^ndim` lattices. Runs on the current rayon pool.
+pub fn box_count(
+    vol: &ByteVolume,
+    ndim: usize,
+    box_sizes: &[usize],
+    n_offsets: usize,
+    anchor: Anchor,
+) -> CoreResult<BoxCounts> {
+    let max_len = *vol.shape.iter().max().unwrap_or(&0);
+    let sizes = validate_box_sizes(box_sizes, max_len)?;
+    if n_offsets == 0 {
+        return Err(CoreError::invalid("offsets", "must be a positive integer"));
+    }
+    let (n_fg, bmin, bmax) = scan(vol);
+    if n_fg == 0 {
+        return Err(CoreError::invalid("data", "the set is empty (no foreground sample)"));
+    }
+    let (lo, hi) = match anchor {
+        Anchor::BoundingBox => (bmin, bmax),
+        Anchor::Array => ([0; 3], vol.shape),
+    };
+    let shape = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
+    let [_, n1, n2] = vol.shape;
+    let base = Src {
+        data: vol.data,
+        start: lo[0] * n1 * n2 + lo[1] * n2 + lo[2],
+        strides: [n1 * n2, n2],
+        shape,
+    };
+    let s_max = *sizes.last().unwrap();
+    let shifts = lattice_shifts(ndim, n_offsets, s_max);
+    let mut counts = vec![vec![0u64; shifts.len()]; sizes.len()];
+    for (j, g) in shifts.iter().enumerate() {
+        // computed grids of this lattice, by size (ascending)
+        let mut done: Vec<usize> = Vec::new();
+        let mut grids: Vec<Grid> = Vec::new();
+        for (i, &s) in sizes.iter().enumerate() {
+            if s == 1 {
+                counts[i][j] = n_fg;
+                continue;
+            }
+            let t = best_source(s, &done);
+            let m_ = s / t;
+            let mut m = [1usize; 3];
+            let mut c = [0usize; 3];
+            for a in (3 - ndim)..3 {
+                m[a] = m_;
+                c[a] = ((g[a] % s) - (g[a] % t)) / t;
+            }
+            let (grid, cnt) = if t == 1 {
+                reduce_or(&base, m, c)
+            } else {
+                let k = done.iter().position(|&d| d == t).unwrap();
+                let gsrc = &grids[k];
+                let src = Src {
+                    data: &gsrc.data,
+                    start: 0,
+                    strides: [gsrc.shape[1] * gsrc.shape[2], gsrc.shape[2]],
+                    shape: gsrc.shape,
+                };
+                reduce_or(&src, m, c)
+            };
+            counts[i][j] = cnt;
+            done.push(s);
+            grids.push(grid);
+        }
+    }
+    Ok(BoxCounts { box_sizes: sizes, shifts, counts, n_foreground: n_fg, bbox_min: bmin, bbox_max: bmax })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Direct count: box of every foreground sample, deduplicated.
+    fn naive(data: &[u8], dims: &[usize], s: usize, g: Shape3, anchor: Anchor) -> u64 {
+        let vol = ByteVolume::new(data, dims).unwrap();
+        let (_, bmin, _) = scan(&vol);
+        let lo = if anchor == Anchor::BoundingBox { bmin } else { [0; 3] };
+        let mut set = std::collections::HashSet::new();
+        let [n0, n1, n2] = vol.shape;
+        for i in 0..n0 {
+            for j in 0..n1 {
+                for k in 0..n2 {
+                    if data[(i * n1 + j) * n2 + k] != 0 {
+                        let key = [
+                            (i - lo[0] + g[0] % s) / s,
+                            (j - lo[1] + g[1] % s) / s,
+                            (k - lo[2] + g[2] % s) / s,
+                        ];
+                        set.insert(key);
+                    }
+                }
+            }
+        }
+        set.len() as u64
+    }
+
+    fn lcg(seed: &mut u64) -> u64 {
+        *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        *seed >> 33
+    }
+
+    #[test]
+    fn matches_naive_count_on_random_sets() {
+        let mut seed = 7u64;
+        for trial in 0..40 {
+            let ndim = 1 + trial % 3;
+            let dims: Vec<usize> = (0..ndim).map(|_| 3 + (lcg(&mut seed) % 30) as usize).collect();
+            let n: usize = dims.iter().product();
+            let density = 1 + lcg(&mut seed) % 20;
+            let mut data: Vec<u8> = (0..n).map(|_| (lcg(&mut seed) % 100 < density) as u8).collect();
+            data[n / 2] = 1;
+            let vol = ByteVolume::new(&data, &dims).unwrap();
+            let maxlen = *dims.iter().max().unwrap();
+            let sizes: Vec<usize> = vec![1, 2, 3, 4, 6, 8, 12].into_iter().filter(|&s| s <= maxlen).collect();
+            for anchor in [Anchor::BoundingBox, Anchor::Array] {
+                for offs in [1usize, 2, 3] {
+                    let r = box_count(&vol, ndim, &sizes, offs, anchor).unwrap();
+                    for (i, &s) in r.box_sizes.iter().enumerate() {
+                        for (j, g) in r.shifts.iter().enumerate() {
+                            assert_eq!(r.counts[i][j], naive(&data, &dims, s, *g, anchor), "s={s} g={g:?} dims={dims:?}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn sierpinski_triangle_counts_are_exact() {
+        // Pascal's triangle mod 2 on a 2^L grid: N(2^k) = 3^(L-k).
+        let l = 7;
+        let n = 1usize << l;
+        let data: Vec<u8> = (0..n * n).map(|p| ((p / n) & (p % n) == 0) as u8).collect();
+        let vol = ByteVolume::new(&data, &[n, n]).unwrap();
+        let sizes: Vec<usize> = (0..=l).map(|k| 1 << k).collect();
+        let r = box_count(&vol, 2, &sizes, 1, Anchor::BoundingBox).unwrap();
+        for (k, c) in r.counts.iter().enumerate() {
+            assert_eq!(c[0], 3u64.pow((l - k) as u32));
+        }
+    }
+
+    #[test]
+    fn thread_count_does_not_change_counts() {
+        let mut seed = 3u64;
+        let dims = [301usize, 257];
+        let data: Vec<u8> = (0..dims[0] * dims[1]).map(|_| (lcg(&mut seed) % 7 == 0) as u8).collect();
+        let vol = ByteVolume::new(&data, &dims).unwrap();
+        let run = |t| {
+            crate::parallel::run_in_pool(Some(t), || box_count(&vol, 2, &[1, 2, 3, 5, 8, 16, 64], 3, Anchor::BoundingBox))
+                .unwrap()
+        };
+        assert_eq!(run(1), run(2));
+        assert_eq!(run(1), run(5));
+    }
+
+    #[test]
+    fn bad_input_is_an_error() {
+        let data = vec![0u8; 16];
+        let vol = ByteVolume::new(&data, &[4, 4]).unwrap();
+        assert!(matches!(box_count(&vol, 2, &[1, 2, 4], 1, Anchor::BoundingBox), Err(CoreError::InvalidArgument { .. })));
+        assert!(ByteVolume::new(&[], &[0]).is_err());
+        assert!(ByteVolume::new(&data, &[2, 2, 2, 2]).is_err());
+    }
+}

@@ -1,0 +1,15 @@
+//! Fractal dimension estimators: the heavy counting work. The log-log fit and
+//! the choice of scale range are done by the caller (the Python
+//! `DimensionFit`), so every kernel here returns raw measures per scale.
+//!
+//! * [`boxcount`]: lattice box counting of binary sets in 1, 2 and 3 dimensions.
+//! * [`points`]: box counting of point sets given as coordinates.
+//! * [`dbc`]: differential box counting of grayscale images and DEMs.
+//! * [`affine`]: per-column height ranges for self-affine box counting of graphs.
+//! * [`lattice`]: the box lattices (sizes, grid shifts) shared by the counters.
+
+pub mod affine;
+pub mod boxcount;
+pub mod dbc;
+pub mod lattice;
+pub mod points;

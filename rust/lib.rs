@@ -1,0 +1,28 @@
+//! fractalgeo_rs: fractal geometry for geo-information processing.
+//!
+//! The crate is organised by domain. Every kernel is plain Rust over slices and
+//! `ndarray` views, returns `Result<_, CoreError>` and knows nothing of Python,
+//! so `cargo test` and `cargo bench` run without an interpreter. The PyO3
+//! bindings live in [`bindings`] behind the `python` cargo feature and do only
+//! conversion, GIL release and error mapping.
+//!
+//! | module | what |
+//! |---|---|
+//! | [`dimension`] | fractal dimension estimators (box counting, DBC, self-affine boxes) |
+//! | [`io`] | raster readers and writers that the bindings expose |
+//! | [`synth`] | fBm and surface synthesis |
+//! | [`dem`] | DEM work: shaded relief, lakes, resampling |
+//! | [`lsystem`] | L-systems, turtle geometry and IFS |
+
+pub mod dem;
+pub mod dimension;
+pub mod error;
+pub mod io;
+pub mod lsystem;
+pub mod parallel;
+pub mod synth;
+
+#[cfg(feature = "python")]
+pub mod bindings;
+
+pub use error::{CoreError, CoreResult};
