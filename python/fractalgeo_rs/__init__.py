@@ -11,7 +11,13 @@ The package mirrors the Rust crate's domains: :mod:`fractalgeo_rs.dimension`
 """
 from fractalgeo_rs._core import __version__
 from fractalgeo_rs.fit import DimensionFit
-from fractalgeo_rs.dimension import box_counting, dimension
+from fractalgeo_rs.dimension import (
+    box_counting,
+    box_counting_points,
+    differential_box_counting,
+    dimension,
+    self_affine_box_counting,
+)
 
 # -- domain exports: each issue adds its own line below --
 
@@ -19,5 +25,8 @@ __all__ = [
     "__version__",
     "DimensionFit",
     "box_counting",
+    "box_counting_points",
+    "differential_box_counting",
     "dimension",
+    "self_affine_box_counting",
 ]

@@ -192,7 +192,41 @@ fn reduce_or(src: &Src, m: Shape3, c: Shape3) -> (Grid, u64) {
     (Grid { data: out, shape: out_shape }, count)
 }
 
+/// Default box sizes for a set whose bounding box spans `extent` samples along
+/// its longest axis.
+///
+/// Preferred: the sizes that divide `extent`, so that whole boxes tile the
+/// bounding box at every scale (no partial box at the far edge; on a set built
+/// by a b-adic construction of side b^L these are the b^k that match it),
+/// thinned so that consecutive sizes differ by a factor of at least 1.4, up to
+/// `extent / DEFAULT_MIN_BOXES`. Used when that gives at least 3 sizes spanning
+/// a factor of 8 or more; otherwise the powers of two up to the same limit.
+pub fn default_box_sizes(extent: usize) -> Vec<usize> {
+    let limit = (extent / DEFAULT_MIN_BOXES).max(1);
+    let mut divisors = vec![];
+    for d in 1..=limit {
+        if extent % d == 0 && divisors.last().is_none_or(|&last: &usize| d as f64 >= 1.4 * last as f64) {
+            divisors.push(d);
+        }
+    }
+    if divisors.len() >= 3 && divisors[divisors.len() - 1] >= 8 * divisors[0] {
+        return divisors;
+    }
+    let mut v = vec![];
+    let mut s = 1usize;
+    while s <= limit {
+        v.push(s);
+        s *= 2;
+    }
+    v
+}
+
+/// The coarsest default lattice has at least this many boxes across the set.
+pub const DEFAULT_MIN_BOXES: usize = 4;
+
 /// Count occupied boxes of a binary set for every box size and lattice shift.
+///
+/// An empty `box_sizes` asks for [`default_box_sizes`] of the set's extent.
 ///
 /// `box_sizes` are in samples (validated: positive, at least three distinct,
 /// none larger than the longest axis). `n_offsets` shifts per axis give
@@ -204,15 +238,28 @@ pub fn box_count(
     n_offsets: usize,
     anchor: Anchor,
 ) -> CoreResult<BoxCounts> {
-    let max_len = *vol.shape.iter().max().unwrap_or(&0);
-    let sizes = validate_box_sizes(box_sizes, max_len)?;
     if n_offsets == 0 {
         return Err(CoreError::invalid("offsets", "must be a positive integer"));
+    }
+    let max_len = *vol.shape.iter().max().unwrap_or(&0);
+    if !box_sizes.is_empty() {
+        validate_box_sizes(box_sizes, max_len)?;
     }
     let (n_fg, bmin, bmax) = scan(vol);
     if n_fg == 0 {
         return Err(CoreError::invalid("data", "the set is empty (no foreground sample)"));
     }
+    let sizes = if box_sizes.is_empty() {
+        let extent = (0..3).map(|a| bmax[a] - bmin[a]).max().unwrap_or(1);
+        validate_box_sizes(&default_box_sizes(extent), max_len).map_err(|_| {
+            CoreError::invalid(
+                "data",
+                format!("the set spans only {extent} samples: too small for the default box sizes (give box_sizes)"),
+            )
+        })?
+    } else {
+        validate_box_sizes(box_sizes, max_len)?
+    };
     let (lo, hi) = match anchor {
         Anchor::BoundingBox => (bmin, bmax),
         Anchor::Array => ([0; 3], vol.shape),
@@ -351,6 +398,16 @@ mod tests {
         };
         assert_eq!(run(1), run(2));
         assert_eq!(run(1), run(5));
+    }
+
+    #[test]
+    fn default_sizes_tile_the_extent_when_they_can() {
+        assert_eq!(default_box_sizes(729), vec![1, 3, 9, 27, 81]);
+        assert_eq!(default_box_sizes(512), vec![1, 2, 4, 8, 16, 32, 64, 128]);
+        assert_eq!(default_box_sizes(81), vec![1, 3, 9]);
+        // 613 is prime: powers of two
+        assert_eq!(default_box_sizes(613), vec![1, 2, 4, 8, 16, 32, 64, 128]);
+        assert_eq!(default_box_sizes(500), vec![1, 2, 4, 10, 20, 50, 100]);
     }
 
     #[test]

@@ -1,0 +1,70 @@
+"""Fractal dimension estimators.
+
+One entry point, :func:`dimension`, dispatches on ``method`` to a named
+function; every estimator returns a :class:`fractalgeo_rs.DimensionFit`.
+
+=============  ===============================================  =====================================
+method         data                                             function
+=============  ===============================================  =====================================
+``"box"``      binary sets, 1D/2D/3D arrays                     :func:`box_counting`
+``"points"``   point sets, (N, d) coordinates                   :func:`box_counting_points`
+``"dbc"``      grayscale images, DEMs                           :func:`differential_box_counting`
+``"affine"``   graphs of profiles and surfaces (self-affine)    :func:`self_affine_box_counting`
+=============  ===============================================  =====================================
+"""
+from __future__ import annotations
+
+from typing import Callable, Dict
+
+from fractalgeo_rs.dimension.boxcount import (
+    box_counting,
+    box_counting_points,
+    differential_box_counting,
+    self_affine_box_counting,
+)
+from fractalgeo_rs.fit import DimensionFit
+
+__all__ = [
+    "METHODS",
+    "box_counting",
+    "box_counting_points",
+    "differential_box_counting",
+    "dimension",
+    "self_affine_box_counting",
+]
+
+METHODS: Dict[str, Callable[..., DimensionFit]] = {
+    "box": box_counting,
+    "points": box_counting_points,
+    "dbc": differential_box_counting,
+    "affine": self_affine_box_counting,
+}
+
+
+def dimension(data, method: str = "box", **options) -> DimensionFit:
+    """Estimate the fractal dimension of ``data`` with ``method``.
+
+    Parameters
+    ----------
+    data : array_like
+        What the method accepts (see the table in this module's docstring).
+    method : str, default "box"
+        One of ``METHODS``.
+    **options
+        Keyword options of the method's function (``box_sizes``,
+        ``scale_range``, ``n_threads``, ...).
+
+    Returns
+    -------
+    DimensionFit
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> square = np.ones((100, 100), dtype=bool)
+    >>> round(fg.dimension(square, method="box").dimension, 3)
+    2.0
+    """
+    if not isinstance(method, str) or method not in METHODS:
+        raise ValueError(f"method: expected one of {', '.join(map(repr, METHODS))}, got {method!r}")
+    return METHODS[method](data, **options)

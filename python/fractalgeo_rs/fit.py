@@ -1,0 +1,270 @@
+"""The result object every dimension estimator returns.
+
+An estimator measures a quantity ``M(s)`` at scales ``s`` (box counts against
+box size, areas against radius, ...) and the dimension follows from the slope
+of the ordinary least-squares line through ``(log s, log M(s))``:
+
+    D = dim_offset + dim_factor * slope
+
+(box counting: ``D = -slope``; Minkowski sausage in the plane:
+``D = 2 - slope``). :func:`fit_loglog` does the fit, the choice of scale range
+and the uncertainty; :class:`DimensionFit` holds the result and draws it.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+__all__ = ["DimensionFit", "fit_loglog"]
+
+ScaleRange = Union[None, str, Tuple[float, float]]
+
+
+@dataclass(frozen=True)
+class DimensionFit:
+    """A fractal dimension estimated from a log-log regression.
+
+    Attributes
+    ----------
+    dimension : float
+        The estimated dimension ``D = dim_offset + dim_factor * slope``.
+    slope, intercept : float
+        OLS line ``log M = intercept + slope * log s`` (natural logarithms)
+        over the scales used.
+    r_squared : float
+        Coefficient of determination of that line (1.0 for a perfect power law).
+    stderr : float
+        Standard error of ``dimension`` (``|dim_factor|`` times the slope's
+        OLS standard error; 0 when the points are exactly collinear).
+    ci95 : tuple of float
+        95 % confidence interval of ``dimension`` from Student's t with
+        ``n_used - 2`` degrees of freedom. The log-log residuals of nested
+        boxes are correlated, so this interval is nominal: it measures how
+        straight the line is, not the spread over realisations of a random set.
+    scales : ndarray
+        Every scale measured (box sizes, radii, ...), ascending, in the data's
+        units (samples for rasters, coordinate units for point sets).
+    measures : ndarray
+        The measure at each scale (e.g. the number of occupied boxes).
+    used : ndarray of bool
+        Which scales entered the fit.
+    scale_range : tuple of float
+        Smallest and largest scale used.
+    method : str
+        Name of the estimator.
+    range_selection : str
+        ``"all"``, ``"user"`` or ``"auto"`` (the most linear range, see
+        :func:`fit_loglog`).
+    extra : mapping
+        Method-specific results (e.g. ``hurst`` for self-affine counting, the
+        counts of every lattice offset).
+    """
+
+    dimension: float
+    slope: float
+    intercept: float
+    r_squared: float
+    stderr: float
+    ci95: Tuple[float, float]
+    scales: np.ndarray
+    measures: np.ndarray
+    used: np.ndarray
+    scale_range: Tuple[float, float]
+    method: str
+    range_selection: str = "all"
+    dim_offset: float = 0.0
+    dim_factor: float = -1.0
+    x_label: str = "scale"
+    y_label: str = "measure"
+    extra: Mapping[str, Any] = field(default_factory=dict)
+
+    @property
+    def n_used(self) -> int:
+        """Number of scales in the fit."""
+        return int(np.count_nonzero(self.used))
+
+    def __repr__(self) -> str:
+        lo, hi = self.ci95
+        extra = ""
+        if "hurst" in self.extra:
+            extra = f", hurst={self.extra['hurst']:.4f}"
+        return (
+            f"DimensionFit(method={self.method!r}, dimension={self.dimension:.4f}{extra}, "
+            f"ci95=({lo:.4f}, {hi:.4f}), r_squared={self.r_squared:.6f}, "
+            f"scales {self.scale_range[0]:g}..{self.scale_range[1]:g} "
+            f"({self.n_used} of {len(self.scales)}, {self.range_selection}))"
+        )
+
+    def plot(self, ax=None, *, label: Optional[str] = None):
+        """Draw the log-log points and the fitted line.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw into; a new figure is made when omitted.
+        label : str, optional
+            Legend label of the points (default: the method name).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+        """
+        try:
+            import matplotlib.pyplot as plt
+        except ImportError as exc:  # pragma: no cover - depends on the install
+            raise ImportError(
+                "DimensionFit.plot needs matplotlib: pip install 'fractalgeo_rs[plot]'"
+            ) from exc
+        if ax is None:
+            _, ax = plt.subplots(figsize=(4.5, 3.6))
+        s, m, u = self.scales, self.measures, self.used
+        ok = m > 0
+        ax.loglog(s[u & ok], m[u & ok], "o", color="C0", label=label or self.method)
+        if np.any(~u & ok):
+            ax.loglog(s[~u & ok], m[~u & ok], "o", mfc="none", color="C0", label="not fitted")
+        xs = np.array(self.scale_range, dtype=float)
+        ax.loglog(xs, np.exp(self.intercept + self.slope * np.log(xs)), "-", color="C3",
+                  label=f"D = {self.dimension:.3f} ± {1.96 * self.stderr:.3f}")
+        ax.set_xlabel(self.x_label)
+        ax.set_ylabel(self.y_label)
+        ax.legend(fontsize="small")
+        return ax
+
+
+def _ols(x: np.ndarray, y: np.ndarray):
+    n = len(x)
+    xm, ym = x.mean(), y.mean()
+    sxx = float(np.sum((x - xm) ** 2))
+    sxy = float(np.sum((x - xm) * (y - ym)))
+    slope = sxy / sxx
+    intercept = ym - slope * xm
+    resid = y - (intercept + slope * x)
+    sse = float(np.sum(resid**2))
+    syy = float(np.sum((y - ym) ** 2))
+    r2 = 1.0 - sse / syy if syy > 0 else 1.0
+    se = math.sqrt(sse / (n - 2) / sxx) if n > 2 else float("inf")
+    return slope, float(intercept), r2, se
+
+
+def _auto_range(x: np.ndarray, y: np.ndarray, min_points: int) -> Tuple[int, int]:
+    """Contiguous range ``[i, j)`` of at least ``min_points`` scales that
+    minimises the slope's standard error; ties go to the longer range, then to
+    the finer scales."""
+    n = len(x)
+    best_key, best = None, (0, n)
+    for i in range(n):
+        for j in range(i + min_points, n + 1):
+            se = _ols(x[i:j], y[i:j])[3]
+            key = (round(se, 12), -(j - i), i)
+            if best_key is None or key < best_key:
+                best_key, best = key, (i, j)
+    return best
+
+
+def fit_loglog(
+    scales: Sequence[float],
+    measures: Sequence[float],
+    *,
+    method: str,
+    dim_offset: float = 0.0,
+    dim_factor: float = -1.0,
+    scale_range: ScaleRange = None,
+    min_points: Optional[int] = None,
+    x_label: str = "scale",
+    y_label: str = "measure",
+    extra: Optional[Mapping[str, Any]] = None,
+) -> DimensionFit:
+    """Fit ``log M = a + b log s`` and map the slope to a dimension.
+
+    Parameters
+    ----------
+    scales, measures : sequence of float
+        Scales (ascending after sorting) and positive measures.
+    method : str
+        Name recorded in the result.
+    dim_offset, dim_factor : float
+        ``D = dim_offset + dim_factor * slope``.
+    scale_range : None, "auto" or (float, float)
+        ``None`` fits every scale; a ``(low, high)`` pair fits the scales with
+        ``low <= s <= high``; ``"auto"`` picks the contiguous range of at least
+        ``min_points`` scales whose slope has the smallest standard error (a
+        long straight range beats a short one; curvature at either end raises
+        the error), and records the choice in ``scale_range`` and
+        ``range_selection``.
+    min_points : int, optional
+        Fewest scales in an automatic range (default ``max(3, ceil(n / 2))``).
+        A user range must also hold at least 3 scales.
+
+    Returns
+    -------
+    DimensionFit
+    """
+    s = np.asarray(scales, dtype=float)
+    m = np.asarray(measures, dtype=float)
+    if s.shape != m.shape or s.ndim != 1:
+        raise ValueError("scales: scales and measures must be 1D arrays of the same length")
+    order = np.argsort(s, kind="stable")
+    s, m = s[order], m[order]
+    valid = np.isfinite(s) & np.isfinite(m) & (s > 0) & (m > 0)
+    if np.count_nonzero(valid) < 3:
+        raise ValueError(
+            f"box_sizes: need at least 3 scales with a positive measure for a fit, got {np.count_nonzero(valid)}"
+        )
+    if scale_range is None:
+        used = valid.copy()
+        selection = "all"
+    elif isinstance(scale_range, str):
+        if scale_range != "auto":
+            raise ValueError(f"scale_range: expected None, 'auto' or (low, high), got {scale_range!r}")
+        idx = np.flatnonzero(valid)
+        n = len(idx)
+        mp = max(3, math.ceil(n / 2)) if min_points is None else int(min_points)
+        if mp < 3 or mp > n:
+            raise ValueError(f"min_points: expected an int in [3, {n}], got {min_points!r}")
+        i, j = _auto_range(np.log(s[idx]), np.log(m[idx]), mp)
+        used = np.zeros_like(valid)
+        used[idx[i:j]] = True
+        selection = "auto"
+    else:
+        try:
+            lo, hi = (float(v) for v in scale_range)
+        except (TypeError, ValueError):
+            raise ValueError(f"scale_range: expected None, 'auto' or (low, high), got {scale_range!r}") from None
+        if not (lo <= hi):
+            raise ValueError(f"scale_range: low must not exceed high, got ({lo}, {hi})")
+        used = valid & (s >= lo) & (s <= hi)
+        if np.count_nonzero(used) < 3:
+            raise ValueError(
+                f"scale_range: ({lo:g}, {hi:g}) holds {np.count_nonzero(used)} usable scales, need at least 3"
+            )
+        selection = "user"
+    x, y = np.log(s[used]), np.log(m[used])
+    slope, intercept, r2, se = _ols(x, y)
+    dim = dim_offset + dim_factor * slope
+    dse = abs(dim_factor) * se
+    from scipy.stats import t as student_t
+
+    q = float(student_t.ppf(0.975, len(x) - 2))
+    half = q * dse
+    return DimensionFit(
+        dimension=float(dim),
+        slope=float(slope),
+        intercept=float(intercept),
+        r_squared=float(r2),
+        stderr=float(dse),
+        ci95=(float(dim - half), float(dim + half)),
+        scales=s,
+        measures=m,
+        used=used,
+        scale_range=(float(s[used][0]), float(s[used][-1])),
+        method=method,
+        range_selection=selection,
+        dim_offset=float(dim_offset),
+        dim_factor=float(dim_factor),
+        x_label=x_label,
+        y_label=y_label,
+        extra=dict(extra or {}),
+    )
