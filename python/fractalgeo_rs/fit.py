@@ -98,7 +98,7 @@ class DimensionFit:
             f"({self.n_used} of {len(self.scales)}, {self.range_selection}))"
         )
 
-    def plot(self, ax=None, *, label: Optional[str] = None):
+    def plot(self, ax=None, *, label: Optional[str] = None, color: Optional[str] = None):
         """Draw the log-log points and the fitted line.
 
         Parameters
@@ -107,6 +107,9 @@ class DimensionFit:
             Axes to draw into; a new figure is made when omitted.
         label : str, optional
             Legend label of the points (default: the method name).
+        color : str, optional
+            Colour of points and line (default: the next colour of the
+            cycle, so several fits can share one axes).
 
         Returns
         -------
@@ -122,12 +125,18 @@ class DimensionFit:
             _, ax = plt.subplots(figsize=(4.5, 3.6))
         s, m, u = self.scales, self.measures, self.used
         ok = m > 0
-        ax.loglog(s[u & ok], m[u & ok], "o", color="C0", label=label or self.method)
+        if color is None:
+            n_prev = sum(1 for line in ax.lines if str(line.get_label()).startswith("D = "))
+            color = f"C{n_prev % 10}"
+        ax.loglog(s[u & ok], m[u & ok], "o", color=color, label=label or self.method)
         if np.any(~u & ok):
-            ax.loglog(s[~u & ok], m[~u & ok], "o", mfc="none", color="C0", label="not fitted")
+            ax.loglog(s[~u & ok], m[~u & ok], "o", mfc="none", color=color, label="not fitted")
         xs = np.array(self.scale_range, dtype=float)
-        ax.loglog(xs, np.exp(self.intercept + self.slope * np.log(xs)), "-", color="C3",
+        ax.loglog(xs, np.exp(self.intercept + self.slope * np.log(xs)), "-", color=color,
                   label=f"D = {self.dimension:.3f} ± {1.96 * self.stderr:.3f}")
+        from matplotlib.ticker import NullFormatter
+
+        ax.xaxis.set_minor_formatter(NullFormatter())
         ax.set_xlabel(self.x_label)
         ax.set_ylabel(self.y_label)
         ax.legend(fontsize="small")

@@ -200,7 +200,8 @@ fn reduce_or(src: &Src, m: Shape3, c: Shape3) -> (Grid, u64) {
 /// by a b-adic construction of side b^L these are the b^k that match it),
 /// thinned so that consecutive sizes differ by a factor of at least 1.4, up to
 /// `extent / DEFAULT_MIN_BOXES`. Used when that gives at least 3 sizes spanning
-/// a factor of 8 or more; otherwise the powers of two up to the same limit.
+/// a factor of 8 or more with no gap wider than a factor of 4; otherwise the
+/// powers of two up to the same limit.
 pub fn default_box_sizes(extent: usize) -> Vec<usize> {
     let limit = (extent / DEFAULT_MIN_BOXES).max(1);
     let mut divisors = vec![];
@@ -209,7 +210,8 @@ pub fn default_box_sizes(extent: usize) -> Vec<usize> {
             divisors.push(d);
         }
     }
-    if divisors.len() >= 3 && divisors[divisors.len() - 1] >= 8 * divisors[0] {
+    let max_gap = divisors.windows(2).map(|w| w[1] as f64 / w[0] as f64).fold(1.0, f64::max);
+    if divisors.len() >= 3 && divisors[divisors.len() - 1] >= 8 * divisors[0] && max_gap <= 4.0 {
         return divisors;
     }
     let mut v = vec![];
@@ -408,6 +410,8 @@ mod tests {
         // 613 is prime: powers of two
         assert_eq!(default_box_sizes(613), vec![1, 2, 4, 8, 16, 32, 64, 128]);
         assert_eq!(default_box_sizes(500), vec![1, 2, 4, 10, 20, 50, 100]);
+        // 762 = 2 * 3 * 127: divisors leave a gap from 6 to 127, so powers of two
+        assert_eq!(default_box_sizes(762), vec![1, 2, 4, 8, 16, 32, 64, 128]);
     }
 
     #[test]

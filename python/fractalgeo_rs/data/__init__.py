@@ -1,0 +1,79 @@
+"""Small real data sets bundled with the package (see ``DATA.md`` beside
+this file for provenance and licences).
+
+Each loader returns ``(array, info)`` where ``info`` is a dict with
+``description``, ``attribution``, ``crs``, ``transform`` (GDAL order
+``(a, b, c, d, e, f)``) and, where it applies, ``cell_size`` in metres and
+``nodata``.
+"""
+from __future__ import annotations
+
+import os
+from typing import Any, Dict, Tuple
+
+import numpy as np
+
+__all__ = ["srtm_alps", "srtm_po_plain", "kilauea_land_mask", "sentinel1_vv_db"]
+
+_HERE = os.path.dirname(__file__)
+_SRTM = "NASA SRTM 3 arc-second DEM, tile N44E007 (US public domain)"
+
+
+def _load(name: str):
+    return np.load(os.path.join(_HERE, name), allow_pickle=False)
+
+
+def _srtm(key: str, description: str) -> Tuple[np.ndarray, Dict[str, Any]]:
+    with _load("srtm_n44e007_crops.npz") as f:
+        z = f[key].copy()
+        r0, c0 = (int(v) for v in f[f"{key}_origin"])
+        a, b, c, d, e, g = (float(v) for v in f["transform"])
+    transform = (a, b, c + c0 * a, d, e, g + r0 * e)
+    lat = transform[5] + e * z.shape[0] / 2
+    cell = (abs(a) * 111_320.0 * np.cos(np.radians(lat)), abs(e) * 110_574.0)
+    return z, {
+        "description": description,
+        "attribution": _SRTM,
+        "crs": "EPSG:4326",
+        "transform": transform,
+        "cell_size": cell,  # (x, y) metres, from latitude
+        "nodata": -32768,
+        "units": "m",
+    }
+
+
+def srtm_alps() -> Tuple[np.ndarray, Dict[str, Any]]:
+    """SRTM DEM of the Maritime Alps, 256 x 256 int16 metres (no voids)."""
+    return _srtm("alps", "SRTM N44E007 rows 536:792, cols 288:544: Maritime Alps")
+
+
+def srtm_po_plain() -> Tuple[np.ndarray, Dict[str, Any]]:
+    """SRTM DEM of the Po plain, 400 x 400 int16 metres (no voids)."""
+    return _srtm("po_plain", "SRTM N44E007 rows 170:570, cols 740:1140: Po plain")
+
+
+def kilauea_land_mask() -> Tuple[np.ndarray, Dict[str, Any]]:
+    """Land mask of the Kilauea 30 m DEM, 793 x 857 bool (False = ocean)."""
+    with _load("kilauea_land_mask.npz") as f:
+        shape = tuple(int(v) for v in f["shape"])
+        mask = np.unpackbits(f["packed"], axis=1, count=shape[1]).astype(bool)
+    return mask, {
+        "description": "Land mask of the 30 m DEM of Kilauea, Hawaii (ocean = DEM nodata)",
+        "attribution": "Kilauea 30 m DEM as distributed with the GMT example data (origin presumably USGS)",
+        "crs": "EPSG:32605",
+        "transform": (30.0, 0.0, 254325.0, 0.0, -30.0, 2153655.0),
+        "cell_size": (30.0, 30.0),
+    }
+
+
+def sentinel1_vv_db() -> Tuple[np.ndarray, Dict[str, Any]]:
+    """Sentinel-1 sigma0 VV in dB, Vega Baja del Segura (Spain), 512 x 512 float32."""
+    with _load("s1_vega_baja_vv_db.npz") as f:
+        vv = f["vv_db"].copy()
+    return vv, {
+        "description": "Sentinel-1 IW GRD sigma0 VV (dB), Vega Baja del Segura, Sept 2019 flood",
+        "attribution": "Contains modified Copernicus Sentinel data 2019 (Sen1Floods11 sample)",
+        "crs": "EPSG:4326",
+        "transform": (8.983152841195215e-05, 0.0, -0.7818936232976315, 0.0, -8.983152841195215e-05, 38.12881257139627),
+        "units": "dB",
+    }
