@@ -85,33 +85,66 @@ struct Src<'a> {
     shape: Shape3,
 }
 
-/// Count foreground and find the bounding box in one parallel pass.
-fn scan(vol: &ByteVolume) -> (u64, Shape3, Shape3) {
+/// Index of the first nonzero byte, scanning eight bytes at a time.
+#[inline]
+fn first_nonzero(row: &[u8]) -> Option<usize> {
+    let words = row.chunks_exact(8);
+    let rem_start = row.len() - words.remainder().len();
+    for (k, w) in words.enumerate() {
+        let v = u64::from_le_bytes(w.try_into().unwrap());
+        if v != 0 {
+            return Some(k * 8 + (v.trailing_zeros() / 8) as usize);
+        }
+    }
+    row[rem_start..].iter().position(|&v| v != 0).map(|p| rem_start + p)
+}
+
+/// Index of the last nonzero byte, scanning eight bytes at a time from the end.
+#[inline]
+fn last_nonzero(row: &[u8]) -> Option<usize> {
+    let words = row.rchunks_exact(8);
+    let rem_len = words.remainder().len();
+    for (k, w) in words.enumerate() {
+        let v = u64::from_le_bytes(w.try_into().unwrap());
+        if v != 0 {
+            return Some(row.len() - 8 * (k + 1) + 7 - (v.leading_zeros() / 8) as usize);
+        }
+    }
+    row[..rem_len].iter().rposition(|&v| v != 0)
+}
+
+/// Bounding box of the foreground (first sample and one past the last, per
+/// axis), or None for an empty set. Rows stop at their first and last
+/// foreground byte, so dense sets are scanned in a fraction of a pass.
+fn scan(vol: &ByteVolume) -> Option<(Shape3, Shape3)> {
     let [_, n1, n2] = vol.shape;
-    let init = || (0u64, [usize::MAX; 3], [0usize; 3]);
-    vol.data
+    let init = || ([usize::MAX; 3], [0usize; 3]);
+    let (lo, hi) = vol
+        .data
         .par_chunks(n2)
         .enumerate()
         .with_min_len((4096 / n2).max(1))
-        .fold(init, |(cnt, mut lo, mut hi), (r, row)| {
-            let c = count_nonzero(row);
-            if c == 0 {
-                return (cnt, lo, hi);
-            }
+        .fold(init, |(mut lo, mut hi), (r, row)| {
+            let Some(first) = first_nonzero(row) else {
+                return (lo, hi);
+            };
+            let last = last_nonzero(row).unwrap_or(first);
             let (i0, i1) = (r / n1, r % n1);
-            let first = row.iter().position(|&v| v != 0).unwrap_or(0);
-            let last = row.iter().rposition(|&v| v != 0).unwrap_or(0);
             lo = [lo[0].min(i0), lo[1].min(i1), lo[2].min(first)];
             hi = [hi[0].max(i0 + 1), hi[1].max(i1 + 1), hi[2].max(last + 1)];
-            (cnt + c, lo, hi)
+            (lo, hi)
         })
         .reduce(init, |a, b| {
             (
-                a.0 + b.0,
-                [a.1[0].min(b.1[0]), a.1[1].min(b.1[1]), a.1[2].min(b.1[2])],
-                [a.2[0].max(b.2[0]), a.2[1].max(b.2[1]), a.2[2].max(b.2[2])],
+                [a.0[0].min(b.0[0]), a.0[1].min(b.0[1]), a.0[2].min(b.0[2])],
+                [a.1[0].max(b.1[0]), a.1[1].max(b.1[1]), a.1[2].max(b.1[2])],
             )
-        })
+        });
+    if lo[0] == usize::MAX {
+        None
+    } else {
+        Some((lo, hi))
+    }
 }
 
 /// Number of nonzero bytes (vectorises: bytes are mapped to 0/1 and summed in chunks).
@@ -131,9 +164,51 @@ pub fn count_nonzero(row: &[u8]) -> u64 {
     total
 }
 
+/// OR of the byte pairs of a little-endian word: bytes (b0|b1, b2|b3, b4|b5,
+/// b6|b7) in the low four bytes.
+#[inline(always)]
+fn pair_or_word(w: u64) -> u64 {
+    let x = (w | (w >> 8)) & 0x00FF_00FF_00FF_00FF;
+    let x = (x | (x >> 8)) & 0x0000_FFFF_0000_FFFF;
+    (x | (x >> 16)) & 0x0000_0000_FFFF_FFFF
+}
+
+/// OR adjacent byte pairs of `row` (the first box holds one byte when the
+/// shift `c` is 1) into `out`: overwrite when `first`, else OR into it.
+/// Works on 16 input bytes at a time with word arithmetic.
+#[inline]
+fn pair_or_into(row: &[u8], c: usize, out: &mut [u8], first: bool) {
+    let (rest, out_rest) = if c == 1 {
+        let (h, r) = row.split_at(1);
+        let (oh, orr) = out.split_at_mut(1);
+        oh[0] = if first { h[0] } else { oh[0] | h[0] };
+        (r, orr)
+    } else {
+        (row, out)
+    };
+    let n16 = rest.len() / 16;
+    let (body, tail) = rest.split_at(n16 * 16);
+    let (obody, otail) = out_rest.split_at_mut(n16 * 8);
+    for (o, ch) in obody.chunks_exact_mut(8).zip(body.chunks_exact(16)) {
+        let lo = u64::from_le_bytes(ch[..8].try_into().unwrap());
+        let hi = u64::from_le_bytes(ch[8..].try_into().unwrap());
+        let mut v = pair_or_word(lo) | (pair_or_word(hi) << 32);
+        if !first {
+            v |= u64::from_le_bytes((&*o).try_into().unwrap());
+        }
+        o.copy_from_slice(&v.to_le_bytes());
+    }
+    for (k, o) in otail.iter_mut().enumerate() {
+        let v = tail.get(2 * k).copied().unwrap_or(0) | tail.get(2 * k + 1).copied().unwrap_or(0);
+        *o = if first { v } else { *o | v };
+    }
+}
+
 /// Block-OR reduction of `src` by factors `m` and shifts `c` per axis.
 /// Returns the reduced grid and its number of occupied boxes.
-fn reduce_or(src: &Src, m: Shape3, c: Shape3) -> (Grid, u64) {
+/// Also returns the number of nonzero source bytes read (every source byte
+/// lies in exactly one box, so this is the source's count).
+fn reduce_or(src: &Src, m: Shape3, c: Shape3) -> (Grid, u64, u64) {
     let out_shape = [
         n_boxes(src.shape[0], m[0], c[0]),
         n_boxes(src.shape[1], m[1], c[1]),
@@ -142,7 +217,7 @@ fn reduce_or(src: &Src, m: Shape3, c: Shape3) -> (Grid, u64) {
     let n2 = src.shape[2];
     let o2 = out_shape[2];
     let mut out = vec![0u8; out_shape[0] * out_shape[1] * o2];
-    let count: u64 = out
+    let (count, src_count): (u64, u64) = out
         .par_chunks_mut(o2)
         .enumerate()
         .with_min_len((1 << 14) / (n2 * m[0] * m[1]).max(1) + 1)
@@ -152,11 +227,29 @@ fn reduce_or(src: &Src, m: Shape3, c: Shape3) -> (Grid, u64) {
                 let (b0, b1) = (idx / out_shape[1], idx % out_shape[1]);
                 let (lo0, hi0) = box_range(b0, m[0], c[0], src.shape[0]);
                 let (lo1, hi1) = box_range(b1, m[1], c[1], src.shape[1]);
+                if m[2] == 2 {
+                    // Fast path of the dyadic pyramid: OR byte pairs of every source
+                    // row straight into the output row (vectorises; no accumulator).
+                    let mut first = true;
+                    let mut read = 0u64;
+                    for i in lo0..hi0 {
+                        for j in lo1..hi1 {
+                            let off = src.start + i * src.strides[0] + j * src.strides[1];
+                            let row = &src.data[off..off + n2];
+                            read += count_nonzero(row);
+                            pair_or_into(row, c[2], orow, first);
+                            first = false;
+                        }
+                    }
+                    return (count_nonzero(orow), read);
+                }
                 acc.iter_mut().for_each(|a| *a = 0);
+                let mut read = 0u64;
                 for i in lo0..hi0 {
                     for j in lo1..hi1 {
                         let off = src.start + i * src.strides[0] + j * src.strides[1];
                         let row = &src.data[off..off + n2];
+                        read += count_nonzero(row);
                         for (a, &v) in acc.iter_mut().zip(row) {
                             *a |= v;
                         }
@@ -185,11 +278,11 @@ fn reduce_or(src: &Src, m: Shape3, c: Shape3) -> (Grid, u64) {
                         cnt += *o as u64;
                     }
                 }
-                cnt
+                (cnt, read)
             },
         )
-        .sum();
-    (Grid { data: out, shape: out_shape }, count)
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    (Grid { data: out, shape: out_shape }, count, src_count)
 }
 
 /// Default box sizes for a set whose bounding box spans `extent` samples along
@@ -247,10 +340,12 @@ pub fn box_count(
     if !box_sizes.is_empty() {
         validate_box_sizes(box_sizes, max_len)?;
     }
-    let (n_fg, bmin, bmax) = scan(vol);
-    if n_fg == 0 {
+    let Some((bmin, bmax)) = scan(vol) else {
         return Err(CoreError::invalid("data", "the set is empty (no foreground sample)"));
-    }
+    };
+    // the number of foreground samples (the count at size 1) comes from the
+    // first reduction of the data, which reads every sample once
+    let mut n_fg: Option<u64> = None;
     let sizes = if box_sizes.is_empty() {
         let extent = (0..3).map(|a| bmax[a] - bmin[a]).max().unwrap_or(1);
         validate_box_sizes(&default_box_sizes(extent), max_len).map_err(|_| {
@@ -283,8 +378,7 @@ pub fn box_count(
         let mut grids: Vec<Grid> = Vec::new();
         for (i, &s) in sizes.iter().enumerate() {
             if s == 1 {
-                counts[i][j] = n_fg;
-                continue;
+                continue; // filled in below from n_fg
             }
             let t = best_source(s, &done);
             let m_ = s / t;
@@ -295,7 +389,9 @@ pub fn box_count(
                 c[a] = ((g[a] % s) - (g[a] % t)) / t;
             }
             let (grid, cnt) = if t == 1 {
-                reduce_or(&base, m, c)
+                let (g, cnt, read) = reduce_or(&base, m, c);
+                n_fg.get_or_insert(read);
+                (g, cnt)
             } else {
                 let k = done.iter().position(|&d| d == t).unwrap();
                 let gsrc = &grids[k];
@@ -305,12 +401,17 @@ pub fn box_count(
                     strides: [gsrc.shape[1] * gsrc.shape[2], gsrc.shape[2]],
                     shape: gsrc.shape,
                 };
-                reduce_or(&src, m, c)
+                let (g, cnt, _) = reduce_or(&src, m, c);
+                (g, cnt)
             };
             counts[i][j] = cnt;
             done.push(s);
             grids.push(grid);
         }
+    }
+    let n_fg = n_fg.ok_or_else(|| CoreError::Internal("no reduction of the data was made".into()))?;
+    if sizes[0] == 1 {
+        counts[0].iter_mut().for_each(|c| *c = n_fg);
     }
     Ok(BoxCounts { box_sizes: sizes, shifts, counts, n_foreground: n_fg, bbox_min: bmin, bbox_max: bmax })
 }
@@ -322,7 +423,7 @@ mod tests {
     /// Direct count: box of every foreground sample, deduplicated.
     fn naive(data: &[u8], dims: &[usize], s: usize, g: Shape3, anchor: Anchor) -> u64 {
         let vol = ByteVolume::new(data, dims).unwrap();
-        let (_, bmin, _) = scan(&vol);
+        let (bmin, _) = scan(&vol).unwrap();
         let lo = if anchor == Anchor::BoundingBox { bmin } else { [0; 3] };
         let mut set = std::collections::HashSet::new();
         let [n0, n1, n2] = vol.shape;
