@@ -88,3 +88,13 @@ def test_demo_prints_fits_and_writes_figure(tmp_path, capsys):
     d = float(line.split("D = ")[1].split()[0])
     assert 1.0 <= d < 1.3
     assert not [f for f in os.listdir(tmp_path) if f.startswith(".")]  # no temp files left
+
+
+def test_written_files_have_normal_permissions(tmp_path, capsys):
+    path = tmp_path / "tri.npy"
+    np.save(path, sierpinski_triangle(6))
+    plot = tmp_path / "fit.png"
+    run(["dimension", str(path), "--plot", str(plot)], capsys)
+    umask = os.umask(0)
+    os.umask(umask)
+    assert plot.stat().st_mode & 0o777 == 0o666 & ~umask

@@ -10,6 +10,7 @@ The package mirrors the Rust crate's domains: :mod:`fractalgeo_rs.dimension`
 :mod:`fractalgeo_rs.lsystem`.
 """
 from fractalgeo_rs._core import __version__
+from fractalgeo_rs import data, io
 from fractalgeo_rs.fit import DimensionFit
 from fractalgeo_rs.dimension import (
     box_counting,
@@ -23,6 +24,8 @@ from fractalgeo_rs.dimension import (
 
 __all__ = [
     "__version__",
+    "data",
+    "io",
     "DimensionFit",
     "box_counting",
     "box_counting_points",
