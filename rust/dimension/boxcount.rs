@@ -227,32 +227,28 @@ fn reduce_or(src: &Src, m: Shape3, c: Shape3) -> (Grid, u64, u64) {
                 let (b0, b1) = (idx / out_shape[1], idx % out_shape[1]);
                 let (lo0, hi0) = box_range(b0, m[0], c[0], src.shape[0]);
                 let (lo1, hi1) = box_range(b1, m[1], c[1], src.shape[1]);
+                let rows = (lo0..hi0).flat_map(|i| (lo1..hi1).map(move |j| (i, j)));
+                let row_at = |(i, j): (usize, usize)| {
+                    let off = src.start + i * src.strides[0] + j * src.strides[1];
+                    &src.data[off..off + n2]
+                };
+                let mut read = 0u64;
                 if m[2] == 2 {
                     // Fast path of the dyadic pyramid: OR byte pairs of every source
-                    // row straight into the output row (vectorises; no accumulator).
-                    let mut first = true;
-                    let mut read = 0u64;
-                    for i in lo0..hi0 {
-                        for j in lo1..hi1 {
-                            let off = src.start + i * src.strides[0] + j * src.strides[1];
-                            let row = &src.data[off..off + n2];
-                            read += count_nonzero(row);
-                            pair_or_into(row, c[2], orow, first);
-                            first = false;
-                        }
+                    // row straight into the output row (word-wise; no accumulator).
+                    for (k, ij) in rows.enumerate() {
+                        let row = row_at(ij);
+                        read += count_nonzero(row);
+                        pair_or_into(row, c[2], orow, k == 0);
                     }
                     return (count_nonzero(orow), read);
                 }
                 acc.iter_mut().for_each(|a| *a = 0);
-                let mut read = 0u64;
-                for i in lo0..hi0 {
-                    for j in lo1..hi1 {
-                        let off = src.start + i * src.strides[0] + j * src.strides[1];
-                        let row = &src.data[off..off + n2];
-                        read += count_nonzero(row);
-                        for (a, &v) in acc.iter_mut().zip(row) {
-                            *a |= v;
-                        }
+                for ij in rows {
+                    let row = row_at(ij);
+                    read += count_nonzero(row);
+                    for (a, &v) in acc.iter_mut().zip(row) {
+                        *a |= v;
                     }
                 }
                 let mut cnt = 0u64;
@@ -260,16 +256,6 @@ fn reduce_or(src: &Src, m: Shape3, c: Shape3) -> (Grid, u64, u64) {
                     for (o, &a) in orow.iter_mut().zip(acc.iter()) {
                         *o = (a != 0) as u8;
                         cnt += *o as u64;
-                    }
-                } else if m[2] == 2 && c[2] == 0 {
-                    let (pairs, rest) = acc.split_at(n2 & !1);
-                    for (o, p) in orow.iter_mut().zip(pairs.chunks_exact(2)) {
-                        *o = ((p[0] | p[1]) != 0) as u8;
-                        cnt += *o as u64;
-                    }
-                    if let Some(&r) = rest.first() {
-                        orow[o2 - 1] = (r != 0) as u8;
-                        cnt += orow[o2 - 1] as u64;
                     }
                 } else {
                     for (b2, o) in orow.iter_mut().enumerate() {

@@ -42,6 +42,19 @@ __all__ = [
 ]
 
 
+def _lattice_fit(method, sizes, counts, offset_reduce, scale_range, x_label, y_label, extra) -> DimensionFit:
+    """Fit ``D = -slope`` to lattice counts combined over the shifted lattices."""
+    return fit_loglog(
+        sizes,
+        reduce_offsets(counts, offset_reduce),
+        method=method,
+        scale_range=scale_range,
+        x_label=x_label,
+        y_label=y_label,
+        extra={"counts": counts, "offset_reduce": offset_reduce, **extra},
+    )
+
+
 def _binary_bytes(data) -> Tuple[np.ndarray, bool]:
     """A C-contiguous uint8 view (0/1) of a binary set, and whether the axes
     were reversed (a Fortran-ordered input is counted through its transpose,
@@ -155,24 +168,9 @@ def box_counting(
     s, counts, n_fg, lo, hi = _core.box_count_binary(b, sizes or [], offsets, anchor == "bbox", n_threads)
     if transposed:
         lo, hi = lo[::-1], hi[::-1]
-    measures = reduce_offsets(counts, offset_reduce)
-    return fit_loglog(
-        s,
-        measures,
-        method="box",
-        dim_offset=0.0,
-        dim_factor=-1.0,
-        scale_range=scale_range,
-        x_label="box size s (samples)",
-        y_label="occupied boxes N(s)",
-        extra={
-            "counts": counts,
-            "n_foreground": int(n_fg),
-            "bbox": (tuple(lo), tuple(hi)),
-            "offsets": offsets,
-            "offset_reduce": offset_reduce,
-            "anchor": anchor,
-        },
+    return _lattice_fit(
+        "box", s, counts, offset_reduce, scale_range, "box size s (samples)", "occupied boxes N(s)",
+        {"n_foreground": int(n_fg), "bbox": (tuple(lo), tuple(hi)), "offsets": offsets, "anchor": anchor},
     )
 
 
@@ -219,6 +217,7 @@ def box_counting_points(
     pts = np.ascontiguousarray(arr, dtype=np.float64)
     sizes = check_box_sizes(box_sizes, integer=False)
     offsets = check_positive_int(offsets, "offsets")
+    check_choice(offset_reduce, "offset_reduce", ("mean", "min"))
     n_threads = check_n_threads(n_threads)
     n = pts.shape[0]
     if sizes is None:
@@ -236,14 +235,9 @@ def box_counting_points(
         s, counts = s[keep], counts[keep]
     else:
         s, counts = _core.box_count_points(pts, sizes, offsets, n_threads)
-    return fit_loglog(
-        s,
-        reduce_offsets(counts, offset_reduce),
-        method="points",
-        scale_range=scale_range,
-        x_label="box size s",
-        y_label="occupied boxes N(s)",
-        extra={"counts": counts, "n_points": n, "offsets": offsets, "offset_reduce": offset_reduce},
+    return _lattice_fit(
+        "points", s, counts, offset_reduce, scale_range, "box size s", "occupied boxes N(s)",
+        {"n_points": n, "offsets": offsets},
     )
 
 
@@ -330,6 +324,7 @@ def differential_box_counting(
     z = _surface_float(image, nodata, "image")
     sizes = check_box_sizes(box_sizes)
     offsets = check_positive_int(offsets, "offsets")
+    check_choice(offset_reduce, "offset_reduce", ("mean", "min"))
     n_threads = check_n_threads(n_threads)
     valid = z[~np.isnan(z)]
     if valid.size == 0:
@@ -347,14 +342,9 @@ def differential_box_counting(
                 f"image: shape {z.shape} is too small for the default box sizes 2, 4, 8 (needs at least 32 pixels a side); give box_sizes"
             )
     s, counts = _core.dbc_count(z, sizes, offsets, z0, z_unit, n_threads)
-    return fit_loglog(
-        s,
-        reduce_offsets(counts, offset_reduce),
-        method="dbc",
-        scale_range=scale_range,
-        x_label="box size s (pixels)",
-        y_label="box count N(s)",
-        extra={"counts": counts, "z_scale": z_unit, "z0": z0, "offsets": offsets, "offset_reduce": offset_reduce},
+    return _lattice_fit(
+        "dbc", s, counts, offset_reduce, scale_range, "box size s (pixels)", "box count N(s)",
+        {"z_scale": z_unit, "z0": z0, "offsets": offsets},
     )
 
 
