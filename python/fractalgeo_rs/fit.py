@@ -154,7 +154,7 @@ def _ols(x: np.ndarray, y: np.ndarray):
     sse = float(np.sum(resid**2))
     syy = float(np.sum((y - ym) ** 2))
     r2 = 1.0 - sse / syy if syy > 0 else 1.0
-    se = math.sqrt(sse / (n - 2) / sxx) if n > 2 else float("inf")
+    se = math.sqrt(sse / (n - 2) / sxx) if n > 2 else float("nan")
     return slope, float(intercept), r2, se
 
 
@@ -182,6 +182,7 @@ def fit_loglog(
     dim_factor: float = -1.0,
     scale_range: ScaleRange = None,
     min_points: Optional[int] = None,
+    min_scales: int = 3,
     x_label: str = "scale",
     y_label: str = "measure",
     extra: Optional[Mapping[str, Any]] = None,
@@ -205,7 +206,10 @@ def fit_loglog(
         ``range_selection``.
     min_points : int, optional
         Fewest scales in an automatic range (default ``max(3, ceil(n / 2))``).
-        A user range must also hold at least 3 scales.
+    min_scales : int, default 3
+        Fewest scales a fit may use. Estimators that by design fit two lags
+        (variogram and madogram at lags 1 and 2, Gneiting et al. 2012) pass 2;
+        such a fit is exact, its ``stderr`` and ``ci95`` are NaN.
 
     Returns
     -------
@@ -218,9 +222,9 @@ def fit_loglog(
     order = np.argsort(s, kind="stable")
     s, m = s[order], m[order]
     valid = np.isfinite(s) & np.isfinite(m) & (s > 0) & (m > 0)
-    if np.count_nonzero(valid) < 3:
+    if np.count_nonzero(valid) < min_scales:
         raise ValueError(
-            f"box_sizes: need at least 3 scales with a positive measure for a fit, got {np.count_nonzero(valid)}"
+            f"box_sizes: need at least {min_scales} scales with a positive measure for a fit, got {np.count_nonzero(valid)}"
         )
     if scale_range is None:
         used = valid.copy()
@@ -245,9 +249,9 @@ def fit_loglog(
         if not (lo <= hi):
             raise ValueError(f"scale_range: low must not exceed high, got ({lo}, {hi})")
         used = valid & (s >= lo) & (s <= hi)
-        if np.count_nonzero(used) < 3:
+        if np.count_nonzero(used) < min_scales:
             raise ValueError(
-                f"scale_range: ({lo:g}, {hi:g}) holds {np.count_nonzero(used)} usable scales, need at least 3"
+                f"scale_range: ({lo:g}, {hi:g}) holds {np.count_nonzero(used)} usable scales, need at least {min_scales}"
             )
         selection = "user"
     x, y = np.log(s[used]), np.log(m[used])
@@ -256,8 +260,10 @@ def fit_loglog(
     dse = abs(dim_factor) * se
     from scipy.stats import t as student_t
 
-    q = float(student_t.ppf(0.975, len(x) - 2))
-    half = q * dse
+    if len(x) > 2:
+        half = float(student_t.ppf(0.975, len(x) - 2)) * dse
+    else:
+        dse = half = float("nan")
     return DimensionFit(
         dimension=float(dim),
         slope=float(slope),

@@ -10,7 +10,20 @@ method         data                                             function
 ``"points"``   point sets, (N, d) coordinates                   :func:`box_counting_points`
 ``"dbc"``      grayscale images, DEMs                           :func:`differential_box_counting`
 ``"affine"``   graphs of profiles and surfaces (self-affine)    :func:`self_affine_box_counting`
+``"minkowski"`` binary sets (sausage of radius r)               :func:`minkowski`
+``"mass"``     binary images, point sets, grayscale (P(m,L))    :func:`mass_dimension`
+``"blanket"``  grayscale surfaces (Peleg covering blanket)      :func:`blanket`
+``"spectral"`` profiles and surfaces (power spectrum)           :func:`spectral_dimension`
+``"variogram"`` profiles (p=2, first differences, lags 1, 2)    :func:`variogram`
+``"madogram"`` profiles (p=1, first differences, lags 1, 2)     :func:`madogram`
+``"variation"`` profiles, power variation (p, order)            :func:`power_variation`
+``"surface_variation"`` surfaces: square, first or transect     :func:`surface_variation`
+``"wavelet"``  profiles and surfaces (Haar detail variance)     :func:`wavelet_dimension`
+``"scale_space"`` profiles (Gaussian scale space, eq. 14)       :func:`scale_space`
+``"higuchi"``  profiles and time series                         :func:`higuchi`
 =============  ===============================================  =====================================
+
+:func:`lacunarity` (gliding box) returns its own :class:`Lacunarity` result.
 """
 from __future__ import annotations
 
@@ -22,10 +35,28 @@ from fractalgeo_rs.dimension.boxcount import (
     differential_box_counting,
     self_affine_box_counting,
 )
+from fractalgeo_rs.dimension.lacunarity import Lacunarity, lacunarity
+from fractalgeo_rs.dimension.profile import higuchi, scale_space, wavelet_dimension
+from fractalgeo_rs.dimension.spectral import spectral_dimension
+from fractalgeo_rs.dimension.surface import blanket, mass_dimension, minkowski
+from fractalgeo_rs.dimension.variation import madogram, power_variation, surface_variation, variogram
 from fractalgeo_rs.fit import DimensionFit
 
 __all__ = [
     "METHODS",
+    "Lacunarity",
+    "blanket",
+    "higuchi",
+    "lacunarity",
+    "madogram",
+    "mass_dimension",
+    "minkowski",
+    "power_variation",
+    "scale_space",
+    "spectral_dimension",
+    "surface_variation",
+    "variogram",
+    "wavelet_dimension",
     "box_counting",
     "box_counting_points",
     "differential_box_counting",
@@ -38,6 +69,17 @@ METHODS: Dict[str, Callable[..., DimensionFit]] = {
     "points": box_counting_points,
     "dbc": differential_box_counting,
     "affine": self_affine_box_counting,
+    "minkowski": minkowski,
+    "mass": mass_dimension,
+    "blanket": blanket,
+    "spectral": spectral_dimension,
+    "variogram": variogram,
+    "madogram": madogram,
+    "variation": power_variation,
+    "surface_variation": surface_variation,
+    "wavelet": wavelet_dimension,
+    "scale_space": scale_space,
+    "higuchi": higuchi,
 }
 
 
