@@ -1,1 +1,18 @@
-//! Placeholder: filled by its issue.
+//! L-systems, turtle geometry and iterated function systems.
+//!
+//! | module | what |
+//! |---|---|
+//! | [`expr`] | arithmetic and logical expressions of parametric productions |
+//! | [`grammar`] | module strings, productions, the rule text format |
+//! | [`derive`] | parallel (stochastic, context-sensitive, parametric) rewriting |
+//!
+//! References: P. Prusinkiewicz and A. Lindenmayer, *The Algorithmic Beauty
+//! of Plants*, Springer 1990 (ABOP); M. Barnsley, *Fractals Everywhere*,
+//! Academic Press 1988; J. E. Hutchinson, Fractals and self-similarity,
+//! *Indiana Univ. Math. J.* 30 (1981) 713-747.
+pub mod derive;
+pub mod expr;
+pub mod grammar;
+
+pub use derive::LSystem;
+pub use grammar::ModString;
