@@ -5,14 +5,20 @@
 //! | [`expr`] | arithmetic and logical expressions of parametric productions |
 //! | [`grammar`] | module strings, productions, the rule text format |
 //! | [`derive`] | parallel (stochastic, context-sensitive, parametric) rewriting |
+//! | [`turtle`] | 2D and 3D turtle interpretation |
+//! | [`mesh`] | generalised cylinders and leaf polygons |
+//! | [`export`] | OBJ and PLY files |
 //!
 //! References: P. Prusinkiewicz and A. Lindenmayer, *The Algorithmic Beauty
 //! of Plants*, Springer 1990 (ABOP); M. Barnsley, *Fractals Everywhere*,
 //! Academic Press 1988; J. E. Hutchinson, Fractals and self-similarity,
 //! *Indiana Univ. Math. J.* 30 (1981) 713-747.
 pub mod derive;
+pub mod export;
 pub mod expr;
 pub mod grammar;
+pub mod mesh;
+pub mod turtle;
 
 pub use derive::LSystem;
 pub use grammar::ModString;
