@@ -8,6 +8,8 @@
 //! | [`turtle`] | 2D and 3D turtle interpretation |
 //! | [`mesh`] | generalised cylinders and leaf polygons |
 //! | [`export`] | OBJ and PLY files |
+//! | [`ifs`] | iterated function systems, presets, Moran's equation |
+//! | [`terrain`] | stochastic plants placed on a DEM, one scene mesh |
 //!
 //! References: P. Prusinkiewicz and A. Lindenmayer, *The Algorithmic Beauty
 //! of Plants*, Springer 1990 (ABOP); M. Barnsley, *Fractals Everywhere*,
@@ -17,7 +19,9 @@ pub mod derive;
 pub mod export;
 pub mod expr;
 pub mod grammar;
+pub mod ifs;
 pub mod mesh;
+pub mod terrain;
 pub mod turtle;
 
 pub use derive::LSystem;
