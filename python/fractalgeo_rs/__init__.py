@@ -14,10 +14,14 @@ from fractalgeo_rs.fit import DimensionFit
 from fractalgeo_rs.dimension import box_counting, dimension
 
 # -- domain exports: each issue adds its own line below --
+from fractalgeo_rs.lsystem import IFS, LString, LSystem
 
 __all__ = [
     "__version__",
     "DimensionFit",
     "box_counting",
     "dimension",
+    "IFS",
+    "LString",
+    "LSystem",
 ]
