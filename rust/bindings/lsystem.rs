@@ -207,10 +207,17 @@ fn mesh_arrays(py: Python<'_>, m: Mesh) -> MeshArrays<'_> {
 
 /// Mesh of a module string: (vertices, normals, uvs, faces, part_ids, kinds, colors, instances).
 #[pyfunction]
-fn turtle_mesh<'py>(py: Python<'py>, lstring: &ModuleString, turtle: TurtleArgs, sides: usize) -> PyResult<MeshArrays<'py>> {
+#[pyo3(signature = (lstring, turtle, sides, n_threads=None))]
+fn turtle_mesh<'py>(
+    py: Python<'py>,
+    lstring: &ModuleString,
+    turtle: TurtleArgs,
+    sides: usize,
+    n_threads: Option<usize>,
+) -> PyResult<MeshArrays<'py>> {
     let s = lstring.inner.clone();
     let p = turtle_params(turtle);
-    let m = py.detach(|| build_mesh(&s, &p, sides))?;
+    let m = py.detach(|| run_in_pool(n_threads, || build_mesh(&s, &p, sides)))?;
     Ok(mesh_arrays(py, m))
 }
 

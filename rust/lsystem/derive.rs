@@ -39,6 +39,9 @@ pub fn unit3(seed: u64, a: u64, b: u64) -> f64 {
     (hash3(seed, a, b) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
+/// Successor tables of a deterministic context-free system: ASCII by code, others by map.
+type DolTable = (Vec<Option<Vec<char>>>, HashMap<char, Vec<char>>);
+
 /// A compiled L-system.
 #[derive(Debug, Clone)]
 pub struct LSystem {
@@ -53,7 +56,7 @@ pub struct LSystem {
     parametric: bool,
     max_slots: usize,
     /// Fast path: deterministic, context-free, condition-free, non-parametric.
-    dol: Option<(Vec<Option<Vec<char>>>, HashMap<char, Vec<char>>)>,
+    dol: Option<DolTable>,
 }
 
 /// Per-chunk output.

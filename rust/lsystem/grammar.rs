@@ -483,10 +483,13 @@ fn compile_group(lhs: &str, items: &[(Option<f64>, String)], line: &str) -> Core
     })
 }
 
+/// Lines with one left-hand side: (lhs, [(weight, successor)], first line).
+type RuleGroup = (String, Vec<(Option<f64>, String)>, String);
+
 /// Compile production lines. Lines with a weighted arrow and the same
 /// left-hand side (whitespace ignored) form one stochastic production.
 pub fn compile_rules(lines: &[String]) -> CoreResult<Vec<Rule>> {
-    let mut groups: Vec<(String, Vec<(Option<f64>, String)>, String)> = Vec::new();
+    let mut groups: Vec<RuleGroup> = Vec::new();
     let mut index: HashMap<String, usize> = HashMap::new();
     for line in lines {
         let line = line.trim();

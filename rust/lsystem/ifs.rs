@@ -384,6 +384,7 @@ mod tests {
     /// shrinks only slowly with resolution). The fern is not a similarity
     /// IFS and has no exact dimension to compare with.
     #[test]
+    #[allow(clippy::type_complexity)]
     fn box_counting_matches_similarity_dimension() {
         let cases: [(&str, usize, usize, [f64; 4], &[usize], f64); 5] = [
             ("sierpinski_triangle", 11, 1024, [0.0, 1.0, 0.0, 1.0], &[4, 8, 16, 32, 64, 128], 0.03),

@@ -15,6 +15,7 @@ use super::grammar::ModString;
 use super::turtle::{interpret, Sink, State, TurtleParams, NO_TAG};
 use crate::error::{CoreError, CoreResult};
 use glam::{DQuat, DVec3};
+use rayon::prelude::*;
 
 /// Triangle kinds in [`Mesh::kinds`].
 pub const KIND_BRANCH: u8 = 0;
@@ -59,25 +60,31 @@ impl Mesh {
     }
 }
 
+/// A ring of a tube, before its vertices are made.
 struct Ring {
-    first: u32,
+    center: DVec3,
+    axis: DVec3,
     reference: DVec3,
+    radius: f64,
     v: f64,
 }
 
-/// The mesh builder: a turtle [`Sink`].
+/// The mesh builder: a turtle [`Sink`]. The turtle pass only records rings
+/// and tubes (cheap, sequential: each ring's reference depends on the one
+/// before); [`MeshBuilder::finish`] then writes vertices and triangles in
+/// parallel.
 pub struct MeshBuilder {
-    pub mesh: Mesh,
     sides: usize,
     cos_sin: Vec<(f64, f64)>,
     rings: Vec<Ring>,
-    n_segments: u32,
+    /// (start ring, end ring, colour) per segment.
+    tubes: Vec<(u32, u32, u32)>,
+    leaves: Mesh,
     n_leaves: u32,
-    overflow: bool,
 }
 
 impl MeshBuilder {
-    /// A builder for tubes of `sides` (>= 3) sides.
+    /// A builder for tubes of `sides` (3 to 64) sides.
     pub fn new(sides: usize) -> CoreResult<Self> {
         if !(3..=64).contains(&sides) {
             return Err(CoreError::invalid("sides", format!("must be between 3 and 64, got {sides}")));
@@ -88,31 +95,73 @@ impl MeshBuilder {
                 (t.cos(), t.sin())
             })
             .collect();
-        Ok(MeshBuilder { mesh: Mesh::default(), sides, cos_sin, rings: Vec::new(), n_segments: 0, n_leaves: 0, overflow: false })
+        Ok(MeshBuilder { sides, cos_sin, rings: Vec::new(), tubes: Vec::new(), leaves: Mesh::default(), n_leaves: 0 })
+    }
+
+    /// Reserve room for about `n` segments.
+    pub fn reserve(&mut self, n: usize) {
+        self.rings.reserve(n + n / 4);
+        self.tubes.reserve(n);
     }
 
     fn ring(&mut self, center: DVec3, axis: DVec3, reference: DVec3, radius: f64, v: f64) -> u32 {
-        let first = self.mesh.vertices.len();
-        if first + self.sides + 1 > u32::MAX as usize {
-            self.overflow = true;
-        }
-        let side = axis.cross(reference);
-        for (j, &(c, s)) in self.cos_sin.iter().enumerate() {
-            let n = reference * c + side * s;
-            self.mesh.vertices.push((center + n * radius).as_vec3().to_array());
-            self.mesh.normals.push(n.as_vec3().to_array());
-            self.mesh.uvs.push([j as f32 / self.sides as f32, v as f32]);
-        }
-        self.rings.push(Ring { first: first as u32, reference, v });
+        self.rings.push(Ring { center, axis, reference, radius, v });
         (self.rings.len() - 1) as u32
     }
 
-    /// Finish; errors when the mesh is too large for u32 indices.
+    /// Write the vertices and triangles (in parallel in the current rayon
+    /// pool). Errors when the mesh is too large for u32 indices.
     pub fn finish(self) -> CoreResult<Mesh> {
-        if self.overflow {
+        let k1 = self.sides + 1;
+        let n_tube_v = self.rings.len() * k1;
+        if n_tube_v + self.leaves.vertices.len() > u32::MAX as usize {
             return Err(CoreError::invalid("lstring", "the mesh has more than 2^32 vertices"));
         }
-        Ok(self.mesh)
+        let mut m = Mesh {
+            vertices: vec![[0.0; 3]; n_tube_v],
+            normals: vec![[0.0; 3]; n_tube_v],
+            uvs: vec![[0.0; 2]; n_tube_v],
+            ..Mesh::default()
+        };
+        let (cs, sides) = (&self.cos_sin, self.sides);
+        m.vertices
+            .par_chunks_mut(k1)
+            .zip(m.normals.par_chunks_mut(k1))
+            .zip(m.uvs.par_chunks_mut(k1))
+            .zip(self.rings.par_iter())
+            .for_each(|(((vs, ns), ts), r)| {
+                let side = r.axis.cross(r.reference);
+                for (j, &(c, s)) in cs.iter().enumerate() {
+                    let n = r.reference * c + side * s;
+                    vs[j] = (r.center + n * r.radius).as_vec3().to_array();
+                    ns[j] = n.as_vec3().to_array();
+                    ts[j] = [j as f32 / sides as f32, r.v as f32];
+                }
+            });
+        let per = 2 * sides;
+        let nt = self.tubes.len() * per;
+        m.faces = vec![[0; 3]; nt];
+        m.part_ids = vec![0; nt];
+        m.colors = vec![0; nt];
+        m.faces
+            .par_chunks_mut(per)
+            .zip(m.part_ids.par_chunks_mut(per))
+            .zip(m.colors.par_chunks_mut(per))
+            .zip(self.tubes.par_iter().enumerate())
+            .for_each(|(((fs, ps), cl), (i, &(a, b, color)))| {
+                let (a, b) = (a * k1 as u32, b * k1 as u32);
+                for j in 0..sides as u32 {
+                    let (a0, a1, b0, b1) = (a + j, a + j + 1, b + j, b + j + 1);
+                    fs[2 * j as usize] = [a0, a1, b1];
+                    fs[2 * j as usize + 1] = [a0, b1, b0];
+                }
+                ps.fill(i as u32);
+                cl.fill(color);
+            });
+        m.kinds = vec![KIND_BRANCH; nt];
+        m.instances = vec![0; nt];
+        m.append_transformed(&self.leaves, 0, |v| v, |n| n)?;
+        Ok(m)
     }
 }
 
@@ -140,32 +189,19 @@ impl Sink for MeshBuilder {
             return from.tag;
         }
         let axis = d / len;
-        let r = 0.5 * from.width;
         let start = if from.tag != NO_TAG {
             from.tag
         } else {
             let reference = perpendicular(from.l, axis, from.u);
-            self.ring(from.pos, axis, reference, r, 0.0)
+            self.ring(from.pos, axis, reference, 0.5 * from.width, 0.0)
         };
-        let (s_ref, s_v, s_first) = {
+        let (s_ref, s_v) = {
             let s = &self.rings[start as usize];
-            (s.reference, s.v, s.first)
+            (s.reference, s.v)
         };
         let reference = perpendicular(s_ref, axis, from.l);
         let end = self.ring(to.pos, axis, reference, 0.5 * to.width, s_v + len);
-        let e_first = self.rings[end as usize].first;
-        let part = self.n_segments;
-        self.n_segments += 1;
-        for j in 0..self.sides as u32 {
-            let (a0, a1, b0, b1) = (s_first + j, s_first + j + 1, e_first + j, e_first + j + 1);
-            self.mesh.faces.push([a0, a1, b1]);
-            self.mesh.faces.push([a0, b1, b0]);
-        }
-        let n = 2 * self.sides;
-        self.mesh.part_ids.extend(std::iter::repeat_n(part, n));
-        self.mesh.kinds.extend(std::iter::repeat_n(KIND_BRANCH, n));
-        self.mesh.colors.extend(std::iter::repeat_n(from.color, n));
-        self.mesh.instances.extend(std::iter::repeat_n(0, n));
+        self.tubes.push((start, end, from.color));
         end
     }
 
@@ -196,21 +232,21 @@ impl Sink for MeshBuilder {
                 c
             })
             .collect();
-        let first = self.mesh.vertices.len() as u32;
+        let first = self.leaves.vertices.len() as u32;
         for (p, c) in pts.iter().zip(&uv) {
-            self.mesh.vertices.push(p.as_vec3().to_array());
-            self.mesh.normals.push(nrm.as_vec3().to_array());
+            self.leaves.vertices.push(p.as_vec3().to_array());
+            self.leaves.normals.push(nrm.as_vec3().to_array());
             let u = |k: usize| if hi[k] > lo[k] { ((c[k] - lo[k]) / (hi[k] - lo[k])) as f32 } else { 0.0 };
-            self.mesh.uvs.push([u(0), u(1)]);
+            self.leaves.uvs.push([u(0), u(1)]);
         }
         let part = self.n_leaves;
         self.n_leaves += 1;
         for k in 1..pts.len() as u32 - 1 {
-            self.mesh.faces.push([first, first + k, first + k + 1]);
-            self.mesh.part_ids.push(part);
-            self.mesh.kinds.push(KIND_LEAF);
-            self.mesh.colors.push(color);
-            self.mesh.instances.push(0);
+            self.leaves.faces.push([first, first + k, first + k + 1]);
+            self.leaves.part_ids.push(part);
+            self.leaves.kinds.push(KIND_LEAF);
+            self.leaves.colors.push(color);
+            self.leaves.instances.push(0);
         }
     }
 }
@@ -218,6 +254,7 @@ impl Sink for MeshBuilder {
 /// The mesh of a module string: tubes of `sides` sides and leaves.
 pub fn build_mesh(s: &ModString, p: &TurtleParams, sides: usize) -> CoreResult<Mesh> {
     let mut b = MeshBuilder::new(sides)?;
+    b.reserve(s.syms.iter().filter(|c| p.draw.contains(c)).count());
     interpret(s, p, &mut b)?;
     b.finish()
 }
@@ -279,3 +316,4 @@ mod tests {
         assert!(m.uvs.iter().all(|t| (0.0..=1.0).contains(&t[0]) && (0.0..=1.0).contains(&t[1])));
     }
 }
+

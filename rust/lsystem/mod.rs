@@ -15,6 +15,9 @@
 //! of Plants*, Springer 1990 (ABOP); M. Barnsley, *Fractals Everywhere*,
 //! Academic Press 1988; J. E. Hutchinson, Fractals and self-similarity,
 //! *Indiana Univ. Math. J.* 30 (1981) 713-747.
+// NaN must fail every check: `!(x > 0.0)` is deliberate.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod derive;
 pub mod export;
 pub mod expr;

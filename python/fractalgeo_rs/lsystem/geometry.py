@@ -12,6 +12,7 @@ from typing import Optional, Sequence, Union
 import numpy as np
 
 from fractalgeo_rs import _core
+from fractalgeo_rs._validation import check_n_threads
 from fractalgeo_rs.lsystem.core import LString
 
 __all__ = ["Polylines", "Segments", "Mesh", "turtle_2d", "turtle_3d", "plant_mesh", "TURTLE_SYMBOLS"]
@@ -234,7 +235,8 @@ def turtle_3d(lstring: Union[LString, str], *, angle: float = 90.0, step: float 
 
 def plant_mesh(lstring: Union[LString, str], *, sides: int = 6, angle: float = 90.0, step: float = 1.0,
                width: float = 1.0, width_factor: float = 0.7, tropism: Sequence[float] = (0.0, 0.0, 0.0),
-               elasticity: float = 0.0, draw: str = "FG", move: str = "fg") -> Mesh:
+               elasticity: float = 0.0, draw: str = "FG", move: str = "fg",
+               n_threads: Optional[int] = None) -> Mesh:
     """Triangle mesh of an L-string: generalised cylinders and leaves.
 
     Each chain of segments drawn without lifting the pen becomes one tube
@@ -242,7 +244,8 @@ def plant_mesh(lstring: Union[LString, str], *, sides: int = 6, angle: float = 9
     (a ring of ``sides + 1`` vertices, the last repeating the first for the
     texture seam); a branch ``[`` starts a new tube. Leaves (``{ . }``) are
     fan-triangulated with their Newell normal. Turtle options as in
-    :func:`turtle_3d`.
+    :func:`turtle_3d`; the triangles are written by ``n_threads`` threads
+    (all cores when None), with the same result for any number.
 
     Returns
     -------
@@ -266,4 +269,4 @@ def plant_mesh(lstring: Union[LString, str], *, sides: int = 6, angle: float = 9
         raise TypeError(f"sides: expected an int, got {sides!r}")
     args = turtle_args(angle=angle, step=step, width=width, width_factor=width_factor, tropism=tropism,
                        elasticity=elasticity, draw=draw, move=move)
-    return Mesh._from_core(_core.turtle_mesh(s._core, args, int(sides)))
+    return Mesh._from_core(_core.turtle_mesh(s._core, args, int(sides), check_n_threads(n_threads)))
