@@ -18,6 +18,10 @@ use std::collections::HashMap;
 /// Default limit on the number of modules of a derived string.
 pub const DEFAULT_MAX_LENGTH: usize = 100_000_000;
 
+/// Largest number of derivation steps (a string that does not grow would
+/// otherwise let a huge `n` run for hours).
+pub const MAX_STEPS: usize = 1_000_000;
+
 /// SplitMix64 finaliser (Steele, Lea and Flood 2014).
 #[inline]
 pub fn mix64(mut z: u64) -> u64 {
@@ -369,6 +373,9 @@ impl LSystem {
 
     /// Derive `n` steps from the axiom with another seed.
     pub fn derive_with_seed(&self, n: usize, seed: u64) -> CoreResult<ModString> {
+        if n > MAX_STEPS {
+            return Err(CoreError::invalid("n", format!("at most {MAX_STEPS} derivation steps, got {n}")));
+        }
         let mut s = self.axiom.clone();
         for g in 0..n {
             s = self.step_with_seed(&s, g as u64, seed)?;
@@ -443,6 +450,7 @@ mod tests {
         assert_eq!(l.derive(9).unwrap().len(), 512);
         let e = l.derive(10).unwrap_err();
         assert!(e.to_string().starts_with("max_length:"), "{e}");
+        assert!(l.derive(MAX_STEPS + 1).unwrap_err().to_string().starts_with("n:"));
     }
 
     #[test]

@@ -261,9 +261,14 @@ fn tokenize(src: &str, param: &str) -> CoreResult<Vec<Tok>> {
     Ok(out)
 }
 
+/// Deepest nesting of parentheses and unary operators accepted (the parser
+/// is recursive; this keeps it far from the stack limit).
+pub const MAX_DEPTH: usize = 200;
+
 struct Parser<'a> {
     toks: Vec<Tok>,
     pos: usize,
+    depth: usize,
     src: &'a str,
     param: &'a str,
     lookup: &'a dyn Fn(&str) -> Option<usize>,
@@ -327,7 +332,20 @@ impl<'a> Parser<'a> {
         }
         Ok(lhs)
     }
+    fn enter(&mut self) -> CoreResult<()> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            return Err(self.err(&format!("nesting deeper than {MAX_DEPTH}")));
+        }
+        Ok(())
+    }
     fn unary(&mut self) -> CoreResult<Expr> {
+        self.enter()?;
+        let r = self.unary_inner();
+        self.depth -= 1;
+        r
+    }
+    fn unary_inner(&mut self) -> CoreResult<Expr> {
         match self.peek_op() {
             Some("-") => {
                 self.pos += 1;
@@ -404,7 +422,7 @@ pub fn parse_expr(src: &str, param: &str, lookup: &dyn Fn(&str) -> Option<usize>
     if toks.is_empty() {
         return Err(CoreError::invalid(param, format!("empty expression in {src:?}")));
     }
-    let mut p = Parser { toks, pos: 0, src, param, lookup };
+    let mut p = Parser { toks, pos: 0, depth: 0, src, param, lookup };
     let e = p.binary(0)?;
     if p.pos != p.toks.len() {
         return Err(p.err("trailing text"));
@@ -446,6 +464,9 @@ mod tests {
             let e = parse_expr(bad, "rules", &look).unwrap_err();
             assert!(e.to_string().starts_with("rules:"), "{bad}: {e}");
         }
+        let deep = format!("{}1{}", "(".repeat(100_000), ")".repeat(100_000));
+        assert!(parse_expr(&deep, "rules", &look).unwrap_err().to_string().contains("nesting"));
+        assert!(parse_expr(&"-".repeat(100_000), "rules", &look).is_err());
         let e = parse_expr("x+1", "rules", &look).unwrap_err();
         assert!(e.to_string().contains("unknown parameter \"x\""), "{e}");
     }
