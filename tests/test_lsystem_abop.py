@@ -201,3 +201,17 @@ def test_stochastic_figure_1_27_mean_length():
     assert abs(f.mean() - m ** n) < 4 * f.std(ddof=1) / np.sqrt(len(f))
     # and the strings really vary
     assert len(set(lengths.tolist())) > 20
+
+
+@pytest.mark.parametrize("name,angle", [("1.10b Sierpinski gasket", 60), ("1.11a hexagonal Gosper", 60),
+                                        ("1.11b quadratic Gosper", 90)])
+def test_edge_rewriting_curves_are_self_avoiding(name, angle):
+    """These curves (ABOP 1.4.1) never revisit a vertex: a check of both the
+    transcribed productions and the turtle."""
+    _, axiom, rules, n, draw = next(f for f in FIGURES if f[0] == name)
+    d = turtle_2d(LSystem(axiom, rules).derive(n), angle=angle, draw=draw)
+    assert len(d.lines) == 1
+    n_edges = parikh(axiom, rules, n)["L"] + parikh(axiom, rules, n)["R"]
+    assert len(d.xy) == n_edges + 1
+    assert len({tuple(p) for p in np.round(d.xy, 6)}) == n_edges + 1
+    assert np.allclose(np.linalg.norm(np.diff(d.xy, axis=0), axis=1), 1.0)

@@ -111,6 +111,10 @@ def test_runaway_growth_is_a_value_error():
         s.derive(14)
     with pytest.raises(ValueError, match="^max_length:"):
         LSystem("F", {"F": "F" * 50}).derive(40)  # default limit, no hang
+    with pytest.raises(ValueError, match="^n:"):
+        LSystem("F", {"F": "F"}).derive(10**7)  # would never end otherwise
+    with pytest.raises(ValueError, match="^rules:.*nesting"):
+        LSystem("A(1)", ["A(x) -> A(" + "(" * 5000 + "x" + ")" * 5000 + ")"])
     with pytest.raises(ValueError, match="^rules:.*non-finite"):
         LSystem("A(1)", ["A(x) -> A(x/0)"]).derive(1)
 

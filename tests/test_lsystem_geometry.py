@@ -52,6 +52,9 @@ def test_plant_mesh_invariants():
     assert m.uvs[:, 0].min() >= 0 and m.uvs[:, 0].max() <= 1
     assert set(np.unique(m.part_ids[m.kinds == 0])) == set(range(n_seg))
     assert set(np.unique(m.part_ids[m.kinds == 1])) == set(range(n_leaf))
+    m2 = plant_mesh(s, angle=22.5, sides=5, n_threads=2)
+    m1 = plant_mesh(s, angle=22.5, sides=5, n_threads=1)
+    assert all(np.array_equal(getattr(m1, k), getattr(m2, k)) for k in Mesh.__dataclass_fields__)
 
 
 def test_obj_ply_svg_png_files(tmp_path):
