@@ -41,6 +41,26 @@ def py_derive(axiom: str, rules: dict, n: int) -> str:
     return s
 
 
+STOCH = [("F[&+F]F[^-F]/F", 0.4), ("F[&+F]/F", 0.3), ("F[^-F]F", 0.3)]
+
+
+def py_derive_stochastic(axiom: str, alts, n: int, seed: int) -> str:
+    """Stochastic rewriting of F: split at F, draw all choices at once with
+    numpy, join (the fastest pure-Python form found)."""
+    rng = np.random.default_rng(seed)
+    succ = [a for a, _ in alts]
+    p = np.array([w for _, w in alts]) / sum(w for _, w in alts)
+    s = axiom
+    for _ in range(n):
+        parts = s.split("F")
+        picks = rng.choice(len(succ), size=len(parts) - 1, p=p)
+        out = [""] * (2 * len(parts) - 1)
+        out[0::2] = parts
+        out[1::2] = [succ[k] for k in picks]
+        s = "".join(out)
+    return s
+
+
 def py_turtle(s: str, angle: float, step: float = 1.0):
     """Pure-Python 3D turtle (same conventions as fractalgeo_rs)."""
     ca, sa = math.cos(math.radians(angle)), math.sin(math.radians(angle))
@@ -124,6 +144,13 @@ def main() -> int:
     assert str(s_rs) == s_py
     print(f"derivation    {len(s_rs):>11,d} modules  python {t_py:8.3f} s  rust {t_rs:8.3f} s  "
           f"ratio {t_py / t_rs:6.1f}x  ({len(s_rs) / t_rs / 1e6:.1f} M modules/s)")
+
+    stoch = LSystem(AXIOM, {"F": STOCH}, seed=1)
+    t_py, s_py = best(lambda: py_derive_stochastic(AXIOM, STOCH, a.n + 3, 1), a.repeat)
+    t_rs, s_rs2 = best(lambda: stoch.derive(a.n + 3, n_threads=a.threads), a.repeat)
+    r_py, r_rs = len(s_py) / t_py, len(s_rs2) / t_rs
+    print(f"stochastic    {len(s_rs2):>11,d} modules  python {t_py:8.3f} s  rust {t_rs:8.3f} s  "
+          f"ratio {r_rs / r_py:6.1f}x  ({r_rs / 1e6:.1f} M modules/s; python {len(s_py):,d} modules)")
 
     n_tr = min(a.n, 8)
     s_tr = py_derive(AXIOM, RULES, n_tr)

@@ -235,19 +235,6 @@ impl LSystem {
 
     fn rewrite_range(&self, s: &ModString, mates: &[u32], lo: usize, hi: usize, generation: u64, seed: u64) -> CoreResult<Piece> {
         let mut out = Piece { syms: Vec::with_capacity(2 * (hi - lo)), counts: Vec::new(), params: Vec::new() };
-        if let Some((table, other)) = &self.dol {
-            for &c in &s.syms[lo..hi] {
-                let succ = if (c as u32) < 128 { table[c as usize].as_deref() } else { other.get(&c).map(|v| v.as_slice()) };
-                match succ {
-                    Some(v) => out.syms.extend_from_slice(v),
-                    None => out.syms.push(c),
-                }
-                if out.syms.len() > self.max_length {
-                    return Err(self.too_long(generation));
-                }
-            }
-            return Ok(out);
-        }
         let mut vars = vec![0.0f64; self.max_slots.max(1)];
         for i in lo..hi {
             let c = s.syms[i];
@@ -325,6 +312,9 @@ impl LSystem {
     /// One parallel derivation step of `s` (step number `generation`,
     /// counted from 0) with the given seed. Runs in the current rayon pool.
     pub fn step_with_seed(&self, s: &ModString, generation: u64, seed: u64) -> CoreResult<ModString> {
+        if let Some(table) = &self.dol {
+            return self.step_dol(table, s, generation);
+        }
         let n = s.len();
         let mates = if self.needs_mates { s.bracket_mates("axiom")? } else { Vec::new() };
         let threads = rayon::current_num_threads().max(1);
@@ -364,6 +354,47 @@ impl LSystem {
             }
         }
         Ok(out)
+    }
+
+    /// Deterministic context-free step: count the output length of every
+    /// chunk, then write each chunk straight into its place in the result.
+    fn step_dol(&self, table: &DolTable, s: &ModString, generation: u64) -> CoreResult<ModString> {
+        let (ascii, other) = table;
+        let lens: Vec<usize> = (0..128).map(|c| ascii[c].as_ref().map_or(1, |v| v.len())).collect();
+        let len_of = |c: char| if (c as u32) < 128 { lens[c as usize] } else { other.get(&c).map_or(1, |v| v.len()) };
+        let n = s.len();
+        let threads = rayon::current_num_threads().max(1);
+        let chunk = (n / (4 * threads)).clamp(16384, 1 << 20);
+        let sizes: Vec<usize> = s.syms.par_chunks(chunk).map(|c| c.iter().map(|&x| len_of(x)).sum()).collect();
+        let total: usize = sizes.iter().sum();
+        if total > self.max_length {
+            return Err(self.too_long(generation));
+        }
+        let mut out = vec!['\0'; total];
+        let mut slices = Vec::with_capacity(sizes.len());
+        let mut rest: &mut [char] = &mut out;
+        for &k in &sizes {
+            let (a, b) = rest.split_at_mut(k);
+            slices.push(a);
+            rest = b;
+        }
+        s.syms.par_chunks(chunk).zip(slices.into_par_iter()).for_each(|(src, dst)| {
+            let mut o = 0;
+            for &c in src {
+                let succ = if (c as u32) < 128 { ascii[c as usize].as_deref() } else { other.get(&c).map(|v| v.as_slice()) };
+                match succ {
+                    Some(v) => {
+                        dst[o..o + v.len()].copy_from_slice(v);
+                        o += v.len();
+                    }
+                    None => {
+                        dst[o] = c;
+                        o += 1;
+                    }
+                }
+            }
+        });
+        Ok(ModString { syms: out, pstart: Vec::new(), params: Vec::new() })
     }
 
     /// Derive `n` steps from the axiom with the system's seed.
