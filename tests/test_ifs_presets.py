@@ -93,5 +93,9 @@ def test_custom_ifs_and_errors():
         IFS([[0.5, 0, 0, 0.5, 0, 0]], [0.0])
     with pytest.raises(ValueError, match="^name:"):
         ifs_preset("mandelbrot")
+    with pytest.raises(ValueError, match="^n_points:"):
+        ifs_preset("dragon").chaos_game(2**40)
+    with pytest.raises(ValueError, match="^shape:"):
+        rasterize_points([[0.0, 0.0]], (10**6, 10**6))
     with pytest.raises(ValueError, match="^depth:"):
         ifs_preset("sierpinski_carpet").iterate(12, max_points=1000)

@@ -39,6 +39,11 @@ def test_turtle_3d_rotations_keep_unit_steps_and_widths():
     assert bent.ends[:, 2].max() < seg.ends[:, 2].max()
 
 
+def test_mesh_size_limit_is_a_value_error():
+    with pytest.raises(ValueError, match="^lstring:.*triangles"):
+        plant_mesh(LSystem("F", {"F": "FF"}).derive(24), sides=16)  # 2^24 segments x 32 triangles
+
+
 def test_plant_mesh_invariants():
     s = LSystem("A", BUSH).derive(3)
     m = plant_mesh(s, angle=22.5, sides=5)

@@ -342,7 +342,7 @@ fn ifs_chaos_game<'py>(
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let f = ifs_from(&maps, probabilities)?;
-    let pts = py.detach(|| run_in_pool(n_threads, || Ok(f.chaos_game(n_points, seed))))?;
+    let pts = py.detach(|| run_in_pool(n_threads, || f.chaos_game(n_points, seed)))?;
     Ok(rows(pts).into_pyarray(py))
 }
 

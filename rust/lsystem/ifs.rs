@@ -63,6 +63,9 @@ impl Affine {
     }
 }
 
+/// Largest point set the IFS functions make (2^27 points, 2 GiB).
+pub const MAX_POINTS: usize = 1 << 27;
+
 /// An IFS with probabilities.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Ifs {
@@ -138,8 +141,11 @@ impl Ifs {
     /// point of the attractor, so no transient is dropped) and draw their
     /// choices from a hash of `(seed, chain, step)`: the same seed gives the
     /// same points on any number of threads.
-    pub fn chaos_game(&self, n: usize, seed: u64) -> Vec<[f64; 2]> {
+    pub fn chaos_game(&self, n: usize, seed: u64) -> CoreResult<Vec<[f64; 2]>> {
         const CHAIN: usize = 1 << 16;
+        if n > MAX_POINTS {
+            return Err(CoreError::invalid("n_points", format!("at most {MAX_POINTS} points, got {n}")));
+        }
         let start = self.maps[0].fixed_point();
         let n_chains = n.div_ceil(CHAIN);
         let chains: Vec<Vec<[f64; 2]>> = (0..n_chains)
@@ -158,7 +164,7 @@ impl Ifs {
                 out
             })
             .collect();
-        chains.concat()
+        Ok(chains.concat())
     }
 
     /// Deterministic iteration: the `k^depth` images of the fixed point of
@@ -167,7 +173,7 @@ impl Ifs {
     pub fn iterate(&self, depth: usize, max_points: usize) -> CoreResult<Vec<[f64; 2]>> {
         let k = self.maps.len();
         let total = (k as f64).powi(depth as i32);
-        if total > max_points as f64 {
+        if total > max_points.min(MAX_POINTS) as f64 {
             return Err(CoreError::invalid(
                 "depth",
                 format!("{k}^{depth} = {total:.3e} points is more than max_points={max_points}"),
@@ -252,7 +258,7 @@ pub fn rasterize(points: &[[f64; 2]], rows: usize, cols: usize, b: [f64; 4]) -> 
     if rows == 0 || cols == 0 {
         return Err(CoreError::invalid("shape", "rows and cols must be positive"));
     }
-    if rows.checked_mul(cols).is_none_or(|n| n > 1 << 32) {
+    if rows.checked_mul(cols).is_none_or(|n| n > 1 << 30) {
         return Err(CoreError::invalid("shape", "the raster is too large"));
     }
     if !b.iter().all(|v| v.is_finite()) || !(b[1] > b[0]) || !(b[3] > b[2]) {
@@ -407,16 +413,17 @@ mod tests {
     #[test]
     fn chaos_game_is_seeded_and_thread_independent() {
         let (ifs, d) = preset("sierpinski_triangle").unwrap();
-        let a = run_in_pool(Some(1), || Ok(ifs.chaos_game(300_000, 7))).unwrap();
-        let b = run_in_pool(Some(3), || Ok(ifs.chaos_game(300_000, 7))).unwrap();
+        let a = run_in_pool(Some(1), || ifs.chaos_game(300_000, 7)).unwrap();
+        let b = run_in_pool(Some(3), || ifs.chaos_game(300_000, 7)).unwrap();
         assert_eq!(a, b);
-        assert_ne!(a, ifs.chaos_game(300_000, 8));
+        assert_ne!(a, ifs.chaos_game(300_000, 8).unwrap());
+        assert!(ifs.chaos_game(MAX_POINTS + 1, 8).unwrap_err().to_string().starts_with("n_points:"));
         let img = rasterize(&a, 512, 512, [0.0, 1.0, 0.0, 1.0]).unwrap();
         let est = box_dimension(&img, 512, 512, &[4, 8, 16, 32, 64]);
         assert!((est - d.unwrap()).abs() < 0.05, "{est}");
         // the fern: every point stays in its known box
         let (fern, _) = preset("barnsley_fern").unwrap();
-        let pts = fern.chaos_game(100_000, 1);
+        let pts = fern.chaos_game(100_000, 1).unwrap();
         assert!(pts.iter().all(|p| p[0] > -2.2 && p[0] < 2.7 && p[1] >= 0.0 && p[1] < 10.0));
         assert!(fern.similarity_dimension().is_none());
     }

@@ -17,6 +17,9 @@ use crate::error::{CoreError, CoreResult};
 use glam::{DQuat, DVec3};
 use rayon::prelude::*;
 
+/// Largest number of branch triangles of one mesh (2^28, about 7 GB of mesh).
+pub const MAX_TRIANGLES: usize = 1 << 28;
+
 /// Triangle kinds in [`Mesh::kinds`].
 pub const KIND_BRANCH: u8 = 0;
 /// Leaf polygons.
@@ -254,7 +257,14 @@ impl Sink for MeshBuilder {
 /// The mesh of a module string: tubes of `sides` sides and leaves.
 pub fn build_mesh(s: &ModString, p: &TurtleParams, sides: usize) -> CoreResult<Mesh> {
     let mut b = MeshBuilder::new(sides)?;
-    b.reserve(s.syms.iter().filter(|c| p.draw.contains(c)).count());
+    let n_draw = s.syms.iter().filter(|c| p.draw.contains(c)).count();
+    if 2 * sides * n_draw > MAX_TRIANGLES {
+        return Err(CoreError::invalid(
+            "lstring",
+            format!("the mesh would have {} branch triangles, more than {MAX_TRIANGLES}; derive fewer steps or use fewer sides", 2 * sides * n_draw),
+        ));
+    }
+    b.reserve(n_draw);
     interpret(s, p, &mut b)?;
     b.finish()
 }

@@ -170,7 +170,7 @@ class IFS:
         """Binary raster of the attractor.
 
         Uses deterministic iteration to ``depth`` when given, else the chaos
-        game with ``n_points`` (default: 20 points per pixel). See
+        game with ``n_points`` (default: 20 points per pixel, at most 2**27). See
         :func:`rasterize_points` for ``bounds``.
         """
         rows, cols = _check_shape(shape)
@@ -179,7 +179,9 @@ class IFS:
         if depth is not None:
             pts = self.iterate(depth, n_threads=n_threads)
         else:
-            pts = self.chaos_game(n_points if n_points is not None else 20 * rows * cols, seed=seed, n_threads=n_threads)
+            if n_points is None:
+                n_points = min(20 * rows * cols, 1 << 27)
+            pts = self.chaos_game(n_points, seed=seed, n_threads=n_threads)
         return rasterize_points(pts, (rows, cols), bounds=bounds)
 
 
