@@ -1,5 +1,7 @@
 //! Bindings of `crate::lsystem`: L-systems, turtle geometry, mesh files, IFS
 //! and plants on terrain. The documented API is `fractalgeo_rs.lsystem`.
+//! Every kernel runs through `run_in_pool`, so even a bug (a panic) comes
+//! back as RuntimeError, never as a PanicException.
 use crate::lsystem::derive::LSystem;
 use crate::lsystem::grammar::{parse_module_string, parse_rule_text, ModString};
 use crate::lsystem::mesh::{build_mesh, Mesh};
@@ -66,7 +68,8 @@ impl LSystemCore {
     #[new]
     #[pyo3(signature = (axiom, rules, ignore, seed, max_length))]
     fn new(axiom: &str, rules: Vec<String>, ignore: &str, seed: u64, max_length: usize) -> PyResult<Self> {
-        Ok(LSystemCore { inner: Arc::new(LSystem::new(axiom, &rules, ignore, seed, max_length)?) })
+        let l = run_in_pool(Some(1), || LSystem::new(axiom, &rules, ignore, seed, max_length))?;
+        Ok(LSystemCore { inner: Arc::new(l) })
     }
 
     /// Derive `n` steps with `seed` (the system's seed when None).
@@ -99,7 +102,7 @@ impl ModuleString {
     /// Parse a module string such as `"F(1)[+A(2,3)]"` (constant parameters).
     #[staticmethod]
     fn parse(text: &str) -> PyResult<Self> {
-        Ok(ModuleString { inner: Arc::new(parse_module_string(text, "text")?) })
+        Ok(ModuleString { inner: Arc::new(run_in_pool(Some(1), || parse_module_string(text, "text"))?) })
     }
     fn __len__(&self) -> usize {
         self.inner.len()
@@ -131,7 +134,7 @@ impl ModuleString {
 #[pyfunction]
 #[allow(clippy::type_complexity)]
 fn lsystem_parse_text(text: &str) -> PyResult<(String, Option<String>, Vec<String>, Vec<(String, String)>)> {
-    let t = parse_rule_text(text)?;
+    let t = run_in_pool(Some(1), || parse_rule_text(text))?;
     Ok((t.axiom.unwrap_or_default(), t.ignore, t.rules, t.directives))
 }
 
@@ -145,7 +148,7 @@ fn turtle_polylines<'py>(
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u64>>)> {
     let s = lstring.inner.clone();
     let p = turtle_params(turtle);
-    let r = py.detach(|| polylines(&s, &p))?;
+    let r = py.detach(|| run_in_pool(Some(1), || polylines(&s, &p)))?;
     let off: Vec<u64> = r.offsets.iter().map(|&v| v as u64).collect();
     let (pp, po) = flat_polys(r.polygons);
     Ok((rows(r.xy).into_pyarray(py), off.into_pyarray(py), pp.into_pyarray(py), po.into_pyarray(py)))
@@ -169,7 +172,7 @@ fn turtle_segments<'py>(
 )> {
     let s = lstring.inner.clone();
     let p = turtle_params(turtle);
-    let r = py.detach(|| segments(&s, &p))?;
+    let r = py.detach(|| run_in_pool(Some(1), || segments(&s, &p)))?;
     let (pp, po) = flat_polys(r.polygons);
     Ok((
         rows(r.starts).into_pyarray(py),
@@ -271,8 +274,8 @@ fn write_mesh(
 ) -> PyResult<()> {
     let m = mesh_from_arrays(vertices, normals, uvs, faces, part_ids, kinds, colors, instances)?;
     match format {
-        "obj" => py.detach(|| export::write_obj(&m, &path))?,
-        "ply" => py.detach(|| export::write_ply(&m, &path))?,
+        "obj" => py.detach(|| run_in_pool(Some(1), || export::write_obj(&m, &path)))?,
+        "ply" => py.detach(|| run_in_pool(Some(1), || export::write_ply(&m, &path)))?,
         _ => return Err(PyValueError::new_err(format!("format: expected 'obj' or 'ply', got {format:?}"))),
     }
     Ok(())
@@ -306,7 +309,7 @@ fn plants_on_terrain<'py>(
 
 fn ifs_from(maps: &PyReadonlyArray2<'_, f64>, probabilities: Option<Vec<f64>>) -> PyResult<ifs::Ifs> {
     let rows_: Vec<[f64; 6]> = to_rows(maps, "maps")?;
-    Ok(ifs::Ifs::new(&rows_, probabilities.as_deref())?)
+    Ok(run_in_pool(Some(1), || ifs::Ifs::new(&rows_, probabilities.as_deref()))?)
 }
 
 /// Validate an IFS: returns (maps (k,6), probabilities (k,), similarity dimension or None).
@@ -326,7 +329,7 @@ fn ifs_check<'py>(
 #[pyfunction]
 #[allow(clippy::type_complexity)]
 fn ifs_preset<'py>(py: Python<'py>, name: &str) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Option<f64>)> {
-    let (f, d) = ifs::preset(name)?;
+    let (f, d) = run_in_pool(Some(1), || ifs::preset(name))?;
     Ok((rows(f.rows()).into_pyarray(py), f.probs.clone().into_pyarray(py), d))
 }
 
@@ -373,7 +376,7 @@ fn ifs_rasterize<'py>(
 ) -> PyResult<(Bound<'py, PyArray2<u8>>, [f64; 4])> {
     let pts: Vec<[f64; 2]> = to_rows(&points, "points")?;
     let b = bounds.unwrap_or_else(|| ifs::bounds(&pts));
-    let img = py.detach(|| ifs::rasterize(&pts, n_rows, n_cols, b))?;
+    let img = py.detach(|| run_in_pool(Some(1), || ifs::rasterize(&pts, n_rows, n_cols, b)))?;
     let a = Array2::from_shape_vec((n_rows, n_cols), img).expect("raster shape");
     Ok((a.into_pyarray(py), b))
 }
@@ -381,7 +384,7 @@ fn ifs_rasterize<'py>(
 /// Root of Moran's equation sum r_i^s = 1.
 #[pyfunction]
 fn moran_dimension(ratios: Vec<f64>) -> PyResult<f64> {
-    Ok(ifs::moran_dimension(&ratios)?)
+    Ok(run_in_pool(Some(1), || ifs::moran_dimension(&ratios))?)
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
