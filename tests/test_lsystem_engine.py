@@ -2,6 +2,7 @@
 parameters, seeds, the text format and errors."""
 import lsystem_compat  # noqa: F401  (temporary, see the module)
 
+import numpy as np
 import pytest
 
 import fractalgeo_rs
@@ -69,9 +70,25 @@ def test_text_format_and_file(tmp_path):
     assert s.defaults == {"n": "7", "angle": "20"}
     assert str(s.derive(1)) == "F[+X]F[-X]+X"
     p = tmp_path / "plant.txt"
-    p.write_text(text + "seed: 3\nF -(1)-> G\n".replace("F -(1)-> G\n", ""))
-    assert LSystem.from_file(p).seed == 3
+    p.write_text("axiom: F\nseed: 3\nF -(1)-> F[+F]F\nF -(3)-> F[-F]F  # three times as likely\n")
+    st = LSystem.from_file(p)
+    assert st.seed == 3 and st.is_stochastic
+    s1 = st.derive(1)
+    assert str(s1) in ("F[+F]F", "F[-F]F")
+    counts = [str(LSystem.from_file(p, seed=k).derive(1)) for k in range(400)]
+    assert 0.65 < counts.count("F[-F]F") / 400 < 0.85
     assert LSystem.from_string("axiom: a\nignore: +\nb < a -> c\n").ignore == "+"
+
+
+def test_parametric_turtle_total_length():
+    """A(s) -> F(s)[+A(s/2)][-A(s/2)]: step k draws 2^k segments of length
+    2^-k, so after n steps the drawn length is exactly n."""
+    from fractalgeo_rs.lsystem import turtle_2d
+    s = LSystem("A(1)", ["A(s) -> F(s)[+A(s/2)][-A(s/2)]"]).derive(8)
+    d = turtle_2d(s, angle=30)
+    length = sum(np.linalg.norm(np.diff(line, axis=0), axis=1).sum() for line in d.lines)
+    assert length == pytest.approx(8.0, abs=1e-12)
+    assert s.count("F") == 2 ** 8 - 1
 
 
 def test_lstring_parse():
