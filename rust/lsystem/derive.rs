@@ -43,8 +43,9 @@ pub fn unit3(seed: u64, a: u64, b: u64) -> f64 {
     (hash3(seed, a, b) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
-/// Successor tables of a deterministic context-free system: ASCII by code, others by map.
-type DolTable = (Vec<Option<Vec<char>>>, HashMap<char, Vec<char>>);
+/// Rule of each symbol of a context-free, condition-free, non-parametric
+/// system: ASCII by code (`u32::MAX` = none), others by map.
+type SimpleTable = (Vec<u32>, HashMap<char, u32>);
 
 /// A compiled L-system.
 #[derive(Debug, Clone)]
@@ -59,8 +60,8 @@ pub struct LSystem {
     needs_mates: bool,
     parametric: bool,
     max_slots: usize,
-    /// Fast path: deterministic, context-free, condition-free, non-parametric.
-    dol: Option<DolTable>,
+    /// Fast path: context-free, condition-free, non-parametric (deterministic or stochastic).
+    simple: Option<SimpleTable>,
 }
 
 /// Per-chunk output.
@@ -100,17 +101,17 @@ impl LSystem {
         let needs_mates = rules.iter().any(|r| r.has_context());
         let parametric = !axiom.pstart.is_empty() || rules.iter().any(|r| r.successors.iter().any(|s| s.parametric));
         let max_slots = rules.iter().map(|r| r.n_slots).max().unwrap_or(0);
-        let simple = !parametric
-            && rules.iter().all(|r| !r.has_context() && r.cond.is_none() && r.successors.len() == 1 && r.pred.arity.is_none());
-        let dol = simple.then(|| {
-            let mut t = vec![None; 128];
+        let simple_ok = !parametric && rules.iter().all(|r| !r.has_context() && r.cond.is_none() && r.pred.arity.is_none());
+        let simple = simple_ok.then(|| {
+            let mut t = vec![u32::MAX; 128];
             let mut o = HashMap::new();
-            for r in &rules {
+            for (k, r) in rules.iter().enumerate().rev() {
+                // the first production of a symbol always applies: keep it
                 let c = r.pred.sym;
                 if (c as u32) < 128 {
-                    t[c as usize] = Some(r.successors[0].syms.clone());
+                    t[c as usize] = k as u32;
                 } else {
-                    o.insert(c, r.successors[0].syms.clone());
+                    o.insert(c, k as u32);
                 }
             }
             (t, o)
@@ -122,7 +123,7 @@ impl LSystem {
         if axiom.len() > max_length {
             return Err(CoreError::invalid("max_length", format!("the axiom has {} modules, more than max_length={max_length}", axiom.len())));
         }
-        Ok(LSystem { axiom, rules, ignore, seed, max_length, ascii, other, needs_mates, parametric, max_slots, dol })
+        Ok(LSystem { axiom, rules, ignore, seed, max_length, ascii, other, needs_mates, parametric, max_slots, simple })
     }
 
     /// True when some production is stochastic.
@@ -312,8 +313,8 @@ impl LSystem {
     /// One parallel derivation step of `s` (step number `generation`,
     /// counted from 0) with the given seed. Runs in the current rayon pool.
     pub fn step_with_seed(&self, s: &ModString, generation: u64, seed: u64) -> CoreResult<ModString> {
-        if let Some(table) = &self.dol {
-            return self.step_dol(table, s, generation);
+        if let Some(table) = &self.simple {
+            return self.step_simple(table, s, generation, seed);
         }
         let n = s.len();
         let mates = if self.needs_mates { s.bracket_mates("axiom")? } else { Vec::new() };
@@ -356,16 +357,34 @@ impl LSystem {
         Ok(out)
     }
 
-    /// Deterministic context-free step: count the output length of every
-    /// chunk, then write each chunk straight into its place in the result.
-    fn step_dol(&self, table: &DolTable, s: &ModString, generation: u64) -> CoreResult<ModString> {
+    /// Context-free, non-parametric step: count the output length of every
+    /// chunk, then write each chunk straight into its place in the result
+    /// (a stochastic choice is drawn twice from the same hash: same result).
+    fn step_simple(&self, table: &SimpleTable, s: &ModString, generation: u64, seed: u64) -> CoreResult<ModString> {
         let (ascii, other) = table;
-        let lens: Vec<usize> = (0..128).map(|c| ascii[c].as_ref().map_or(1, |v| v.len())).collect();
-        let len_of = |c: char| if (c as u32) < 128 { lens[c as usize] } else { other.get(&c).map_or(1, |v| v.len()) };
+        let succ = |i: usize, c: char| -> Option<&[char]> {
+            let r = if (c as u32) < 128 { ascii[c as usize] } else { other.get(&c).copied().unwrap_or(u32::MAX) };
+            if r == u32::MAX {
+                return None;
+            }
+            let rule = &self.rules[r as usize];
+            let k = if rule.successors.len() == 1 {
+                0
+            } else {
+                let u = unit3(seed, generation, i as u64);
+                rule.cum_weights.iter().position(|&w| u < w).unwrap_or(rule.cum_weights.len() - 1)
+            };
+            Some(&rule.successors[k].syms)
+        };
         let n = s.len();
         let threads = rayon::current_num_threads().max(1);
         let chunk = (n / (4 * threads)).clamp(16384, 1 << 20);
-        let sizes: Vec<usize> = s.syms.par_chunks(chunk).map(|c| c.iter().map(|&x| len_of(x)).sum()).collect();
+        let sizes: Vec<usize> = s
+            .syms
+            .par_chunks(chunk)
+            .enumerate()
+            .map(|(b, c)| c.iter().enumerate().map(|(j, &x)| succ(b * chunk + j, x).map_or(1, |v| v.len())).sum())
+            .collect();
         let total: usize = sizes.iter().sum();
         if total > self.max_length {
             return Err(self.too_long(generation));
@@ -378,11 +397,10 @@ impl LSystem {
             slices.push(a);
             rest = b;
         }
-        s.syms.par_chunks(chunk).zip(slices.into_par_iter()).for_each(|(src, dst)| {
+        s.syms.par_chunks(chunk).zip(slices.into_par_iter()).enumerate().for_each(|(b, (src, dst))| {
             let mut o = 0;
-            for &c in src {
-                let succ = if (c as u32) < 128 { ascii[c as usize].as_deref() } else { other.get(&c).map(|v| v.as_slice()) };
-                match succ {
+            for (j, &c) in src.iter().enumerate() {
+                match succ(b * chunk + j, c) {
                     Some(v) => {
                         dst[o..o + v.len()].copy_from_slice(v);
                         o += v.len();
@@ -500,6 +518,21 @@ mod tests {
         assert_eq!(a, b);
         let c = run_in_pool(Some(2), || l.derive_with_seed(9, 43)).unwrap();
         assert_ne!(a, c);
+    }
+
+    #[test]
+    fn fast_and_general_paths_agree() {
+        let base = vec!["F -(1)-> F[+F]F[-F]F".to_string(), "F -(2)-> F[+F]F".to_string(), "X -> F-X".to_string()];
+        let fast = LSystem::new("FX", &base, "", 11, DEFAULT_MAX_LENGTH).unwrap();
+        assert!(fast.simple.is_some());
+        let mut with_ctx = base.clone();
+        with_ctx.push("Z < Q -> Q".to_string()); // never applies, forces the general path
+        let general = LSystem::new("FX", &with_ctx, "", 11, DEFAULT_MAX_LENGTH).unwrap();
+        assert!(general.simple.is_none());
+        let a = run_in_pool(Some(2), || fast.derive(8)).unwrap();
+        let b = run_in_pool(Some(2), || general.derive(8)).unwrap();
+        assert!(a.len() > 20_000);
+        assert_eq!(a, b);
     }
 
     #[test]

@@ -101,9 +101,9 @@ impl MeshBuilder {
         Ok(MeshBuilder { sides, cos_sin, rings: Vec::new(), tubes: Vec::new(), leaves: Mesh::default(), n_leaves: 0 })
     }
 
-    /// Reserve room for about `n` segments.
-    pub fn reserve(&mut self, n: usize) {
-        self.rings.reserve(n + n / 4);
+    /// Reserve room for `n` segments and `starts` tube starts.
+    pub fn reserve(&mut self, n: usize, starts: usize) {
+        self.rings.reserve(n + starts.min(n));
         self.tubes.reserve(n);
     }
 
@@ -257,14 +257,21 @@ impl Sink for MeshBuilder {
 /// The mesh of a module string: tubes of `sides` sides and leaves.
 pub fn build_mesh(s: &ModString, p: &TurtleParams, sides: usize) -> CoreResult<Mesh> {
     let mut b = MeshBuilder::new(sides)?;
-    let n_draw = s.syms.iter().filter(|c| p.draw.contains(c)).count();
+    let (mut n_draw, mut n_new) = (0usize, 1usize);
+    for c in &s.syms {
+        if p.draw.contains(c) {
+            n_draw += 1;
+        } else if *c == '[' || *c == '}' || p.moves.contains(c) {
+            n_new += 1; // places where a new tube may start
+        }
+    }
     if 2 * sides * n_draw > MAX_TRIANGLES {
         return Err(CoreError::invalid(
             "lstring",
             format!("the mesh would have {} branch triangles, more than {MAX_TRIANGLES}; derive fewer steps or use fewer sides", 2 * sides * n_draw),
         ));
     }
-    b.reserve(n_draw);
+    b.reserve(n_draw, n_new);
     interpret(s, p, &mut b)?;
     b.finish()
 }
