@@ -219,6 +219,12 @@ def turtle_3d(lstring: Union[LString, str], *, angle: float = 90.0, step: float 
     -------
     Segments
 
+    References
+    ----------
+    P. Prusinkiewicz and A. Lindenmayer, *The Algorithmic Beauty of Plants*,
+    Springer, 1990, sections 1.5 (turtle in three dimensions), 2.3.2
+    (tropism) and 5.1 (polygons).
+
     Examples
     --------
     >>> from fractalgeo_rs.lsystem import turtle_3d

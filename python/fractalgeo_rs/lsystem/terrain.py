@@ -67,6 +67,22 @@ def plants_on_terrain(
         ``mesh.instances`` holds the plant number of every triangle.
     bases : (P, 3) ndarray
         Base point of every plant placed.
+
+    References
+    ----------
+    P. Prusinkiewicz and A. Lindenmayer, *The Algorithmic Beauty of Plants*,
+    Springer, 1990, section 1.7 (stochastic L-systems: every plant of a
+    population differs).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fractalgeo_rs.lsystem import LSystem, plants_on_terrain
+    >>> weed = LSystem("F", {"F": [("F[+F]F", 1), ("F[-F]F", 1)]})
+    >>> dem = np.zeros((11, 11))
+    >>> mesh, bases = plants_on_terrain(weed, 3, dem, cell_size=1.0, density=0.2, seed=1, angle=25)
+    >>> bases.shape, int(mesh.instances.max())
+    ((20, 3), 19)
     """
     if not isinstance(lsystem, LSystem):
         raise TypeError(f"lsystem: expected an LSystem, got {type(lsystem).__name__}")
