@@ -19,6 +19,7 @@ def test_parallel_not_sequential_and_case_sensitive():
     s = LSystem("aA", ["a -> b", "b -> c", "A -> a"])
     assert str(s.derive(1)) == "ba"
     assert str(LSystem("Ff", {"F": "FF"}).derive(2)) == "FFFFf"
+    assert str(LSystem("α", {"α": "αβ", "β": "γ"}).derive(3)) == "αβγγ"  # any Unicode symbol
 
 
 def test_parametric_abop_page_43():
