@@ -8,7 +8,7 @@ from __future__ import annotations
 import numbers
 import os
 import secrets
-from typing import Mapping, Optional, Sequence, Union
+from typing import Any, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
@@ -20,7 +20,7 @@ __all__ = ["LSystem", "LString", "DEFAULT_MAX_LENGTH"]
 #: Default limit on the number of modules of a derived string.
 DEFAULT_MAX_LENGTH = 100_000_000
 
-RulesLike = Union[str, Mapping[str, object], Sequence[str]]
+RulesLike = Union[str, Mapping[str, Any], Sequence[str]]
 
 
 def _check_seed(seed, name: str = "seed") -> int:
@@ -208,13 +208,14 @@ class LSystem:
             raise TypeError(f"ignore: expected a str of symbols or None, got {type(ignore).__name__}")
         if isinstance(max_length, bool) or not isinstance(max_length, numbers.Integral) or max_length < 1:
             raise ValueError(f"max_length: expected a positive int, got {max_length!r}")
-        self._lines = tuple(_rule_lines(rules))
-        self._seed = _check_seed(seed)
-        self._ignore = ignore or ""
-        self._axiom = axiom
-        self._max_length = int(max_length)
-        self._core = _core.LSystemCore(axiom, list(self._lines), self._ignore, self._seed, self._max_length)
-        self.defaults = dict(defaults or {})
+        self._lines: tuple = tuple(_rule_lines(rules))
+        self._seed: int = _check_seed(seed)
+        self._ignore: str = ignore or ""
+        self._axiom: str = axiom
+        self._max_length: int = int(max_length)
+        self._core: _core.LSystemCore = _core.LSystemCore(axiom, list(self._lines), self._ignore, self._seed,
+                                                          self._max_length)
+        self.defaults: dict = dict(defaults or {})
 
     @classmethod
     def from_string(cls, text: str, *, seed: Optional[int] = None, max_length: int = DEFAULT_MAX_LENGTH) -> "LSystem":

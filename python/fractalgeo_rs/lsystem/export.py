@@ -125,7 +125,7 @@ def write_png(geometry: Union[Polylines, Segments, Mesh], path: PathLike, *, siz
         segs = np.stack([geometry.starts[:, ax2], geometry.ends[:, ax2]], axis=1)
         wmax = float(geometry.widths.max()) if len(geometry.widths) else 1.0
         lw = 0.3 + 3.0 * geometry.widths / (wmax if wmax > 0 else 1.0)
-        ax.add_collection(LineCollection(segs, colors="#5d4037", linewidths=lw))
+        ax.add_collection(LineCollection(list(segs), colors="#5d4037", linewidths=lw))
         polys = [np.asarray(p)[:, ax2] for p in geometry.polygons]
         if polys:
             ax.add_collection(PolyCollection(polys, facecolors="#66bb6a"))
