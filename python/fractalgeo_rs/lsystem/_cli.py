@@ -7,7 +7,8 @@ Example::
 
 Turtle options not given on the command line come from the rule file's
 directives (``n``, ``angle``, ``step``, ``width``, ``width_factor``,
-``tropism``, ``elasticity``, ``sides``, ``draw``, ``move``, ``seed``).
+``tropism``, ``elasticity``, ``sides``, ``draw``, ``move``, ``seed``);
+``dimensions: 2`` makes a ``--png``-only run draw the 2D turtle.
 """
 from __future__ import annotations
 
