@@ -140,11 +140,13 @@ def test_cli_writes_obj_png_and_svg(tmp_path, capsys):
     assert (tmp_path / "b.obj").stat().st_size > 0 and (tmp_path / "b.png").stat().st_size > 0
     args = parser.parse_args(["lsystem", str(rules), "--out", str(tmp_path / "b.svg")])
     assert args.func(args) == 0
+    assert "segments" in capsys.readouterr().out
     flat = tmp_path / "weed.txt"
     flat.write_text("axiom: X\ndimensions: 2\nangle: 20\nX -> F[+X]F[-X]+X\nF -> FF\n")
     args = parser.parse_args(["lsystem", str(flat), "-n", "4", "--png", str(tmp_path / "w.png")])
     assert args.func(args) == 0
-    assert "segments" in capsys.readouterr().out  # the 2D turtle was used
+    out = capsys.readouterr().out
+    assert "segments" in out and "triangles" not in out  # the 2D turtle was used
     args = parser.parse_args(["lsystem", str(rules), "--out", str(tmp_path / "b.txt")])
     with pytest.raises(ValueError, match="--out"):
         args.func(args)
