@@ -34,6 +34,7 @@ from fractalgeo_rs.dimension import (
 )
 
 # -- domain exports: each issue adds its own line below --
+from fractalgeo_rs.lsystem import IFS, LString, LSystem
 
 __all__ = [
     "__version__",
@@ -58,4 +59,7 @@ __all__ = [
     "differential_box_counting",
     "dimension",
     "self_affine_box_counting",
+    "IFS",
+    "LString",
+    "LSystem",
 ]

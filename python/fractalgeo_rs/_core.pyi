@@ -2,7 +2,7 @@
 # Each domain keeps its own section; the public, documented API is in the
 # Python modules that wrap these functions.
 from os import PathLike
-from typing import Optional, Sequence, Tuple
+from typing import Optional, Sequence, Tuple, final
 
 import numpy as np
 import numpy.typing as npt
@@ -44,3 +44,92 @@ def write_png(path: str | PathLike[str], image: np.ndarray) -> None: ...
 # ---- synth / dem ----
 
 # ---- lsystem ----
+_TurtleArgs = Tuple[
+    float, float, float, float,
+    Tuple[float, float, float], float,
+    Tuple[float, float, float], Tuple[float, float, float],
+    str, str,
+]  # angle, step, width, width_factor, tropism, elasticity, heading, left, draw, move
+_MeshArrays = Tuple[
+    npt.NDArray[np.float32], npt.NDArray[np.float32], npt.NDArray[np.float32], npt.NDArray[np.uint32],
+    npt.NDArray[np.uint32], npt.NDArray[np.uint8], npt.NDArray[np.uint32], npt.NDArray[np.uint32],
+]  # vertices, normals, uvs, faces, part_ids, kinds, colors, instances
+
+@final
+class ModuleString:
+    @staticmethod
+    def parse(text: str) -> ModuleString: ...
+    def __len__(self) -> int: ...
+    def __eq__(self, other: object, /) -> bool: ...
+    def count(self, symbol: str) -> int: ...
+    def symbols(self) -> str: ...
+    def parameters(self) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint64]]: ...
+
+@final
+class LSystemCore:
+    def __new__(cls, axiom: str, rules: Sequence[str], ignore: str, seed: int, max_length: int) -> LSystemCore: ...
+    def derive(self, n: int, seed: Optional[int] = None, n_threads: Optional[int] = None) -> ModuleString: ...
+    @property
+    def is_stochastic(self) -> bool: ...
+    @property
+    def n_rules(self) -> int: ...
+    @property
+    def axiom(self) -> ModuleString: ...
+
+def lsystem_parse_text(text: str) -> Tuple[str, Optional[str], list[str], list[Tuple[str, str]]]: ...
+def turtle_polylines(
+    lstring: ModuleString, turtle: _TurtleArgs
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint64], npt.NDArray[np.float64], npt.NDArray[np.uint64]]: ...
+def turtle_segments(
+    lstring: ModuleString, turtle: _TurtleArgs
+) -> Tuple[
+    npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.uint32],
+    npt.NDArray[np.float64], npt.NDArray[np.uint64],
+]: ...
+def turtle_mesh(lstring: ModuleString, turtle: _TurtleArgs, sides: int, n_threads: Optional[int] = None) -> _MeshArrays: ...
+def write_mesh(
+    path: str | PathLike[str],
+    format: str,
+    vertices: npt.NDArray[np.float32],
+    normals: npt.NDArray[np.float32],
+    uvs: npt.NDArray[np.float32],
+    faces: npt.NDArray[np.uint32],
+    part_ids: npt.NDArray[np.uint32],
+    kinds: npt.NDArray[np.uint8],
+    colors: npt.NDArray[np.uint32],
+    instances: npt.NDArray[np.uint32],
+) -> None: ...
+def plants_on_terrain(
+    lsystem: LSystemCore,
+    n: int,
+    dem: npt.NDArray[np.float64],
+    cell_size: float,
+    density: float,
+    seed: int,
+    scale: float,
+    max_plants: int,
+    turtle: _TurtleArgs,
+    sides: int,
+    n_threads: Optional[int] = None,
+) -> Tuple[_MeshArrays, npt.NDArray[np.float64]]: ...
+def ifs_check(
+    maps: npt.NDArray[np.float64], probabilities: Optional[Sequence[float]] = None
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], Optional[float]]: ...
+def ifs_preset(name: str) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], Optional[float]]: ...
+def ifs_chaos_game(
+    maps: npt.NDArray[np.float64],
+    probabilities: Optional[Sequence[float]],
+    n_points: int,
+    seed: int,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...
+def ifs_iterate(
+    maps: npt.NDArray[np.float64], depth: int, max_points: int, n_threads: Optional[int] = None
+) -> npt.NDArray[np.float64]: ...
+def ifs_rasterize(
+    points: npt.NDArray[np.float64],
+    n_rows: int,
+    n_cols: int,
+    bounds: Optional[Sequence[float]] = None,
+) -> Tuple[npt.NDArray[np.uint8], Tuple[float, float, float, float]]: ...
+def moran_dimension(ratios: Sequence[float]) -> float: ...

@@ -1,6 +1,406 @@
-//! Bindings of `crate::lsystem` (filled by the L-system issue).
+//! Bindings of `crate::lsystem`: L-systems, turtle geometry, mesh files, IFS
+//! and plants on terrain. The documented API is `fractalgeo_rs.lsystem`.
+//! Every kernel runs through `run_in_pool`, so even a bug (a panic) comes
+//! back as RuntimeError, never as a PanicException.
+use crate::lsystem::derive::LSystem;
+use crate::lsystem::grammar::{parse_module_string, parse_rule_text, ModString};
+use crate::lsystem::mesh::{build_mesh, Mesh};
+use crate::lsystem::terrain::{plants_on_terrain as scene_kernel, SceneParams};
+use crate::lsystem::turtle::{polylines, segments, TurtleParams};
+use crate::lsystem::{export, ifs};
+use crate::parallel::run_in_pool;
+use glam::DVec3;
+use numpy::ndarray::{Array1, Array2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use std::path::PathBuf;
+use std::sync::Arc;
 
-pub fn register(_m: &Bound<'_, PyModule>) -> PyResult<()> {
+/// Turtle options as passed from Python:
+/// (angle, step, width, width_factor, tropism, elasticity, heading, left, draw, moves).
+type TurtleArgs = (f64, f64, f64, f64, [f64; 3], f64, [f64; 3], [f64; 3], String, String);
+
+fn turtle_params(t: TurtleArgs) -> TurtleParams {
+    TurtleParams {
+        angle: t.0,
+        step: t.1,
+        width: t.2,
+        width_factor: t.3,
+        tropism: DVec3::from_array(t.4),
+        elasticity: t.5,
+        heading: DVec3::from_array(t.6),
+        left: DVec3::from_array(t.7),
+        draw: t.8.chars().collect(),
+        moves: t.9.chars().collect(),
+    }
+}
+
+fn rows<T: Copy, const N: usize>(v: Vec<[T; N]>) -> Array2<T> {
+    let n = v.len();
+    Array2::from_shape_vec((n, N), v.into_flattened()).expect("rectangular rows")
+}
+
+fn flat_polys<const N: usize>(polys: Vec<Vec<[f64; N]>>) -> (Array2<f64>, Array1<u64>) {
+    let mut offsets = vec![0u64];
+    let mut pts = Vec::new();
+    for p in polys {
+        pts.extend(p);
+        offsets.push(pts.len() as u64);
+    }
+    (rows(pts), Array1::from_vec(offsets))
+}
+
+/// A compiled L-system (see `fractalgeo_rs.lsystem.LSystem`).
+#[pyclass(frozen, module = "fractalgeo_rs._core")]
+pub struct LSystemCore {
+    inner: Arc<LSystem>,
+}
+
+/// A derived string of modules (see `fractalgeo_rs.lsystem.LString`).
+#[pyclass(frozen, module = "fractalgeo_rs._core")]
+pub struct ModuleString {
+    inner: Arc<ModString>,
+}
+
+#[pymethods]
+impl LSystemCore {
+    #[new]
+    #[pyo3(signature = (axiom, rules, ignore, seed, max_length))]
+    fn new(axiom: &str, rules: Vec<String>, ignore: &str, seed: u64, max_length: usize) -> PyResult<Self> {
+        let l = run_in_pool(Some(1), || LSystem::new(axiom, &rules, ignore, seed, max_length))?;
+        Ok(LSystemCore { inner: Arc::new(l) })
+    }
+
+    /// Derive `n` steps with `seed` (the system's seed when None).
+    #[pyo3(signature = (n, seed=None, n_threads=None))]
+    fn derive(&self, py: Python<'_>, n: usize, seed: Option<u64>, n_threads: Option<usize>) -> PyResult<ModuleString> {
+        let l = self.inner.clone();
+        let seed = seed.unwrap_or(l.seed);
+        let s = py.detach(|| run_in_pool(n_threads, || l.derive_with_seed(n, seed)))?;
+        Ok(ModuleString { inner: Arc::new(s) })
+    }
+
+    #[getter]
+    fn is_stochastic(&self) -> bool {
+        self.inner.is_stochastic()
+    }
+
+    #[getter]
+    fn n_rules(&self) -> usize {
+        self.inner.rules.len()
+    }
+
+    #[getter]
+    fn axiom(&self) -> ModuleString {
+        ModuleString { inner: Arc::new(self.inner.axiom.clone()) }
+    }
+}
+
+#[pymethods]
+impl ModuleString {
+    /// Parse a module string such as `"F(1)[+A(2,3)]"` (constant parameters).
+    #[staticmethod]
+    fn parse(text: &str) -> PyResult<Self> {
+        Ok(ModuleString { inner: Arc::new(run_in_pool(Some(1), || parse_module_string(text, "text"))?) })
+    }
+    fn __len__(&self) -> usize {
+        self.inner.len()
+    }
+    fn __str__(&self) -> String {
+        self.inner.to_text()
+    }
+    fn __eq__(&self, other: &ModuleString) -> bool {
+        self.inner == other.inner
+    }
+    /// Number of modules with this symbol.
+    fn count(&self, symbol: char) -> usize {
+        self.inner.count(symbol)
+    }
+    /// The symbols alone, as a str.
+    fn symbols(&self) -> String {
+        self.inner.syms.iter().collect()
+    }
+    /// (parameters (P,), offsets (N+1,)): parameters of module i are
+    /// params[offsets[i]:offsets[i+1]].
+    fn parameters<'py>(&self, py: Python<'py>) -> (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<u64>>) {
+        let s = &self.inner;
+        let off: Vec<u64> = if s.pstart.is_empty() { vec![0; s.len() + 1] } else { s.pstart.iter().map(|&v| v as u64).collect() };
+        (s.params.clone().into_pyarray(py), off.into_pyarray(py))
+    }
+}
+
+/// Parse the rule text format: (axiom, ignore or None, rules, directives).
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn lsystem_parse_text(text: &str) -> PyResult<(String, Option<String>, Vec<String>, Vec<(String, String)>)> {
+    let t = run_in_pool(Some(1), || parse_rule_text(text))?;
+    Ok((t.axiom.unwrap_or_default(), t.ignore, t.rules, t.directives))
+}
+
+/// 2D turtle: (xy (N,2), offsets (K+1,), polygon_xy (M,2), polygon_offsets (P+1,)).
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn turtle_polylines<'py>(
+    py: Python<'py>,
+    lstring: &ModuleString,
+    turtle: TurtleArgs,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u64>>)> {
+    let s = lstring.inner.clone();
+    let p = turtle_params(turtle);
+    let r = py.detach(|| run_in_pool(Some(1), || polylines(&s, &p)))?;
+    let off: Vec<u64> = r.offsets.iter().map(|&v| v as u64).collect();
+    let (pp, po) = flat_polys(r.polygons);
+    Ok((rows(r.xy).into_pyarray(py), off.into_pyarray(py), pp.into_pyarray(py), po.into_pyarray(py)))
+}
+
+/// 3D turtle: (starts (N,3), ends (N,3), widths (N,), colors (N,),
+/// polygon_xyz (M,3), polygon_offsets (P+1,)).
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn turtle_segments<'py>(
+    py: Python<'py>,
+    lstring: &ModuleString,
+    turtle: TurtleArgs,
+) -> PyResult<(
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<u32>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<u64>>,
+)> {
+    let s = lstring.inner.clone();
+    let p = turtle_params(turtle);
+    let r = py.detach(|| run_in_pool(Some(1), || segments(&s, &p)))?;
+    let (pp, po) = flat_polys(r.polygons);
+    Ok((
+        rows(r.starts).into_pyarray(py),
+        rows(r.ends).into_pyarray(py),
+        r.widths.into_pyarray(py),
+        r.colors.into_pyarray(py),
+        pp.into_pyarray(py),
+        po.into_pyarray(py),
+    ))
+}
+
+type MeshArrays<'py> = (
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray2<u32>>,
+    Bound<'py, PyArray1<u32>>,
+    Bound<'py, PyArray1<u8>>,
+    Bound<'py, PyArray1<u32>>,
+    Bound<'py, PyArray1<u32>>,
+);
+
+fn mesh_arrays(py: Python<'_>, m: Mesh) -> MeshArrays<'_> {
+    (
+        rows(m.vertices).into_pyarray(py),
+        rows(m.normals).into_pyarray(py),
+        rows(m.uvs).into_pyarray(py),
+        rows(m.faces).into_pyarray(py),
+        m.part_ids.into_pyarray(py),
+        m.kinds.into_pyarray(py),
+        m.colors.into_pyarray(py),
+        m.instances.into_pyarray(py),
+    )
+}
+
+/// Mesh of a module string: (vertices, normals, uvs, faces, part_ids, kinds, colors, instances).
+#[pyfunction]
+#[pyo3(signature = (lstring, turtle, sides, n_threads=None))]
+fn turtle_mesh<'py>(
+    py: Python<'py>,
+    lstring: &ModuleString,
+    turtle: TurtleArgs,
+    sides: usize,
+    n_threads: Option<usize>,
+) -> PyResult<MeshArrays<'py>> {
+    let s = lstring.inner.clone();
+    let p = turtle_params(turtle);
+    let m = py.detach(|| run_in_pool(n_threads, || build_mesh(&s, &p, sides)))?;
+    Ok(mesh_arrays(py, m))
+}
+
+fn to_rows<T: numpy::Element + Copy, const N: usize>(a: &PyReadonlyArray2<'_, T>, name: &str) -> PyResult<Vec<[T; N]>> {
+    let v = a.as_array();
+    if v.ncols() != N {
+        return Err(PyValueError::new_err(format!("{name}: expected shape (n, {N}), got {:?}", a.shape())));
+    }
+    Ok(v.rows().into_iter().map(|r| std::array::from_fn(|k| r[k])).collect())
+}
+
+#[allow(clippy::too_many_arguments)]
+fn mesh_from_arrays(
+    vertices: PyReadonlyArray2<'_, f32>,
+    normals: PyReadonlyArray2<'_, f32>,
+    uvs: PyReadonlyArray2<'_, f32>,
+    faces: PyReadonlyArray2<'_, u32>,
+    part_ids: PyReadonlyArray1<'_, u32>,
+    kinds: PyReadonlyArray1<'_, u8>,
+    colors: PyReadonlyArray1<'_, u32>,
+    instances: PyReadonlyArray1<'_, u32>,
+) -> PyResult<Mesh> {
+    Ok(Mesh {
+        vertices: to_rows(&vertices, "vertices")?,
+        normals: to_rows(&normals, "normals")?,
+        uvs: to_rows(&uvs, "uvs")?,
+        faces: to_rows(&faces, "faces")?,
+        part_ids: part_ids.as_array().to_vec(),
+        kinds: kinds.as_array().to_vec(),
+        colors: colors.as_array().to_vec(),
+        instances: instances.as_array().to_vec(),
+    })
+}
+
+/// Write a mesh as OBJ (`format="obj"`) or binary PLY (`format="ply"`), atomically.
+#[pyfunction]
+#[pyo3(signature = (path, format, vertices, normals, uvs, faces, part_ids, kinds, colors, instances))]
+#[allow(clippy::too_many_arguments)]
+fn write_mesh(
+    py: Python<'_>,
+    path: PathBuf,
+    format: &str,
+    vertices: PyReadonlyArray2<'_, f32>,
+    normals: PyReadonlyArray2<'_, f32>,
+    uvs: PyReadonlyArray2<'_, f32>,
+    faces: PyReadonlyArray2<'_, u32>,
+    part_ids: PyReadonlyArray1<'_, u32>,
+    kinds: PyReadonlyArray1<'_, u8>,
+    colors: PyReadonlyArray1<'_, u32>,
+    instances: PyReadonlyArray1<'_, u32>,
+) -> PyResult<()> {
+    let m = mesh_from_arrays(vertices, normals, uvs, faces, part_ids, kinds, colors, instances)?;
+    match format {
+        "obj" => py.detach(|| run_in_pool(Some(1), || export::write_obj(&m, &path)))?,
+        "ply" => py.detach(|| run_in_pool(Some(1), || export::write_ply(&m, &path)))?,
+        _ => return Err(PyValueError::new_err(format!("format: expected 'obj' or 'ply', got {format:?}"))),
+    }
+    Ok(())
+}
+
+/// Plants on a DEM: mesh arrays plus the plant base points (P,3).
+#[pyfunction]
+#[pyo3(signature = (lsystem, n, dem, cell_size, density, seed, scale, max_plants, turtle, sides, n_threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn plants_on_terrain<'py>(
+    py: Python<'py>,
+    lsystem: &LSystemCore,
+    n: usize,
+    dem: PyReadonlyArray2<'py, f64>,
+    cell_size: f64,
+    density: f64,
+    seed: u64,
+    scale: f64,
+    max_plants: usize,
+    turtle: TurtleArgs,
+    sides: usize,
+    n_threads: Option<usize>,
+) -> PyResult<(MeshArrays<'py>, Bound<'py, PyArray2<f64>>)> {
+    let (r, c) = (dem.shape()[0], dem.shape()[1]);
+    let z: Vec<f64> = dem.as_array().iter().copied().collect();
+    let l = lsystem.inner.clone();
+    let p = SceneParams { n, turtle: turtle_params(turtle), sides, cell_size, density, seed, scale, max_plants };
+    let (m, bases) = py.detach(|| run_in_pool(n_threads, || scene_kernel(&l, &z, r, c, &p)))?;
+    Ok((mesh_arrays(py, m), rows(bases).into_pyarray(py)))
+}
+
+fn ifs_from(maps: &PyReadonlyArray2<'_, f64>, probabilities: Option<Vec<f64>>) -> PyResult<ifs::Ifs> {
+    let rows_: Vec<[f64; 6]> = to_rows(maps, "maps")?;
+    Ok(run_in_pool(Some(1), || ifs::Ifs::new(&rows_, probabilities.as_deref()))?)
+}
+
+/// Validate an IFS: returns (maps (k,6), probabilities (k,), similarity dimension or None).
+#[pyfunction]
+#[pyo3(signature = (maps, probabilities=None))]
+#[allow(clippy::type_complexity)]
+fn ifs_check<'py>(
+    py: Python<'py>,
+    maps: PyReadonlyArray2<'py, f64>,
+    probabilities: Option<Vec<f64>>,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Option<f64>)> {
+    let f = ifs_from(&maps, probabilities)?;
+    Ok((rows(f.rows()).into_pyarray(py), f.probs.clone().into_pyarray(py), f.similarity_dimension()))
+}
+
+/// A preset IFS: (maps (k,6), probabilities (k,), exact dimension or None).
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn ifs_preset<'py>(py: Python<'py>, name: &str) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Option<f64>)> {
+    let (f, d) = run_in_pool(Some(1), || ifs::preset(name))?;
+    Ok((rows(f.rows()).into_pyarray(py), f.probs.clone().into_pyarray(py), d))
+}
+
+/// Chaos game points (n_points, 2).
+#[pyfunction]
+#[pyo3(signature = (maps, probabilities, n_points, seed, n_threads=None))]
+fn ifs_chaos_game<'py>(
+    py: Python<'py>,
+    maps: PyReadonlyArray2<'py, f64>,
+    probabilities: Option<Vec<f64>>,
+    n_points: usize,
+    seed: u64,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let f = ifs_from(&maps, probabilities)?;
+    let pts = py.detach(|| run_in_pool(n_threads, || f.chaos_game(n_points, seed)))?;
+    Ok(rows(pts).into_pyarray(py))
+}
+
+/// Deterministic iteration points (k^depth, 2).
+#[pyfunction]
+#[pyo3(signature = (maps, depth, max_points, n_threads=None))]
+fn ifs_iterate<'py>(
+    py: Python<'py>,
+    maps: PyReadonlyArray2<'py, f64>,
+    depth: usize,
+    max_points: usize,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let f = ifs_from(&maps, None)?;
+    let pts = py.detach(|| run_in_pool(n_threads, || f.iterate(depth, max_points)))?;
+    Ok(rows(pts).into_pyarray(py))
+}
+
+/// Rasterise points (N,2) to a (rows, cols) uint8 image; returns (image, bounds).
+#[pyfunction]
+#[pyo3(signature = (points, n_rows, n_cols, bounds=None))]
+fn ifs_rasterize<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    n_rows: usize,
+    n_cols: usize,
+    bounds: Option<[f64; 4]>,
+) -> PyResult<(Bound<'py, PyArray2<u8>>, [f64; 4])> {
+    let pts: Vec<[f64; 2]> = to_rows(&points, "points")?;
+    let b = bounds.unwrap_or_else(|| ifs::bounds(&pts));
+    let img = py.detach(|| run_in_pool(Some(1), || ifs::rasterize(&pts, n_rows, n_cols, b)))?;
+    let a = Array2::from_shape_vec((n_rows, n_cols), img).expect("raster shape");
+    Ok((a.into_pyarray(py), b))
+}
+
+/// Root of Moran's equation sum r_i^s = 1.
+#[pyfunction]
+fn moran_dimension(ratios: Vec<f64>) -> PyResult<f64> {
+    Ok(run_in_pool(Some(1), || ifs::moran_dimension(&ratios))?)
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<LSystemCore>()?;
+    m.add_class::<ModuleString>()?;
+    m.add_function(wrap_pyfunction!(lsystem_parse_text, m)?)?;
+    m.add_function(wrap_pyfunction!(turtle_polylines, m)?)?;
+    m.add_function(wrap_pyfunction!(turtle_segments, m)?)?;
+    m.add_function(wrap_pyfunction!(turtle_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(write_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(plants_on_terrain, m)?)?;
+    m.add_function(wrap_pyfunction!(ifs_check, m)?)?;
+    m.add_function(wrap_pyfunction!(ifs_preset, m)?)?;
+    m.add_function(wrap_pyfunction!(ifs_chaos_game, m)?)?;
+    m.add_function(wrap_pyfunction!(ifs_iterate, m)?)?;
+    m.add_function(wrap_pyfunction!(ifs_rasterize, m)?)?;
+    m.add_function(wrap_pyfunction!(moran_dimension, m)?)?;
     Ok(())
 }

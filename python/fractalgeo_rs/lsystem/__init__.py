@@ -1,0 +1,46 @@
+"""L-systems, turtle geometry and iterated function systems.
+
+* :class:`LSystem` - DOL, bracketed, stochastic, context-sensitive and
+  parametric rewriting in Rust, loadable from a small text format;
+* :func:`turtle_2d`, :func:`turtle_3d`, :func:`plant_mesh` - turtle
+  interpretation to polylines, segments and triangle meshes;
+* :func:`write_obj`, :func:`write_ply`, :func:`write_svg`, :func:`write_png`;
+* :class:`IFS`, :func:`ifs_preset`, :func:`moran_dimension` - iterated
+  function systems;
+* :func:`plants_on_terrain` - a scene of plants on a DEM.
+
+References
+----------
+P. Prusinkiewicz and A. Lindenmayer, *The Algorithmic Beauty of Plants*,
+Springer, 1990. M. Barnsley, *Fractals Everywhere*, Academic Press, 1988.
+J. E. Hutchinson, Fractals and self-similarity, *Indiana Univ. Math. J.* 30
+(1981) 713-747.
+"""
+from fractalgeo_rs.lsystem.core import DEFAULT_MAX_LENGTH, LString, LSystem
+from fractalgeo_rs.lsystem.export import write_obj, write_ply, write_png, write_svg
+from fractalgeo_rs.lsystem.geometry import TURTLE_SYMBOLS, Mesh, Polylines, Segments, plant_mesh, turtle_2d, turtle_3d
+from fractalgeo_rs.lsystem.ifs import IFS, IFS_PRESETS, ifs_preset, moran_dimension, rasterize_points
+from fractalgeo_rs.lsystem.terrain import plants_on_terrain
+
+__all__ = [
+    "DEFAULT_MAX_LENGTH",
+    "IFS",
+    "IFS_PRESETS",
+    "LString",
+    "LSystem",
+    "Mesh",
+    "Polylines",
+    "Segments",
+    "TURTLE_SYMBOLS",
+    "ifs_preset",
+    "moran_dimension",
+    "plant_mesh",
+    "plants_on_terrain",
+    "rasterize_points",
+    "turtle_2d",
+    "turtle_3d",
+    "write_obj",
+    "write_ply",
+    "write_png",
+    "write_svg",
+]

@@ -1,0 +1,278 @@
+"""Turtle interpretation of L-strings in 2D and 3D and triangle meshes.
+
+Conventions of Prusinkiewicz and Lindenmayer (1990), sections 1.2, 1.5, 2.3
+and 5.1; see :func:`turtle_3d` for the symbol table.
+"""
+from __future__ import annotations
+
+import numbers
+from dataclasses import dataclass
+from typing import Optional, Sequence, Union
+
+import numpy as np
+
+from fractalgeo_rs import _core
+from fractalgeo_rs._validation import check_n_threads
+from fractalgeo_rs.lsystem.core import LString
+
+__all__ = ["Polylines", "Segments", "Mesh", "turtle_2d", "turtle_3d", "plant_mesh", "TURTLE_SYMBOLS"]
+
+#: The symbols the turtle interprets (others are ignored).
+TURTLE_SYMBOLS = "F G f g + - & ^ \\ / | $ [ ] ! ' { } ."
+
+_PLANAR = ((0.0, 1.0, 0.0), (-1.0, 0.0, 0.0))
+_SPATIAL = ((0.0, 0.0, 1.0), (-1.0, 0.0, 0.0))
+
+
+def _as_lstring(lstring) -> LString:
+    if isinstance(lstring, LString):
+        return lstring
+    if isinstance(lstring, str):
+        return LString.parse(lstring)
+    raise TypeError(f"lstring: expected an LString or a str, got {type(lstring).__name__}")
+
+
+def _real(v, name):
+    if isinstance(v, bool) or not isinstance(v, numbers.Real):
+        raise TypeError(f"{name}: expected a number, got {v!r}")
+    return float(v)
+
+
+def _vec3(v, name):
+    a = np.asarray(v, dtype=float)
+    if a.shape != (3,):
+        raise ValueError(f"{name}: expected 3 numbers, got shape {a.shape}")
+    return tuple(float(x) for x in a)
+
+
+def _symbols(v, name):
+    if not isinstance(v, str):
+        raise TypeError(f"{name}: expected a str of symbols, got {type(v).__name__}")
+    return v
+
+
+def turtle_args(*, angle=90.0, step=1.0, width=1.0, width_factor=0.7, tropism=(0.0, 0.0, 0.0), elasticity=0.0,
+                draw="FG", move="fg", planar=False) -> tuple:
+    """Validated turtle options in the order ``_core`` expects."""
+    h, l = _PLANAR if planar else _SPATIAL
+    return (
+        _real(angle, "angle"),
+        _real(step, "step"),
+        _real(width, "width"),
+        _real(width_factor, "width_factor"),
+        _vec3(tropism, "tropism"),
+        _real(elasticity, "elasticity"),
+        h,
+        l,
+        _symbols(draw, "draw"),
+        _symbols(move, "move"),
+    )
+
+
+def _split(points: np.ndarray, offsets: np.ndarray) -> list:
+    return [points[offsets[k]:offsets[k + 1]] for k in range(len(offsets) - 1)]
+
+
+@dataclass(frozen=True)
+class Polylines:
+    """2D drawing: ``xy`` (N, 2) vertices, polyline ``k`` is
+    ``xy[offsets[k]:offsets[k+1]]``; ``polygons`` are the filled leaves."""
+
+    xy: np.ndarray
+    offsets: np.ndarray
+    polygons: list
+
+    @property
+    def lines(self) -> list:
+        """The polylines as a list of (n_k, 2) arrays."""
+        return _split(self.xy, self.offsets)
+
+    @property
+    def n_segments(self) -> int:
+        return int(len(self.xy) - (len(self.offsets) - 1))
+
+
+@dataclass(frozen=True)
+class Segments:
+    """3D segments: ``starts``/``ends`` (N, 3), ``widths`` (N,) diameters,
+    ``colors`` (N,) colour indices; ``polygons`` is a list of (m, 3) leaves."""
+
+    starts: np.ndarray
+    ends: np.ndarray
+    widths: np.ndarray
+    colors: np.ndarray
+    polygons: list
+
+    def __len__(self) -> int:
+        return len(self.starts)
+
+
+@dataclass(frozen=True)
+class Mesh:
+    """An indexed triangle mesh.
+
+    Attributes
+    ----------
+    vertices, normals : (V, 3) float32
+    uvs : (V, 2) float32
+        Texture coordinates: u around a branch tube in [0, 1], v along the
+        branch in turtle units; leaves are mapped to [0, 1]^2.
+    faces : (T, 3) uint32
+        Counter-clockwise seen from outside.
+    part_ids : (T,) uint32
+        Turtle element of the triangle: segment number (branches) or
+        polygon number (leaves).
+    kinds : (T,) uint8
+        0 for branches, 1 for leaves.
+    colors : (T,) uint32
+        Colour index set by ``'``.
+    instances : (T,) uint32
+        Plant number in a scene (0 for a single plant).
+    """
+
+    vertices: np.ndarray
+    normals: np.ndarray
+    uvs: np.ndarray
+    faces: np.ndarray
+    part_ids: np.ndarray
+    kinds: np.ndarray
+    colors: np.ndarray
+    instances: np.ndarray
+
+    @classmethod
+    def _from_core(cls, t) -> "Mesh":
+        return cls(*t)
+
+    def write_obj(self, path) -> None:
+        """Write a Wavefront OBJ file (see :func:`fractalgeo_rs.lsystem.write_obj`)."""
+        from fractalgeo_rs.lsystem.export import write_obj
+
+        write_obj(self, path)
+
+    def write_ply(self, path) -> None:
+        """Write a binary PLY file (see :func:`fractalgeo_rs.lsystem.write_ply`)."""
+        from fractalgeo_rs.lsystem.export import write_ply
+
+        write_ply(self, path)
+
+
+def turtle_2d(lstring: Union[LString, str], *, angle: float = 90.0, step: float = 1.0, draw: str = "FG",
+              move: str = "fg") -> Polylines:
+    """Interpret an L-string with the turtle in the plane.
+
+    The turtle starts at the origin heading +y; ``+`` turns left
+    (counter-clockwise) by ``angle`` degrees, ``-`` right; see
+    :func:`turtle_3d` for all symbols. Symbols in ``draw`` move forward and
+    draw, those in ``move`` move without drawing (e.g. ``draw="FLR"`` for
+    the ``F_l``/``F_r`` edge-rewriting curves of ABOP section 1.4).
+
+    Returns
+    -------
+    Polylines
+        Connected runs of segments; a polyline ends where the pen lifts
+        (``f``, ``]``).
+
+    References
+    ----------
+    P. Prusinkiewicz and A. Lindenmayer, *The Algorithmic Beauty of Plants*,
+    Springer, 1990, section 1.2.
+
+    Examples
+    --------
+    >>> from fractalgeo_rs.lsystem import turtle_2d
+    >>> (turtle_2d("F+F+F+F").xy.round(12) + 0.0).tolist()
+    [[0.0, 0.0], [0.0, 1.0], [-1.0, 1.0], [-1.0, 0.0], [0.0, 0.0]]
+    """
+    s = _as_lstring(lstring)
+    args = turtle_args(angle=angle, step=step, draw=draw, move=move, planar=True)
+    xy, off, pxy, poff = _core.turtle_polylines(s._core, args)
+    return Polylines(xy, off, _split(pxy, poff))
+
+
+def turtle_3d(lstring: Union[LString, str], *, angle: float = 90.0, step: float = 1.0, width: float = 1.0,
+              width_factor: float = 0.7, tropism: Sequence[float] = (0.0, 0.0, 0.0), elasticity: float = 0.0,
+              draw: str = "FG", move: str = "fg") -> Segments:
+    r"""Interpret an L-string with the turtle in space.
+
+    The state is a position and a frame heading ``H`` (initially +z), left
+    ``L`` (-x) and up ``U = H x L``. A module's first parameter overrides the
+    default step, angle, width or colour.
+
+    ============  ========================================================
+    ``F`` ``G``   move forward by ``step`` and draw a segment
+    ``f`` ``g``   move forward without drawing
+    ``+`` ``-``   turn left / right by ``angle`` (about ``U``)
+    ``&`` ``^``   pitch down / up (about ``L``)
+    ``\`` ``/``   roll left / right (about ``H``)
+    ``|``         turn around
+    ``$``         roll so that ``L`` is horizontal
+    ``[`` ``]``   push / pop the turtle state (branches)
+    ``!``         set the width to the parameter, else multiply by ``width_factor``
+    ``'``         set the colour index to the parameter, else add 1
+    ``{`` ``}``   begin / end a polygon (leaf); ``.`` records a vertex
+    ============  ========================================================
+
+    Tropism (ABOP section 2.3.2): after each drawn step the frame turns about
+    ``H x T`` by ``elasticity * |H x T|``.
+
+    Returns
+    -------
+    Segments
+
+    References
+    ----------
+    P. Prusinkiewicz and A. Lindenmayer, *The Algorithmic Beauty of Plants*,
+    Springer, 1990, sections 1.5 (turtle in three dimensions), 2.3.2
+    (tropism) and 5.1 (polygons).
+
+    Examples
+    --------
+    >>> from fractalgeo_rs.lsystem import turtle_3d
+    >>> seg = turtle_3d("F&F", angle=90)
+    >>> seg.ends.round(12).tolist()
+    [[0.0, 0.0, 1.0], [0.0, 1.0, 1.0]]
+    """
+    s = _as_lstring(lstring)
+    args = turtle_args(angle=angle, step=step, width=width, width_factor=width_factor, tropism=tropism,
+                       elasticity=elasticity, draw=draw, move=move)
+    st, en, w, c, pxyz, poff = _core.turtle_segments(s._core, args)
+    return Segments(st, en, w, c, _split(pxyz, poff))
+
+
+def plant_mesh(lstring: Union[LString, str], *, sides: int = 6, angle: float = 90.0, step: float = 1.0,
+               width: float = 1.0, width_factor: float = 0.7, tropism: Sequence[float] = (0.0, 0.0, 0.0),
+               elasticity: float = 0.0, draw: str = "FG", move: str = "fg",
+               n_threads: Optional[int] = None) -> Mesh:
+    """Triangle mesh of an L-string: generalised cylinders and leaves.
+
+    Each chain of segments drawn without lifting the pen becomes one tube
+    with ``sides`` sides whose rings are shared between consecutive segments
+    (a ring of ``sides + 1`` vertices, the last repeating the first for the
+    texture seam); a branch ``[`` starts a new tube. Leaves (``{ . }``) are
+    fan-triangulated with their Newell normal. Turtle options as in
+    :func:`turtle_3d`; the triangles are written by ``n_threads`` threads
+    (all cores when None), with the same result for any number.
+
+    Returns
+    -------
+    Mesh
+
+    References
+    ----------
+    P. Prusinkiewicz and A. Lindenmayer, *The Algorithmic Beauty of Plants*,
+    Springer, 1990, section 5.1; J. Bloomenthal, Modeling the mighty maple,
+    *SIGGRAPH* 1985.
+
+    Examples
+    --------
+    >>> from fractalgeo_rs.lsystem import plant_mesh
+    >>> m = plant_mesh("FF", sides=6)
+    >>> m.vertices.shape, m.faces.shape
+    ((21, 3), (24, 3))
+    """
+    s = _as_lstring(lstring)
+    if isinstance(sides, bool) or not isinstance(sides, numbers.Integral):
+        raise TypeError(f"sides: expected an int, got {sides!r}")
+    args = turtle_args(angle=angle, step=step, width=width, width_factor=width_factor, tropism=tropism,
+                       elasticity=elasticity, draw=draw, move=move)
+    return Mesh._from_core(_core.turtle_mesh(s._core, args, int(sides), check_n_threads(n_threads)))

@@ -1,0 +1,551 @@
+//! Parallel rewriting of module strings (Prusinkiewicz and Lindenmayer 1990,
+//! chapter 1; eq. 23 of the seed paper).
+//!
+//! In one derivation step every module of the string is rewritten at the
+//! same time: the productions see the string of the previous step only. The
+//! string is cut into chunks that rayon rewrites independently; the chunks
+//! are then concatenated in order, so the result does not depend on the
+//! number of threads.
+//!
+//! Stochastic choices draw a uniform number from a counter-based hash of
+//! `(seed, generation, position)` (SplitMix64 finaliser), not from a
+//! sequential generator: any chunking gives the same string.
+use super::grammar::{compile_rules, parse_module_string, ModString, Rule};
+use crate::error::{CoreError, CoreResult};
+use rayon::prelude::*;
+use std::collections::HashMap;
+
+/// Default limit on the number of modules of a derived string.
+pub const DEFAULT_MAX_LENGTH: usize = 100_000_000;
+
+/// Largest number of derivation steps (a string that does not grow would
+/// otherwise let a huge `n` run for hours).
+pub const MAX_STEPS: usize = 1_000_000;
+
+/// SplitMix64 finaliser (Steele, Lea and Flood 2014).
+#[inline]
+pub fn mix64(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// A hash of three words, for counter-based random numbers.
+#[inline]
+pub fn hash3(seed: u64, a: u64, b: u64) -> u64 {
+    mix64(mix64(mix64(seed) ^ a) ^ b)
+}
+
+/// Uniform number in [0, 1) from `(seed, a, b)`.
+#[inline]
+pub fn unit3(seed: u64, a: u64, b: u64) -> f64 {
+    (hash3(seed, a, b) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+}
+
+/// Rule of each symbol of a context-free, condition-free, non-parametric
+/// system: ASCII by code (`u32::MAX` = none), others by map.
+type SimpleTable = (Vec<u32>, HashMap<char, u32>);
+
+/// A compiled L-system.
+#[derive(Debug, Clone)]
+pub struct LSystem {
+    pub axiom: ModString,
+    pub rules: Vec<Rule>,
+    pub ignore: Vec<char>,
+    pub seed: u64,
+    pub max_length: usize,
+    ascii: Vec<Vec<u32>>,
+    other: HashMap<char, Vec<u32>>,
+    needs_mates: bool,
+    parametric: bool,
+    max_slots: usize,
+    /// Fast path: context-free, condition-free, non-parametric (deterministic or stochastic).
+    simple: Option<SimpleTable>,
+}
+
+/// Per-chunk output.
+struct Piece {
+    syms: Vec<char>,
+    counts: Vec<u32>,
+    params: Vec<f64>,
+}
+
+impl LSystem {
+    /// Compile an L-system from its axiom, production lines (see
+    /// [`super::grammar`]), the symbols ignored by context matching, a seed
+    /// and a size limit.
+    pub fn new(axiom: &str, rules: &[String], ignore: &str, seed: u64, max_length: usize) -> CoreResult<Self> {
+        if max_length == 0 {
+            return Err(CoreError::invalid("max_length", "must be positive"));
+        }
+        let axiom = parse_module_string(axiom, "axiom")?;
+        if axiom.is_empty() {
+            return Err(CoreError::invalid("axiom", "the axiom is empty"));
+        }
+        let rules = compile_rules(rules)?;
+        let ignore: Vec<char> = ignore.chars().filter(|c| !c.is_whitespace()).collect();
+        if ignore.iter().any(|&c| c == '[' || c == ']') {
+            return Err(CoreError::invalid("ignore", "brackets cannot be ignored"));
+        }
+        let mut ascii = vec![Vec::new(); 128];
+        let mut other: HashMap<char, Vec<u32>> = HashMap::new();
+        for (k, r) in rules.iter().enumerate() {
+            let c = r.pred.sym;
+            if (c as u32) < 128 {
+                ascii[c as usize].push(k as u32);
+            } else {
+                other.entry(c).or_default().push(k as u32);
+            }
+        }
+        let needs_mates = rules.iter().any(|r| r.has_context());
+        let parametric = !axiom.pstart.is_empty() || rules.iter().any(|r| r.successors.iter().any(|s| s.parametric));
+        let max_slots = rules.iter().map(|r| r.n_slots).max().unwrap_or(0);
+        let simple_ok = !parametric && rules.iter().all(|r| !r.has_context() && r.cond.is_none() && r.pred.arity.is_none());
+        let simple = simple_ok.then(|| {
+            let mut t = vec![u32::MAX; 128];
+            let mut o = HashMap::new();
+            for (k, r) in rules.iter().enumerate().rev() {
+                // the first production of a symbol always applies: keep it
+                let c = r.pred.sym;
+                if (c as u32) < 128 {
+                    t[c as usize] = k as u32;
+                } else {
+                    o.insert(c, k as u32);
+                }
+            }
+            (t, o)
+        });
+        let mut axiom = axiom;
+        if parametric && axiom.pstart.is_empty() {
+            axiom.pstart = vec![0; axiom.len() + 1];
+        }
+        if axiom.len() > max_length {
+            return Err(CoreError::invalid("max_length", format!("the axiom has {} modules, more than max_length={max_length}", axiom.len())));
+        }
+        Ok(LSystem { axiom, rules, ignore, seed, max_length, ascii, other, needs_mates, parametric, max_slots, simple })
+    }
+
+    /// True when some production is stochastic.
+    pub fn is_stochastic(&self) -> bool {
+        self.rules.iter().any(|r| r.successors.len() > 1)
+    }
+
+    #[inline]
+    fn candidates(&self, c: char) -> &[u32] {
+        if (c as u32) < 128 {
+            &self.ascii[c as usize]
+        } else {
+            self.other.get(&c).map_or(&[], |v| v.as_slice())
+        }
+    }
+
+    #[inline]
+    fn ignored(&self, c: char) -> bool {
+        self.ignore.contains(&c)
+    }
+
+    fn bind(s: &ModString, i: usize, p: &super::grammar::Pattern, vars: &mut [f64]) -> bool {
+        if p.sym != s.syms[i] {
+            return false;
+        }
+        match p.arity {
+            None => true,
+            Some(k) => {
+                let a = s.params(i);
+                if a.len() != k {
+                    return false;
+                }
+                vars[p.first_slot..p.first_slot + k].copy_from_slice(a);
+                true
+            }
+        }
+    }
+
+    fn left_matches(&self, rule: &Rule, s: &ModString, mates: &[u32], i: usize, vars: &mut [f64]) -> bool {
+        let mut pos = i as isize - 1;
+        for p in rule.left.iter().rev() {
+            loop {
+                if pos < 0 {
+                    return false;
+                }
+                let c = s.syms[pos as usize];
+                if c == ']' {
+                    pos = mates[pos as usize] as isize - 1;
+                } else if c == '[' || self.ignored(c) {
+                    pos -= 1;
+                } else {
+                    break;
+                }
+            }
+            if !Self::bind(s, pos as usize, p, vars) {
+                return false;
+            }
+            pos -= 1;
+        }
+        true
+    }
+
+    fn right_matches(&self, rule: &Rule, s: &ModString, mates: &[u32], i: usize, vars: &mut [f64]) -> bool {
+        let n = s.len();
+        let mut pos = i + 1;
+        for p in &rule.right {
+            match p.sym {
+                '[' => {
+                    while pos < n && self.ignored(s.syms[pos]) {
+                        pos += 1;
+                    }
+                    if pos >= n || s.syms[pos] != '[' {
+                        return false;
+                    }
+                    pos += 1;
+                }
+                ']' => {
+                    // skip to the end of the current branch
+                    while pos < n && s.syms[pos] != ']' {
+                        pos = if s.syms[pos] == '[' { mates[pos] as usize + 1 } else { pos + 1 };
+                    }
+                    if pos >= n {
+                        return false;
+                    }
+                    pos += 1;
+                }
+                _ => {
+                    loop {
+                        if pos >= n {
+                            return false;
+                        }
+                        let c = s.syms[pos];
+                        if c == '[' {
+                            pos = mates[pos] as usize + 1;
+                        } else if self.ignored(c) {
+                            pos += 1;
+                        } else {
+                            break;
+                        }
+                    }
+                    if !Self::bind(s, pos, p, vars) {
+                        return false;
+                    }
+                    pos += 1;
+                }
+            }
+        }
+        true
+    }
+
+    fn rewrite_range(&self, s: &ModString, mates: &[u32], lo: usize, hi: usize, generation: u64, seed: u64) -> CoreResult<Piece> {
+        let mut out = Piece { syms: Vec::with_capacity(2 * (hi - lo)), counts: Vec::new(), params: Vec::new() };
+        let mut vars = vec![0.0f64; self.max_slots.max(1)];
+        for i in lo..hi {
+            let c = s.syms[i];
+            let mut applied = false;
+            for &r in self.candidates(c) {
+                let rule = &self.rules[r as usize];
+                if !Self::bind(s, i, &rule.pred, &mut vars) {
+                    continue;
+                }
+                if !rule.left.is_empty() && !self.left_matches(rule, s, mates, i, &mut vars) {
+                    continue;
+                }
+                if !rule.right.is_empty() && !self.right_matches(rule, s, mates, i, &mut vars) {
+                    continue;
+                }
+                if let Some(cond) = &rule.cond {
+                    if cond.eval(&vars) == 0.0 {
+                        continue;
+                    }
+                }
+                let k = if rule.successors.len() == 1 {
+                    0
+                } else {
+                    let u = unit3(seed, generation, i as u64);
+                    rule.cum_weights.iter().position(|&w| u < w).unwrap_or(rule.cum_weights.len() - 1)
+                };
+                let succ = &rule.successors[k];
+                if self.parametric {
+                    for m in &succ.modules {
+                        out.syms.push(m.sym);
+                        for a in &m.args {
+                            let v = a.eval(&vars);
+                            if !v.is_finite() {
+                                return Err(CoreError::invalid(
+                                    "rules",
+                                    format!("rule {:?} gave the non-finite parameter {v} at generation {}", rule.text, generation + 1),
+                                ));
+                            }
+                            out.params.push(v);
+                        }
+                        out.counts.push(m.args.len() as u32);
+                    }
+                } else {
+                    out.syms.extend_from_slice(&succ.syms);
+                }
+                applied = true;
+                break;
+            }
+            if !applied {
+                out.syms.push(c);
+                if self.parametric {
+                    let p = s.params(i);
+                    out.params.extend_from_slice(p);
+                    out.counts.push(p.len() as u32);
+                }
+            }
+            if out.syms.len() > self.max_length {
+                return Err(self.too_long(generation));
+            }
+        }
+        Ok(out)
+    }
+
+    fn too_long(&self, generation: u64) -> CoreError {
+        CoreError::invalid(
+            "max_length",
+            format!(
+                "derivation step {} would give more than max_length={} modules; lower n or raise max_length",
+                generation + 1,
+                self.max_length
+            ),
+        )
+    }
+
+    /// One parallel derivation step of `s` (step number `generation`,
+    /// counted from 0) with the given seed. Runs in the current rayon pool.
+    pub fn step_with_seed(&self, s: &ModString, generation: u64, seed: u64) -> CoreResult<ModString> {
+        if let Some(table) = &self.simple {
+            return self.step_simple(table, s, generation, seed);
+        }
+        let n = s.len();
+        let mates = if self.needs_mates { s.bracket_mates("axiom")? } else { Vec::new() };
+        let threads = rayon::current_num_threads().max(1);
+        let chunk = (n / (4 * threads)).clamp(8192, 1 << 20);
+        let starts: Vec<usize> = (0..n).step_by(chunk).collect();
+        let pieces: Vec<Piece> = if starts.len() <= 1 {
+            vec![self.rewrite_range(s, &mates, 0, n, generation, seed)?]
+        } else {
+            starts
+                .par_iter()
+                .map(|&lo| self.rewrite_range(s, &mates, lo, (lo + chunk).min(n), generation, seed))
+                .collect::<CoreResult<Vec<_>>>()?
+        };
+        let total: usize = pieces.iter().map(|p| p.syms.len()).sum();
+        if total > self.max_length {
+            return Err(self.too_long(generation));
+        }
+        let mut out = ModString { syms: Vec::with_capacity(total), pstart: Vec::new(), params: Vec::new() };
+        for p in &pieces {
+            out.syms.extend_from_slice(&p.syms);
+        }
+        if self.parametric {
+            let np: usize = pieces.iter().map(|p| p.params.len()).sum();
+            if np > u32::MAX as usize {
+                return Err(self.too_long(generation));
+            }
+            out.params.reserve(np);
+            out.pstart.reserve(total + 1);
+            out.pstart.push(0);
+            let mut acc = 0u32;
+            for p in pieces {
+                out.params.extend_from_slice(&p.params);
+                for c in p.counts {
+                    acc += c;
+                    out.pstart.push(acc);
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// Context-free, non-parametric step: count the output length of every
+    /// chunk, then write each chunk straight into its place in the result
+    /// (a stochastic choice is drawn twice from the same hash: same result).
+    fn step_simple(&self, table: &SimpleTable, s: &ModString, generation: u64, seed: u64) -> CoreResult<ModString> {
+        let (ascii, other) = table;
+        let succ = |i: usize, c: char| -> Option<&[char]> {
+            let r = if (c as u32) < 128 { ascii[c as usize] } else { other.get(&c).copied().unwrap_or(u32::MAX) };
+            if r == u32::MAX {
+                return None;
+            }
+            let rule = &self.rules[r as usize];
+            let k = if rule.successors.len() == 1 {
+                0
+            } else {
+                let u = unit3(seed, generation, i as u64);
+                rule.cum_weights.iter().position(|&w| u < w).unwrap_or(rule.cum_weights.len() - 1)
+            };
+            Some(&rule.successors[k].syms)
+        };
+        let n = s.len();
+        let threads = rayon::current_num_threads().max(1);
+        let chunk = (n / (4 * threads)).clamp(16384, 1 << 20);
+        let sizes: Vec<usize> = s
+            .syms
+            .par_chunks(chunk)
+            .enumerate()
+            .map(|(b, c)| c.iter().enumerate().map(|(j, &x)| succ(b * chunk + j, x).map_or(1, |v| v.len())).sum())
+            .collect();
+        let total: usize = sizes.iter().sum();
+        if total > self.max_length {
+            return Err(self.too_long(generation));
+        }
+        let mut out = vec!['\0'; total];
+        let mut slices = Vec::with_capacity(sizes.len());
+        let mut rest: &mut [char] = &mut out;
+        for &k in &sizes {
+            let (a, b) = rest.split_at_mut(k);
+            slices.push(a);
+            rest = b;
+        }
+        s.syms.par_chunks(chunk).zip(slices.into_par_iter()).enumerate().for_each(|(b, (src, dst))| {
+            let mut o = 0;
+            for (j, &c) in src.iter().enumerate() {
+                match succ(b * chunk + j, c) {
+                    Some(v) => {
+                        dst[o..o + v.len()].copy_from_slice(v);
+                        o += v.len();
+                    }
+                    None => {
+                        dst[o] = c;
+                        o += 1;
+                    }
+                }
+            }
+        });
+        Ok(ModString { syms: out, pstart: Vec::new(), params: Vec::new() })
+    }
+
+    /// Derive `n` steps from the axiom with the system's seed.
+    pub fn derive(&self, n: usize) -> CoreResult<ModString> {
+        self.derive_with_seed(n, self.seed)
+    }
+
+    /// Derive `n` steps from the axiom with another seed.
+    pub fn derive_with_seed(&self, n: usize, seed: u64) -> CoreResult<ModString> {
+        if n > MAX_STEPS {
+            return Err(CoreError::invalid("n", format!("at most {MAX_STEPS} derivation steps, got {n}")));
+        }
+        let mut s = self.axiom.clone();
+        for g in 0..n {
+            s = self.step_with_seed(&s, g as u64, seed)?;
+        }
+        Ok(s)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::parallel::run_in_pool;
+
+    fn ls(axiom: &str, rules: &[&str]) -> LSystem {
+        LSystem::new(axiom, &rules.iter().map(|s| s.to_string()).collect::<Vec<_>>(), "", 1, DEFAULT_MAX_LENGTH).unwrap()
+    }
+
+    #[test]
+    fn seed_paper_eq23() {
+        let l = ls("b", &["b -> a", "a -> ab"]);
+        let got: Vec<String> = (0..6).map(|n| l.derive(n).unwrap().to_text()).collect();
+        assert_eq!(got, ["b", "a", "ab", "aba", "abaab", "abaababa"]);
+    }
+
+    #[test]
+    fn rewriting_is_parallel_and_case_sensitive() {
+        // sequential rewriting would turn "a" into "c"
+        let l = ls("aA", &["a -> b", "b -> c", "A -> a"]);
+        assert_eq!(l.derive(1).unwrap().to_text(), "ba");
+        assert_eq!(l.derive(2).unwrap().to_text(), "cb");
+    }
+
+    #[test]
+    fn parametric_abop_1_10() {
+        // ABOP p. 43: axiom B(2)A(4,4); p1: A(x,y): y<=3 -> A(x*2,x+y);
+        // p2: A(x,y): y>3 -> B(x)A(x/y,0); p3: B(x): x<1 -> C; p4: B(x): x>=1 -> B(x-1)
+        let l = ls(
+            "B(2)A(4,4)",
+            &["A(x,y) : y <= 3 -> A(x*2, x+y)", "A(x,y) : y > 3 -> B(x)A(x/y, 0)", "B(x) : x < 1 -> C", "B(x) : x >= 1 -> B(x-1)"],
+        );
+        let g: Vec<String> = (0..5).map(|n| l.derive(n).unwrap().to_text()).collect();
+        assert_eq!(g[1], "B(1)B(4)A(1,0)");
+        assert_eq!(g[2], "B(0)B(3)A(2,1)");
+        assert_eq!(g[3], "CB(2)A(4,3)");
+        assert_eq!(g[4], "CB(1)A(8,7)");
+    }
+
+    #[test]
+    fn context_skips_brackets_and_ignored() {
+        // ABOP p. 32: in ABC[DE][SG[HI[JK]L]MNO], BC < S > G[H]M matches
+        let l = ls("ABC[DE][SG[HI[JK]L]MNO]", &["BC < S > G[H]M -> X"]);
+        assert_eq!(l.derive(1).unwrap().to_text(), "ABC[DE][XG[HI[JK]L]MNO]");
+        // a left context jumps over a whole branch, not into it
+        let l = ls("A[B]C", &["B < C -> X", "A < C -> Y"]);
+        assert_eq!(l.derive(1).unwrap().to_text(), "A[B]Y");
+        // the end of a branch has no right neighbour
+        let l = ls("A[B]C", &["B > C -> X"]);
+        assert_eq!(l.derive(1).unwrap().to_text(), "A[B]C");
+        // ignored symbols are skipped
+        let l = LSystem::new("A+-B", &["A > B -> X".to_string()], "+-", 0, 100).unwrap();
+        assert_eq!(l.derive(1).unwrap().to_text(), "X+-B");
+        let l = LSystem::new("A+-B", &["A > B -> X".to_string()], "", 0, 100).unwrap();
+        assert_eq!(l.derive(1).unwrap().to_text(), "A+-B");
+        // contexts bind parameters
+        let l = ls("A(1)B(2)C(3)", &["A(a) < B(b) > C(c) -> B(a+b*c)"]);
+        assert_eq!(l.derive(1).unwrap().to_text(), "A(1)B(7)C(3)");
+    }
+
+    #[test]
+    fn size_limit_is_an_error() {
+        let l = LSystem::new("F", &["F -> FF".to_string()], "", 0, 1000).unwrap();
+        assert_eq!(l.derive(9).unwrap().len(), 512);
+        let e = l.derive(10).unwrap_err();
+        assert!(e.to_string().starts_with("max_length:"), "{e}");
+        assert!(l.derive(MAX_STEPS + 1).unwrap_err().to_string().starts_with("n:"));
+    }
+
+    #[test]
+    fn stochastic_same_for_any_thread_count() {
+        let l = LSystem::new(
+            "F",
+            &["F -(1)-> F[+F]F[-F]F".to_string(), "F -(1)-> F[+F]F".to_string(), "F -(1)-> F[-F]F".to_string()],
+            "",
+            42,
+            DEFAULT_MAX_LENGTH,
+        )
+        .unwrap();
+        let a = run_in_pool(Some(1), || l.derive(9)).unwrap();
+        let b = run_in_pool(Some(4), || l.derive(9)).unwrap();
+        assert!(a.len() > 100_000, "{}", a.len()); // several chunks
+        assert_eq!(a, b);
+        let c = run_in_pool(Some(2), || l.derive_with_seed(9, 43)).unwrap();
+        assert_ne!(a, c);
+    }
+
+    #[test]
+    fn fast_and_general_paths_agree() {
+        let base = vec!["F -(1)-> F[+F]F[-F]F".to_string(), "F -(2)-> F[+F]F".to_string(), "X -> F-X".to_string()];
+        let fast = LSystem::new("FX", &base, "", 11, DEFAULT_MAX_LENGTH).unwrap();
+        assert!(fast.simple.is_some());
+        let mut with_ctx = base.clone();
+        with_ctx.push("Z < Q -> Q".to_string()); // never applies, forces the general path
+        let general = LSystem::new("FX", &with_ctx, "", 11, DEFAULT_MAX_LENGTH).unwrap();
+        assert!(general.simple.is_none());
+        let a = run_in_pool(Some(2), || fast.derive(8)).unwrap();
+        let b = run_in_pool(Some(2), || general.derive(8)).unwrap();
+        assert!(a.len() > 20_000);
+        assert_eq!(a, b);
+    }
+
+    #[test]
+    fn large_parallel_dol_matches_recurrence() {
+        // F -> F+F-F-F+F: |s_n| = 9 |s_{n-1}| ... counted as F: 5^n, symbols 9^n-ish
+        let l = ls("F", &["F -> F+F-F-F+F"]);
+        let s = run_in_pool(Some(3), || l.derive(7)).unwrap();
+        assert_eq!(s.count('F'), 5usize.pow(7));
+        // |s_n| = |s_{n-1}| + 8 F_{n-1}
+        let mut len = 1usize;
+        for k in 0..7 {
+            len += 8 * 5usize.pow(k);
+        }
+        assert_eq!(s.len(), len);
+    }
+}

@@ -1,0 +1,155 @@
+//! Mesh files: Wavefront OBJ (text, with `vt` and `vn`) and PLY (binary
+//! little-endian, with normals, texture coordinates `s t`, and per-face
+//! `part_id`, `kind`, `color`, `instance`). Both are written to a temporary
+//! file beside the target and renamed over it, so a file appears whole or
+//! not at all.
+use super::mesh::Mesh;
+use crate::error::{CoreError, CoreResult};
+use crate::io::image_io::temp_path;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+fn io_err(path: &Path, e: std::io::Error) -> CoreError {
+    CoreError::Io(format!("{}: {e}", path.display()))
+}
+
+fn atomic<F: FnOnce(&mut BufWriter<File>) -> std::io::Result<()>>(path: &Path, f: F) -> CoreResult<()> {
+    if let Some(dir) = path.parent() {
+        if !dir.as_os_str().is_empty() && !dir.is_dir() {
+            return Err(CoreError::Io(format!("{}: folder does not exist", path.display())));
+        }
+    }
+    let tmp = temp_path(path);
+    let res = (|| {
+        let file = File::create(&tmp)?;
+        let mut w = BufWriter::with_capacity(1 << 20, file);
+        f(&mut w)?;
+        w.flush()?;
+        w.get_ref().sync_all()?;
+        Ok(())
+    })();
+    if let Err(e) = res {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(io_err(path, e));
+    }
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        io_err(path, e)
+    })
+}
+
+/// Write `mesh` as Wavefront OBJ (1-based `f v/vt/vn` faces; branches and
+/// leaves in groups `branches` and `leaves`).
+pub fn write_obj(mesh: &Mesh, path: &Path) -> CoreResult<()> {
+    check(mesh)?;
+    atomic(path, |w| {
+        writeln!(w, "# fractalgeo_rs L-system mesh: {} vertices, {} triangles", mesh.vertices.len(), mesh.faces.len())?;
+        for v in &mesh.vertices {
+            writeln!(w, "v {} {} {}", v[0], v[1], v[2])?;
+        }
+        for t in &mesh.uvs {
+            writeln!(w, "vt {} {}", t[0], t[1])?;
+        }
+        for n in &mesh.normals {
+            writeln!(w, "vn {} {} {}", n[0], n[1], n[2])?;
+        }
+        for (kind, name) in [(0u8, "branches"), (1u8, "leaves")] {
+            if !mesh.kinds.contains(&kind) {
+                continue;
+            }
+            writeln!(w, "g {name}")?;
+            for (f, _) in mesh.faces.iter().zip(&mesh.kinds).filter(|(_, &k)| k == kind) {
+                let (a, b, c) = (f[0] + 1, f[1] + 1, f[2] + 1);
+                writeln!(w, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}")?;
+            }
+        }
+        Ok(())
+    })
+}
+
+/// Write `mesh` as binary little-endian PLY.
+pub fn write_ply(mesh: &Mesh, path: &Path) -> CoreResult<()> {
+    check(mesh)?;
+    atomic(path, |w| {
+        write!(
+            w,
+            "ply\nformat binary_little_endian 1.0\ncomment fractalgeo_rs L-system mesh\n\
+             element vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+             property float nx\nproperty float ny\nproperty float nz\nproperty float s\nproperty float t\n\
+             element face {}\nproperty list uchar uint vertex_indices\nproperty uint part_id\n\
+             property uchar kind\nproperty uint color\nproperty uint instance\nend_header\n",
+            mesh.vertices.len(),
+            mesh.faces.len()
+        )?;
+        let mut buf = Vec::with_capacity(32);
+        for i in 0..mesh.vertices.len() {
+            buf.clear();
+            for x in mesh.vertices[i].iter().chain(&mesh.normals[i]).chain(&mesh.uvs[i]) {
+                buf.extend_from_slice(&x.to_le_bytes());
+            }
+            w.write_all(&buf)?;
+        }
+        for i in 0..mesh.faces.len() {
+            buf.clear();
+            buf.push(3u8);
+            for x in mesh.faces[i] {
+                buf.extend_from_slice(&x.to_le_bytes());
+            }
+            buf.extend_from_slice(&mesh.part_ids[i].to_le_bytes());
+            buf.push(mesh.kinds[i]);
+            buf.extend_from_slice(&mesh.colors[i].to_le_bytes());
+            buf.extend_from_slice(&mesh.instances[i].to_le_bytes());
+            w.write_all(&buf)?;
+        }
+        Ok(())
+    })
+}
+
+fn check(mesh: &Mesh) -> CoreResult<()> {
+    let (nv, nf) = (mesh.vertices.len(), mesh.faces.len());
+    if mesh.normals.len() != nv || mesh.uvs.len() != nv {
+        return Err(CoreError::invalid("mesh", "normals and uvs must have one row per vertex"));
+    }
+    if mesh.part_ids.len() != nf || mesh.kinds.len() != nf || mesh.colors.len() != nf || mesh.instances.len() != nf {
+        return Err(CoreError::invalid("mesh", "part_ids, kinds, colors and instances must have one entry per face"));
+    }
+    if mesh.faces.iter().flatten().any(|&i| i as usize >= nv) {
+        return Err(CoreError::invalid("mesh", "a face refers to a vertex that does not exist"));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lsystem::grammar::parse_module_string;
+    use crate::lsystem::mesh::build_mesh;
+    use crate::lsystem::turtle::TurtleParams;
+
+    #[test]
+    fn obj_and_ply_round_trip_counts() {
+        let s = parse_module_string("F[+F]{.f.+f.+f.}", "axiom").unwrap();
+        let m = build_mesh(&s, &TurtleParams::spatial(60.0, 1.0), 5).unwrap();
+        let dir = std::env::temp_dir().join(format!("fgrs-lsys-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let obj = dir.join("a.obj");
+        write_obj(&m, &obj).unwrap();
+        let text = std::fs::read_to_string(&obj).unwrap();
+        let count = |p: &str| text.lines().filter(|l| l.starts_with(p)).count();
+        assert_eq!(count("v "), m.vertices.len());
+        assert_eq!(count("vt "), m.vertices.len());
+        assert_eq!(count("vn "), m.vertices.len());
+        assert_eq!(count("f "), m.faces.len());
+        let ply = dir.join("a.ply");
+        write_ply(&m, &ply).unwrap();
+        let bytes = std::fs::read(&ply).unwrap();
+        let head = b"end_header\n";
+        let pos = bytes.windows(head.len()).position(|w| w == head).unwrap() + head.len();
+        assert_eq!(bytes.len() - pos, m.vertices.len() * 32 + m.faces.len() * (1 + 12 + 4 + 1 + 4 + 4));
+        // no temporary file is left behind
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 2);
+        assert!(write_obj(&m, &dir.join("missing/a.obj")).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
