@@ -174,3 +174,85 @@ def test_estimator_bad_input(call, exc, param):
     with pytest.raises(exc) as info:
         call()
     assert param in str(info.value)
+
+
+def weierstrass_mandelbrot(n, hurst, gamma=1.5, k_max=45):
+    """Weierstrass-Mandelbrot function sampled at t = j/n (graph D = 2 - H),
+    with terms far beyond the sampling frequency so the samples are those of
+    the continuous function."""
+    t = np.arange(n) / n
+    w = np.zeros(n)
+    for k in range(-10, k_max + 1):
+        w += gamma ** (-k * hurst) * (1 - np.cos(2 * np.pi * gamma**k * t))
+    return w
+
+
+def test_weierstrass_mandelbrot_graph():
+    # Measured errors at n = 4096 (H = 0.3, 0.5, 0.7): variogram over lags
+    # 1..16 <= 0.015, madogram <= 0.029, Higuchi <= 0.046, wavelet <= 0.040,
+    # scale space <= 0.078. The log-periodic modulation of the WM increments
+    # (period ln 1.5) makes two-lag fits unreliable, hence 16 lags here.
+    for h in (0.3, 0.5, 0.7):
+        z = weierstrass_mandelbrot(4096, h)
+        assert fg.variogram(z, lags=range(1, 17)).dimension == pytest.approx(2 - h, abs=0.03)
+        assert fg.madogram(z, lags=range(1, 17)).dimension == pytest.approx(2 - h, abs=0.04)
+        assert fg.higuchi(z).dimension == pytest.approx(2 - h, abs=0.06)
+        assert fg.wavelet_dimension(z).dimension == pytest.approx(2 - h, abs=0.06)
+        assert fg.scale_space(z).dimension == pytest.approx(2 - h, abs=0.1)
+
+
+def numpy_blanket_areas(z, eps_max):
+    """Peleg blanket from the definition, with explicit neighbour shifts
+    (edges replicate the border value, as scipy's mode="nearest")."""
+    u = z.astype(float).copy()
+    b = u.copy()
+    out = []
+    for e in range(1, eps_max + 1):
+        pu = np.pad(u, 1, mode="edge")
+        pb = np.pad(b, 1, mode="edge")
+        nu = np.max([pu[1:-1, 1:-1], pu[:-2, 1:-1], pu[2:, 1:-1], pu[1:-1, :-2], pu[1:-1, 2:]], axis=0)
+        nb = np.min([pb[1:-1, 1:-1], pb[:-2, 1:-1], pb[2:, 1:-1], pb[1:-1, :-2], pb[1:-1, 2:]], axis=0)
+        u = np.maximum(u + 1, nu)
+        b = np.minimum(b - 1, nb)
+        out.append(np.sum(u - b) / (2 * e))
+    return out
+
+
+def numpy_mass_N(z, sizes, z_scale):
+    """Voss N(L) of the point set (i, j, (z - zmin) / z_scale), brute force."""
+    ok = ~np.isnan(z)
+    ij = np.argwhere(ok).astype(float)
+    pts = np.column_stack([ij, (z[ok] - np.nanmin(z)) / z_scale])
+    cheb = np.max(np.abs(pts[:, None, :] - pts[None, :, :]), axis=2)
+    return [float(np.mean(1.0 / np.sum(cheb <= L / 2.0, axis=1))) for L in sizes]
+
+
+def test_blanket_and_mass_equal_independent_numpy():
+    rng = np.random.default_rng(4)
+    for shape in [(17, 23), (30, 30)]:
+        z = np.round(rng.normal(0, 8, size=shape).cumsum(axis=1))
+        fit = fg.blanket(z, epsilons=range(1, 9))
+        assert fit.measures.tolist() == pytest.approx(numpy_blanket_areas(z, 8), rel=1e-12)
+        zn = z.copy()
+        zn[3:6, 4:9] = np.nan
+        fit = fg.mass_dimension(zn, box_sizes=[3, 5, 7, 9], z_scale=2.0)
+        assert fit.measures.tolist() == pytest.approx(numpy_mass_N(zn, [3, 5, 7, 9], 2.0), rel=1e-12)
+
+
+def test_height_unit_conventions():
+    """Grayscale estimators and the units of heights (docs/estimators.md):
+    DBC and mass default to the data's own range, so scaling heights changes
+    nothing; the blanket counts in z_scale units per step, so heights times c
+    with z_scale = c is the same surface; increment estimators are invariant."""
+    z = spectral_surface(64, 0.5, 2)
+    z = 2.0 * z / z.std()  # a few grey levels of relief: the blanket's unit step matters
+    c = 50.0
+    assert fg.differential_box_counting(c * z).dimension == pytest.approx(fg.differential_box_counting(z).dimension, abs=1e-9)
+    m1 = fg.mass_dimension(z, box_sizes=[3, 5, 9])
+    m2 = fg.mass_dimension(c * z, box_sizes=[3, 5, 9])
+    assert np.allclose(m1.measures, m2.measures, rtol=1e-12)
+    b1 = fg.blanket(z)
+    assert fg.blanket(c * z, z_scale=c).measures == pytest.approx(b1.measures, rel=1e-9)
+    # ... and without telling the blanket about the units, the answer changes
+    assert abs(fg.blanket(c * z).dimension - b1.dimension) > 0.05
+    assert fg.surface_variation(c * z).dimension == pytest.approx(fg.surface_variation(z).dimension, abs=1e-12)
