@@ -13,6 +13,7 @@
 //! | [`synth`] | fBm and surface synthesis |
 //! | [`dem`] | DEM work: shaded relief, lakes, resampling |
 //! | [`lsystem`] | L-systems, turtle geometry and IFS |
+//! | [`transform`] | moving-window maps of local dimension |
 
 pub mod dem;
 pub mod dimension;
@@ -21,6 +22,7 @@ pub mod io;
 pub mod lsystem;
 pub mod parallel;
 pub mod synth;
+pub mod transform;
 
 #[cfg(feature = "python")]
 pub mod bindings;

@@ -35,6 +35,7 @@ from fractalgeo_rs.dimension import (
 
 # -- domain exports: each issue adds its own line below --
 from fractalgeo_rs.lsystem import IFS, LString, LSystem
+from fractalgeo_rs.transform import fractal_transform
 
 __all__ = [
     "__version__",
@@ -62,4 +63,5 @@ __all__ = [
     "IFS",
     "LString",
     "LSystem",
+    "fractal_transform",
 ]

@@ -133,3 +133,14 @@ def ifs_rasterize(
     bounds: Optional[Sequence[float]] = None,
 ) -> Tuple[npt.NDArray[np.uint8], Tuple[float, float, float, float]]: ...
 def moran_dimension(ratios: Sequence[float]) -> float: ...
+
+# ---- transform ----
+def variation_transform_map(
+    image: npt.NDArray[np.float64],
+    window_size: int,
+    lags: Sequence[int],
+    p: float,
+    square: bool,
+    min_valid: float,
+    n_threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...

@@ -10,6 +10,7 @@ mod dimension;
 mod io;
 mod lsystem;
 mod synth;
+mod transform;
 
 impl From<CoreError> for PyErr {
     fn from(e: CoreError) -> PyErr {
@@ -28,5 +29,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     io::register(m)?;
     synth::register(m)?;
     lsystem::register(m)?;
+    transform::register(m)?;
     Ok(())
 }

@@ -1,0 +1,44 @@
+//! Bindings of `crate::transform`.
+use crate::parallel::run_in_pool;
+use crate::transform::variation::{variation_transform, Increments, VariationOptions};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+/// Moving-window increment estimator. Returns (dimension, r_squared) float32 maps.
+#[pyfunction]
+#[pyo3(signature = (image, window_size, lags, p, square, min_valid, n_threads=None))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn variation_transform_map<'py>(
+    py: Python<'py>,
+    image: PyReadonlyArray2<'py, f64>,
+    window_size: usize,
+    lags: Vec<usize>,
+    p: f64,
+    square: bool,
+    min_valid: f64,
+    n_threads: Option<usize>,
+) -> PyResult<(Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>)> {
+    let (rows, cols) = (image.shape()[0], image.shape()[1]);
+    let z = image.as_slice().map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
+    let opt = VariationOptions {
+        window: window_size,
+        lags,
+        p,
+        increments: if square { Increments::Square } else { Increments::First },
+        min_valid,
+    };
+    let (d, r2) = py.detach(|| run_in_pool(n_threads, || variation_transform(z, rows, cols, &opt)))?;
+    let shape = (rows, cols);
+    let bad = |_| PyValueError::new_err("internal: map size");
+    Ok((
+        Array2::from_shape_vec(shape, d).map_err(bad)?.into_pyarray(py),
+        Array2::from_shape_vec(shape, r2).map_err(bad)?.into_pyarray(py),
+    ))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(variation_transform_map, m)?)?;
+    Ok(())
+}

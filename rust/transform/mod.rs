@@ -1,0 +1,8 @@
+//! Fractal transform: maps of local fractal dimension over a moving window
+//! (paper section 4.2, figure 10).
+//!
+//! * [`variation`]: increment estimators (variogram, madogram, square
+//!   increments) with summed-area tables, so the cost per pixel does not grow
+//!   with the window.
+
+pub mod variation;

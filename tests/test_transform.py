@@ -1,0 +1,117 @@
+"""Fractal transform: exactness against the per-window estimator, Dask and
+xarray equality, errors."""
+import numpy as np
+import pytest
+
+import fractalgeo_rs as fg
+from fractals import spectral_surface
+
+
+def per_window(z, w, method, lags=(1, 2), min_valid=0.5):
+    """surface_variation on every window of the NaN-padded image."""
+    est, p = {"variogram": ("first", 2.0), "madogram": ("first", 1.0), "square": ("square", 2.0)}[method]
+    h = w // 2
+    zp = np.pad(z.astype(float), h, constant_values=np.nan)
+    win = np.lib.stride_tricks.sliding_window_view(zp, (w, w))
+    out = np.full(z.shape, np.nan)
+    for i in range(z.shape[0]):
+        for j in range(z.shape[1]):
+            a = win[i, j]
+            if np.count_nonzero(~np.isnan(a)) < min_valid * w * w:
+                continue
+            try:
+                out[i, j] = fg.surface_variation(a, estimator=est, p=p, lags=lags).dimension
+            except ValueError:
+                pass
+    return out
+
+
+@pytest.mark.parametrize("method", ["variogram", "madogram", "square"])
+def test_map_equals_per_window_estimator_with_holes(method):
+    rng = np.random.default_rng(1)
+    z = spectral_surface(64, 0.5, 3)[:40, :29] * 10
+    z[rng.random(z.shape) < 0.08] = np.nan
+    z[5:12, 3:9] = np.nan
+    d = fg.fractal_transform(z, 7, method=method, lags=(1, 2, 3))
+    ref = per_window(z, 7, method, lags=(1, 2, 3))
+    assert np.array_equal(np.isnan(d), np.isnan(ref))
+    ok = ~np.isnan(ref)
+    assert np.allclose(d[ok], ref[ok], atol=1e-5)
+
+
+def test_real_sar_window():
+    vv, _ = fg.data.sentinel1_vv_db()
+    z = vv[100:160, 200:250]
+    d = fg.fractal_transform(z, 9)
+    ref = per_window(z, 9, "variogram")
+    assert np.allclose(d, ref, atol=1e-5, equal_nan=True)
+
+
+def test_threads_and_input_untouched():
+    z = spectral_surface(128, 0.4, 0)
+    z32 = z.astype(np.float32)
+    before = z32.copy()
+    a = fg.fractal_transform(z32, 15, n_threads=1)
+    b = fg.fractal_transform(z32, 15, n_threads=3)
+    assert np.array_equal(a, b, equal_nan=True)
+    assert np.array_equal(z32, before)
+    assert a.dtype == np.float32 and a.shape == z32.shape
+
+
+def test_dask_equals_in_memory_for_any_chunking():
+    da = pytest.importorskip("dask.array")
+    z = spectral_surface(128, 0.6, 4)[:100, :90]
+    z[40:44, 10:70] = np.nan
+    ref = fg.fractal_transform(z, 11)
+    for chunks in [(50, 45), (33, 90), (100, 20), (4, 4)]:
+        out = fg.fractal_transform(da.from_array(z, chunks=chunks), 11).compute()
+        assert np.allclose(out, ref, atol=1e-6, equal_nan=True), chunks
+
+
+def test_xarray_keeps_coords_and_attrs():
+    xr = pytest.importorskip("xarray")
+    z = spectral_surface(64, 0.5, 2)
+    arr = xr.DataArray(z, dims=("y", "x"), coords={"y": np.arange(64) * -10.0, "x": np.arange(64) * 10.0},
+                       attrs={"crs": "EPSG:32633"})
+    out = fg.fractal_transform(arr, 9)
+    assert out.dims == ("y", "x") and out.attrs["crs"] == "EPSG:32633"
+    assert np.array_equal(out["x"].values, arr["x"].values)
+    assert np.allclose(out.values, fg.fractal_transform(z, 9), equal_nan=True)
+
+
+def test_plane_is_two_in_the_interior_and_rough_is_higher():
+    i, j = np.indices((80, 80))
+    d = fg.fractal_transform(0.2 * i + 0.5 * j, 9)
+    assert np.allclose(d[4:-4, 4:-4], 2.0, atol=1e-5)
+    rough = fg.fractal_transform(spectral_surface(128, 0.2, 1), 17)
+    smooth = fg.fractal_transform(spectral_surface(128, 0.8, 1), 17)
+    assert np.nanmean(rough) > np.nanmean(smooth) + 0.3
+
+
+@pytest.mark.parametrize(
+    "kwargs, exc, param",
+    [
+        (dict(window_size=8), ValueError, "window_size"),
+        (dict(window_size=1), ValueError, "window_size"),
+        (dict(window_size=201), ValueError, "window_size"),
+        (dict(window_size=9, method="mass"), ValueError, "method"),
+        (dict(window_size=9, lags=(1,)), ValueError, "lags"),
+        (dict(window_size=9, lags=(1, 9)), ValueError, "lags"),
+        (dict(window_size=9, min_valid=2), ValueError, "min_valid"),
+        (dict(window_size=9, n_threads=0), ValueError, "n_threads"),
+    ],
+)
+def test_bad_arguments(kwargs, exc, param):
+    with pytest.raises(exc, match=param):
+        fg.fractal_transform(np.zeros((50, 50)), **kwargs)
+
+
+def test_bad_images():
+    with pytest.raises(ValueError, match="band"):
+        fg.fractal_transform(np.zeros((2, 50, 50)), 9)
+    with pytest.raises(TypeError, match="image"):
+        fg.fractal_transform(np.zeros((50, 50), bool), 9)
+    with pytest.raises(ValueError, match="image"):
+        fg.fractal_transform(np.full((30, 30), np.nan), 9)
+    out = fg.fractal_transform(np.zeros((2, 30, 30)) + np.indices((30, 30)).sum(0), 9, band=1)
+    assert out.shape == (30, 30)
