@@ -14,10 +14,16 @@ from fractalgeo_rs.fit import DimensionFit
 from fractalgeo_rs.dimension import box_counting, dimension
 
 # -- domain exports: each issue adds its own line below --
+from fractalgeo_rs.synth import fbm, fbm_surface, validate_surface, SurfaceReport  # noqa: E402
 
 __all__ = [
     "__version__",
     "DimensionFit",
     "box_counting",
     "dimension",
+    # synth / dem / io
+    "fbm",
+    "fbm_surface",
+    "validate_surface",
+    "SurfaceReport",
 ]

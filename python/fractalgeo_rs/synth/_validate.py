@@ -34,7 +34,7 @@ class SurfaceReport:
         ``lags[0] * sqrt 2``), divided by the axial mean scaled to the same
         distance with ``hurst_variogram``: 1 for an isotropic field.
     axis_ratio : float
-        Lag-one variogram along axis 0 over that along axis 1.
+        Variogram at ``lags[0]`` along axis 0 over that along axis 1.
     increment_skewness, increment_excess_kurtosis : float
         Of the lag-one increments, divided by their standard deviation
         (both 0 for Gaussian increments).
@@ -63,7 +63,7 @@ class SurfaceReport:
     crease_ratio_axes: tuple
     periodicity_ratio: float
     coastline_dimension: float
-    lags: tuple = field(default=(1, 2, 4, 8))
+    lags: tuple = field(default=(8, 16, 32, 64))
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -106,27 +106,31 @@ def crease_ratio(z, period=16):
     return tuple(out)
 
 
-def spectral_slope(z, fmin=None, fmax=None, window=True):
+def spectral_slope(z, fmin=None, fmax=None, periodic=False):
     """Slope of the log radially averaged periodogram against log frequency.
 
-    The surface is detrended by a least-squares plane and, with ``window``,
-    multiplied by a 2D Hann window (the edges of a non-periodic field
-    otherwise leak a ``f^-2`` spectrum). The fit is over radial frequencies in
-    ``[fmin, fmax]`` cycles per cell (default ``[4 / n, 0.25]``, ``n`` the
-    smaller side), in 24 logarithmic bins.
+    A non-periodic surface is detrended by a least-squares plane and
+    multiplied by a 2D Hann window (its edges otherwise leak a ``f^-2``
+    spectrum); a periodic one is used as it is. The fit is over radial
+    frequencies in ``[fmin, fmax]`` cycles per cell (default
+    ``[4 / n, 1 / 8]``, ``n`` the smaller side: wavelengths from 8 cells to a
+    quarter of the grid), in 24 logarithmic bins of the mean periodogram.
+    For fBm the slope is ``-(2H + 2)``.
     """
     z = np.asarray(z, dtype=np.float64)
     n0, n1 = z.shape
-    ii, jj = np.meshgrid(np.arange(n0), np.arange(n1), indexing="ij")
-    a = np.column_stack([np.ones(z.size), ii.ravel(), jj.ravel()])
-    coef, *_ = np.linalg.lstsq(a, z.ravel(), rcond=None)
-    zz = z - (a @ coef).reshape(z.shape)
-    if window:
+    if periodic:
+        zz = z - z.mean()
+    else:
+        ii, jj = np.meshgrid(np.arange(n0), np.arange(n1), indexing="ij")
+        a = np.column_stack([np.ones(z.size), ii.ravel(), jj.ravel()])
+        coef, *_ = np.linalg.lstsq(a, z.ravel(), rcond=None)
+        zz = z - (a @ coef).reshape(z.shape)
         zz = zz * np.outer(np.hanning(n0), np.hanning(n1))
     p = np.abs(np.fft.rfft2(zz)) ** 2
     f = np.hypot(np.fft.fftfreq(n0)[:, None], np.fft.rfftfreq(n1)[None, :])
     fmin = 4.0 / min(n0, n1) if fmin is None else fmin
-    fmax = 0.25 if fmax is None else fmax
+    fmax = 0.125 if fmax is None else fmax
     edges = np.geomspace(fmin, fmax, 25)
     idx = np.digitize(f.ravel(), edges)
     pr = p.ravel()
@@ -152,7 +156,9 @@ def coastline_dimension(z, level=None, sizes=None):
 
     The line is rasterised as the pixels where the mask ``z < level`` changes
     between 4-neighbours; boxes of ``sizes`` pixels (default powers of two
-    from 2 to a sixteenth of the smaller side) on a grid anchored at the array
+    from 4 to a sixteenth of the smaller side; boxes of 2 pixels see the
+    pixel staircase, not the fractal, and bias the dimension down by about
+    0.1) on a grid anchored at the array
     origin; the dimension is minus the least-squares slope of
     ``log N(s)`` against ``log s``. Expected ``2 - H`` for fBm (``D - 1``,
     seed paper section 4.1).
@@ -161,8 +167,8 @@ def coastline_dimension(z, level=None, sizes=None):
     level = float(np.nanmedian(z)) if level is None else float(level)
     line = _boundary_pixels(z < level)
     if sizes is None:
-        top = max(2, min(z.shape) // 16)
-        sizes = [2**k for k in range(1, int(math.log2(top)) + 1)]
+        top = max(8, min(z.shape) // 16)
+        sizes = [2**k for k in range(2, int(math.log2(top)) + 1)]
     counts = []
     for s in sizes:
         r = -(-line.shape[0] // s) * s
@@ -175,7 +181,7 @@ def coastline_dimension(z, level=None, sizes=None):
     return float(-np.polyfit(np.log(sizes), np.log(counts), 1)[0])
 
 
-def validate_surface(z, hurst=None, *, lags=(1, 2, 4, 8), coastline=True):
+def validate_surface(z, hurst=None, *, lags=None, periodic=None, coastline=True):
     r"""Report the fractal statistics of a surface ``z``.
 
     Parameters
@@ -185,9 +191,17 @@ def validate_surface(z, hurst=None, *, lags=(1, 2, 4, 8), coastline=True):
         the coastline need a NaN-free array).
     hurst : float or None
         The Hurst exponent the surface was made with, kept in the report.
-    lags : sequence of int
+    lags : sequence of int or None
         Lags (cells) of the variogram fit:
         :math:`\gamma(h) = \mathrm{mean}(Z(x+h) - Z(x))^2 \propto h^{2H}`.
+        Default ``(8, 16, 32, 64)`` without the lags above a quarter of the
+        smaller side (at least two kept). Lags 1-4 are left out on purpose:
+        there the discretisation of the midpoint and spectral methods bends
+        the variogram (their local slope converges to ``2H`` from 8 cells
+        on), while exact fBm follows :math:`h^{2H}` at every lag.
+    periodic : bool or None
+        Treat the surface as periodic for the spectrum (no window). ``None``:
+        periodic when ``periodicity_ratio < 1.5``.
     coastline : bool
         Compute the coastline dimension (NaN otherwise).
 
@@ -209,6 +223,10 @@ def validate_surface(z, hurst=None, *, lags=(1, 2, 4, 8), coastline=True):
     if z.ndim != 2 or min(z.shape) < 32:
         raise ValueError(f"z: expected a 2D array of at least 32 x 32, got shape {z.shape}")
     z = z.astype(np.float64, copy=False)
+    if lags is None:
+        lags = tuple(v for v in (8, 16, 32, 64) if v <= min(z.shape) // 4) or (1, 2, 4)
+        if len(lags) < 2:
+            lags = (2, 4, 8)
     lags = tuple(int(v) for v in lags)
     if len(lags) < 2 or min(lags) < 1 or max(lags) >= min(z.shape):
         raise ValueError(f"lags: expected at least 2 positive lags below the array size, got {lags}")
@@ -230,9 +248,12 @@ def validate_surface(z, hurst=None, *, lags=(1, 2, 4, 8), coastline=True):
     kurt = float(np.mean(inc**4) / sd**4 - 3.0)
     cr = crease_ratio(z)
     wrap = 0.5 * (np.nanmean((z[0, :] - z[-1, :]) ** 2) + np.nanmean((z[:, 0] - z[:, -1]) ** 2))
-    per = float(wrap / (0.5 * (g0[0] + g1[0])))
+    lag1 = 0.5 * (variogram(z, (1,), 0)[0] + variogram(z, (1,), 1)[0])
+    per = float(wrap / lag1)
     finite = bool(np.isfinite(z).all())
-    slope = spectral_slope(z) if finite else float("nan")
+    if periodic is None:
+        periodic = per < 1.5
+    slope = spectral_slope(z, periodic=bool(periodic)) if finite else float("nan")
     cd = coastline_dimension(z) if (coastline and finite) else float("nan")
     return SurfaceReport(
         hurst_requested=None if hurst is None else float(hurst),
