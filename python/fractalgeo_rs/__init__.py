@@ -14,7 +14,8 @@ from fractalgeo_rs.fit import DimensionFit
 from fractalgeo_rs.dimension import box_counting, dimension
 
 # -- domain exports: each issue adds its own line below --
-from fractalgeo_rs.synth import fbm, fbm_surface, validate_surface, SurfaceReport  # noqa: E402
+from fractalgeo_rs.synth import fbm, fbm_surface, validate_surface, SurfaceReport, synthetic_dem  # noqa: E402
+from fractalgeo_rs.dem import hillshade, lakes  # noqa: E402
 
 __all__ = [
     "__version__",
@@ -26,4 +27,7 @@ __all__ = [
     "fbm_surface",
     "validate_surface",
     "SurfaceReport",
+    "synthetic_dem",
+    "hillshade",
+    "lakes",
 ]
