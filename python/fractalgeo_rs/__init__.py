@@ -16,6 +16,7 @@ from fractalgeo_rs.dimension import box_counting, dimension
 # -- domain exports: each issue adds its own line below --
 from fractalgeo_rs.synth import fbm, fbm_surface, validate_surface, SurfaceReport, synthetic_dem  # noqa: E402
 from fractalgeo_rs.dem import hillshade, lakes  # noqa: E402
+from fractalgeo_rs.io import read_raster, write_raster  # noqa: E402
 
 __all__ = [
     "__version__",
@@ -30,4 +31,6 @@ __all__ = [
     "synthetic_dem",
     "hillshade",
     "lakes",
+    "read_raster",
+    "write_raster",
 ]

@@ -1,5 +1,10 @@
 //! Bindings of `crate::synth` and `crate::dem`.
 use crate::dem::hillshade::{self, ShadeParams};
+use crate::io::exr_io;
+use numpy::ndarray::Array2;
+use numpy::PyUntypedArrayMethods;
+use pyo3::exceptions::PyValueError;
+use std::path::PathBuf;
 use crate::parallel::run_in_pool;
 use crate::synth::midpoint::{self, RefineParams};
 use crate::synth::rng;
@@ -110,7 +115,27 @@ fn hillshade_f64<'py>(
     Ok(v.into_pyarray(py))
 }
 
+/// Read the "Y" (or only) channel of a float EXR as a 2D float32 array.
+#[pyfunction]
+fn read_exr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let (v, rows, cols) = py.detach(|| exr_io::read_exr_gray(&path))?;
+    let a = Array2::from_shape_vec((rows, cols), v)
+        .map_err(|_| PyValueError::new_err("internal: EXR pixel count does not match its size"))?;
+    Ok(a.into_pyarray(py))
+}
+
+/// Write a 2D float32 array as a single-channel ("Y") float EXR, atomically.
+#[pyfunction]
+fn write_exr(py: Python<'_>, path: PathBuf, image: PyReadonlyArray2<'_, f32>) -> PyResult<()> {
+    let (rows, cols) = (image.shape()[0], image.shape()[1]);
+    let v: Vec<f32> = image.as_array().iter().copied().collect();
+    py.detach(|| exr_io::write_exr_gray(&path, v, rows, cols))?;
+    Ok(())
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(read_exr, m)?)?;
+    m.add_function(wrap_pyfunction!(write_exr, m)?)?;
     m.add_function(wrap_pyfunction!(normal_noise, m)?)?;
     m.add_function(wrap_pyfunction!(midpoint_refine_1d, m)?)?;
     m.add_function(wrap_pyfunction!(midpoint_refine_2d, m)?)?;
