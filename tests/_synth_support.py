@@ -26,6 +26,10 @@ def _ensure(name, attrs):
 
 _ensure("fractalgeo_rs.fit", ["DimensionFit"])
 _ensure("fractalgeo_rs.dimension", ["box_counting", "dimension"])
+if isinstance(sys.modules.get("fractalgeo_rs.dimension"), types.ModuleType) and not getattr(
+        sys.modules["fractalgeo_rs.dimension"], "__file__", None):
+    _ensure("fractalgeo_rs.dimension._cli", [])
+    sys.modules["fractalgeo_rs.dimension._cli"].add_parsers = lambda sub: None
 
 import fractalgeo_rs as fg  # noqa: E402
 
