@@ -164,10 +164,13 @@ def test_spectral_periodic_option():
     assert fg.validate_surface(zp, 0.6, coastline=False).periodicity_ratio < 1.5
 
 
-def test_exact_surface_coastline_dimension_is_2_minus_h():
-    h = 0.5
+@pytest.mark.parametrize("h", [0.5, 0.8])
+def test_exact_surface_coastline_dimension_is_2_minus_h(h):
+    # The target: within 0.07 averaged over seeds. Measured over 10
+    # seeds (seeds 100-109): 1.493 +- 0.058 (H=0.5), 1.185 +- 0.056 (H=0.8),
+    # 1.865 +- 0.040 (H=0.2, not asserted: +0.065 is at the target's edge).
     dims = [fg.validate_surface(fbm_surface((1024, 1024), h, method="exact", seed=s), h).coastline_dimension
-            for s in range(3)]
+            for s in range(5)]
     assert abs(np.mean(dims) - (2 - h)) <= 0.07, dims
 
 
@@ -188,7 +191,7 @@ def _ref_normals(seed, stream, index):
         a = _mix64(np.uint64(seed) + g)
         b = _mix64(a ^ (np.uint64(stream) * np.uint64(0xD6E8FEB86659FD93) + g))
         i = np.asarray(index, dtype=np.uint64)
-        bits = _mix64(b ^ _mix64(i * np.uint64(0xA0761D6478BD642F) + np.uint64(0xE7037ED1A0B428DB)))
+        bits = _mix64(b + (i + np.uint64(1)) * g)
     u = ((bits >> np.uint64(11)).astype(np.float64) + 0.5) / 2.0**53
     return ndtri(u)
 

@@ -139,6 +139,8 @@ pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2
     if p.periodic && (r < 1 || c < 1) {
         return Err(CoreError::invalid("coarse", "empty grid"));
     }
+    let coarse = coarse.as_standard_layout();
+    let cs: &[f64] = coarse.as_slice().ok_or_else(|| CoreError::Internal("coarse grid not contiguous".into()))?;
     let (fr, fc) = if p.periodic { (2 * r, 2 * c) } else { (2 * r - 1, 2 * c - 1) };
     let s = p.coarse_spacing;
     let kk = k2(p.hurst, p.additions);
@@ -147,86 +149,94 @@ pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2
     let delta_s = p.sigma * s.powf(p.hurst) * 2f64.powf(-p.hurst / 2.0) * kk;
     let (kd, ka, ks, kas) = (key(p, PHASE_DISPLACE), key(p, PHASE_ADD), key(p, PHASE_DISPLACE_SQ), key(p, PHASE_ADD_SQ));
     let (o0, o1, gc) = (p.origin.0, p.origin.1, p.global_cols.max((p.origin.1) + fc as u64));
-    let cz = coarse;
-    let cget = |i: usize, j: usize| -> f64 { cz[[i % r, j % c]] };
+    let add = p.additions;
 
-    // Diamond step: old samples and cell centres.
-    let mut fine = Array2::<f64>::zeros((fr, fc));
-    {
-        let slice = fine.as_slice_mut().ok_or_else(|| CoreError::Internal("fine grid not contiguous".into()))?;
-        slice.par_chunks_mut(fc).enumerate().for_each(|(i, row)| {
-            let gi = o0 + i as u64;
-            for (j, v) in row.iter_mut().enumerate() {
-                let gj = o1 + j as u64;
-                let x = match (i % 2, j % 2) {
-                    (0, 0) => cget(i / 2, j / 2),
-                    (1, 1) => {
-                        let (a, b) = (i / 2, j / 2);
-                        let mean = 0.25 * (cget(a, b) + cget(a + 1, b) + cget(a, b + 1) + cget(a + 1, b + 1));
-                        if p.additions { mean } else { mean + delta_d * kd.normal2(gi, gj, gc) }
-                    }
-                    _ => continue,
-                };
-                *v = if p.additions { x + delta_d * ka.normal2(gi, gj, gc) } else { x };
+    // Pass A (diamond step): old samples and cell centres, row by row.
+    let mut fine = vec![0.0f64; fr * fc];
+    fine.par_chunks_mut(fc).enumerate().for_each(|(i, row)| {
+        let gbase = (o0 + i as u64) * gc + o1;
+        let a = i / 2;
+        if i % 2 == 0 {
+            let crow = &cs[a * c..(a + 1) * c];
+            for (b, v) in crow.iter().enumerate() {
+                let j = 2 * b;
+                row[j] = if add { v + delta_d * ka.normal(gbase + j as u64) } else { *v };
             }
-        });
-    }
-    // Square step: edge midpoints from their 4 (or 3) neighbours.
-    let fv = fine.view();
-    let square: Vec<Vec<f64>> = (0..fr)
-        .into_par_iter()
-        .map(|i| {
-            let gi = o0 + i as u64;
-            let start = if i % 2 == 0 { 1 } else { 0 };
-            let mut vals = Vec::with_capacity(fc / 2 + 1);
-            let mut j = start;
+        } else {
+            let a1 = if a + 1 == r { 0 } else { a + 1 };
+            let (r0, r1) = (&cs[a * c..(a + 1) * c], &cs[a1 * c..(a1 + 1) * c]);
+            let mut j = 1;
             while j < fc {
-                let mut sum = 0.0;
-                let mut cnt = 0.0;
-                if p.periodic {
-                    sum += fv[[(i + fr - 1) % fr, j]] + fv[[(i + 1) % fr, j]] + fv[[i, (j + fc - 1) % fc]] + fv[[i, (j + 1) % fc]];
-                    cnt = 4.0;
-                } else {
-                    if i > 0 {
-                        sum += fv[[i - 1, j]];
-                        cnt += 1.0;
-                    }
-                    if i + 1 < fr {
-                        sum += fv[[i + 1, j]];
-                        cnt += 1.0;
-                    }
-                    if j > 0 {
-                        sum += fv[[i, j - 1]];
-                        cnt += 1.0;
-                    }
-                    if j + 1 < fc {
-                        sum += fv[[i, j + 1]];
-                        cnt += 1.0;
-                    }
-                }
-                let mean = sum / cnt;
-                vals.push(if p.additions { mean } else { mean + delta_s * ks.normal2(gi, o1 + j as u64, gc) });
+                let b = j / 2;
+                let b1 = if b + 1 == c { 0 } else { b + 1 };
+                let mean = 0.25 * (r0[b] + r0[b1] + r1[b] + r1[b1]);
+                let g = gbase + j as u64;
+                row[j] = if add { mean + delta_d * ka.normal(g) } else { mean + delta_d * kd.normal(g) };
                 j += 2;
             }
-            vals
-        })
-        .collect();
-    {
-        let slice = fine.as_slice_mut().ok_or_else(|| CoreError::Internal("fine grid not contiguous".into()))?;
-        slice.par_chunks_mut(fc).zip(square.par_iter()).enumerate().for_each(|(i, (row, vals))| {
-            let start = if i % 2 == 0 { 1 } else { 0 };
-            for (k, v) in vals.iter().enumerate() {
-                row[start + 2 * k] = *v;
+        }
+    });
+
+    // Pass B (square step), in place: it writes only the samples with i + j
+    // odd and reads only samples with i + j even (written by pass A), so the
+    // rows can be processed in parallel through a shared pointer.
+    struct Shared(*mut f64);
+    unsafe impl Sync for Shared {}
+    unsafe impl Send for Shared {}
+    impl Shared {
+        fn get(&self) -> *mut f64 {
+            self.0
+        }
+    }
+    let ptr = Shared(fine.as_mut_ptr());
+    let periodic = p.periodic;
+    (0..fr).into_par_iter().for_each(|i| {
+        let base = ptr.get();
+        // SAFETY: reads target even-parity cells, writes odd-parity cells of
+        // row i only; both are inside the fr * fc buffer.
+        let get = |ii: usize, jj: usize| unsafe { *base.add(ii * fc + jj) };
+        let gbase = (o0 + i as u64) * gc + o1;
+        let up = if i > 0 { Some(i - 1) } else if periodic { Some(fr - 1) } else { None };
+        let down = if i + 1 < fr { Some(i + 1) } else if periodic { Some(0) } else { None };
+        let mut j = if i % 2 == 0 { 1 } else { 0 };
+        while j < fc {
+            let left = if j > 0 { Some(j - 1) } else if periodic { Some(fc - 1) } else { None };
+            let right = if j + 1 < fc { Some(j + 1) } else if periodic { Some(0) } else { None };
+            let mut sum = 0.0;
+            let mut cnt = 0.0;
+            if let Some(u) = up {
+                sum += get(u, j);
+                cnt += 1.0;
             }
-            if p.additions {
-                let gi = o0 + i as u64;
-                for (j, v) in row.iter_mut().enumerate() {
-                    *v += delta_s * kas.normal2(gi, o1 + j as u64, gc);
-                }
+            if let Some(d) = down {
+                sum += get(d, j);
+                cnt += 1.0;
+            }
+            if let Some(l) = left {
+                sum += get(i, l);
+                cnt += 1.0;
+            }
+            if let Some(rr) = right {
+                sum += get(i, rr);
+                cnt += 1.0;
+            }
+            let mean = sum / cnt;
+            let v = if add { mean } else { mean + delta_s * ks.normal(gbase + j as u64) };
+            unsafe { *base.add(i * fc + j) = v };
+            j += 2;
+        }
+    });
+
+    // Pass C: Voss's additions to every sample after the square step.
+    if add {
+        fine.par_chunks_mut(fc).enumerate().for_each(|(i, row)| {
+            let gbase = (o0 + i as u64) * gc + o1;
+            for (j, v) in row.iter_mut().enumerate() {
+                *v += delta_s * kas.normal(gbase + j as u64);
             }
         });
     }
-    Ok(fine)
+    Array2::from_shape_vec((fr, fc), fine).map_err(|e| CoreError::Internal(e.to_string()))
 }
 
 /// Refine `levels` times (levels numbered `first_level ..`), each time halving

@@ -6,10 +6,11 @@
 //! for any number of threads, in any order of evaluation, and when tiles of a
 //! large field are computed separately.
 //!
-//! The hash is SplitMix64's finaliser (Steele, Lea & Flood 2014) applied to a
-//! combination of the key words, each word first mixed with a distinct odd
-//! constant (Weyl sequence), twice over. The uniform is the top 53 bits, mapped
-//! to the open interval (0, 1). Standard normal variates come from the inverse
+//! `(seed, stream)` is hashed once with SplitMix64's finaliser (Steele, Lea &
+//! Flood 2014) into a 64-bit stream key; the sample at `index` is SplitMix64
+//! started from that key, evaluated directly at position `index` (one
+//! finaliser per sample: `mix64(key + (index + 1) * golden_gamma)`). The
+//! uniform is the top 53 bits, mapped to the open interval (0, 1). Standard normal variates come from the inverse
 //! normal CDF (Acklam's rational approximation, relative error below 1.2e-9),
 //! which needs one uniform per normal and keeps the mapping from key to value
 //! one-to-one.
@@ -27,9 +28,7 @@ const GOLDEN: u64 = 0x9e37_79b9_7f4a_7c15;
 /// Hash of the key `(seed, stream, index)` to 64 random bits.
 #[inline(always)]
 pub fn hash3(seed: u64, stream: u64, index: u64) -> u64 {
-    let a = mix64(seed.wrapping_add(GOLDEN));
-    let b = mix64(a ^ stream.wrapping_mul(0xd6e8_feb8_6659_fd93).wrapping_add(GOLDEN));
-    mix64(b ^ mix64(index.wrapping_mul(0xa076_1d64_78bd_642f).wrapping_add(0xe703_7ed1_a0b4_28db)))
+    StreamKey::new(seed, stream).bits(index)
 }
 
 /// Key prefix that is hashed once per stream: `StreamKey::new(seed, stream)`.
@@ -43,9 +42,12 @@ impl StreamKey {
         StreamKey(mix64(a ^ stream.wrapping_mul(0xd6e8_feb8_6659_fd93).wrapping_add(GOLDEN)))
     }
     /// 64 random bits at `index`; equals `hash3(seed, stream, index)`.
+    ///
+    /// This is SplitMix64 (Steele, Lea & Flood 2014) with the stream key as
+    /// its starting state, evaluated at position `index`.
     #[inline(always)]
     pub fn bits(self, index: u64) -> u64 {
-        mix64(self.0 ^ mix64(index.wrapping_mul(0xa076_1d64_78bd_642f).wrapping_add(0xe703_7ed1_a0b4_28db)))
+        mix64(self.0.wrapping_add(index.wrapping_add(1).wrapping_mul(GOLDEN)))
     }
     /// Uniform in the open interval (0, 1) at `index`.
     #[inline(always)]
@@ -137,8 +139,16 @@ mod tests {
     use super::*;
 
     #[test]
-    fn stream_key_matches_hash3() {
+    fn splitmix64_reference() {
+        // SplitMix64 from state 0: first output 0xe220a8397b1dcdaf (Vigna's reference code).
+        assert_eq!(mix64(GOLDEN), 0xe220_a839_7b1d_cdaf);
+        // A stream is SplitMix64 started from its key, read at any position.
         let k = StreamKey::new(42, 7);
+        let mut state = k.0;
+        for i in 0..100u64 {
+            state = state.wrapping_add(GOLDEN);
+            assert_eq!(k.bits(i), mix64(state));
+        }
         for i in [0u64, 1, 2, 1000, u64::MAX] {
             assert_eq!(k.bits(i), hash3(42, 7, i));
         }
