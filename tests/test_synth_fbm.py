@@ -295,3 +295,17 @@ def test_bad_arguments():
         fbm_surface((20, 16), 0.5, method="midpoint", periodic=True)
     with pytest.raises(ValueError, match="hurst"):
         _core.midpoint_refine_2d(np.zeros((2, 2)), 1, 1.5, 1.0, 1.0, False, False, 0)
+
+
+@pytest.mark.parametrize("periodic", [True, False])
+@pytest.mark.parametrize("shape", [(64, 64), (63, 90)])
+def test_spectral_lag_one_variance_is_sigma2(periodic, shape):
+    # The filter is scaled so that E[(z[x+1] - z[x])^2] = sigma^2 cell^(2H)
+    # (mean of both axes); checked over seeds on even and odd sizes.
+    sigma, cell, h = 1.5, 10.0, 0.6
+    v = []
+    for s in range(40):
+        z = fbm_surface(shape, h, method="spectral", seed=s, sigma=sigma, cell_size=cell, periodic=periodic)
+        v.append(0.5 * (np.mean(np.diff(z, axis=0) ** 2) + np.mean(np.diff(z, axis=1) ** 2)))
+    ok, info = within(np.array(v) / (sigma**2 * cell ** (2 * h)), 1.0)
+    assert ok, info

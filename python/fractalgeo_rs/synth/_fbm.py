@@ -233,7 +233,9 @@ def fbm_surface(shape, hurst, *, method="exact", seed=None, cell_size=1.0, sigma
           ``R = 2`` above), in memory too.
         * ``"spectral"``: figure 3 of the seed paper: a random matrix (white
           noise), its FFT, the filter :math:`|f|^{-\beta/2}` with
-          :math:`\beta = 2H + 2`, the inverse FFT (Voss 1988). Periodic on the
+          :math:`\beta = 2H + 2`, the inverse FFT (Voss 1988). The FFT of the
+          random matrix is drawn directly with its exact distribution, which
+          saves one FFT. Periodic on the
           generated grid; with ``periodic=False`` the grid is padded by a
           quarter in each direction and cropped. Scaled so that the lag-one
           increments have the variance above.
@@ -322,24 +324,56 @@ def _surface_midpoint(rows, cols, h, seed, additions, periodic, n_threads):
     return np.ascontiguousarray(z[:rows, :cols])
 
 
+@functools.lru_cache(maxsize=2)
 def _spectral_amplitude(n0, n1, h):
-    f0 = sfft.fftfreq(n0)[:, None]
-    f1 = sfft.rfftfreq(n1)[None, :]
-    f2 = f0**2 + f1**2
-    f2[0, 0] = 1.0
-    amp = f2 ** (-(2 * h + 2) / 4)  # |f|^(-beta/2), beta = 2H + 2
-    amp[0, 0] = 0.0
-    # Lag-1 variance along both axes of the real field irfft2(amp * rfft2(w)):
-    # Var = (1/N) sum over the full spectrum of amp^2 * 2 (1 - cos(2 pi f)).
-    weight = np.full(f1.shape, 2.0)
-    weight[0, 0] = 1.0
+    """Filter |f|^(-beta/2), beta = 2H + 2, on the rfft2 grid, scaled so the
+    field has unit lag-one increment variance (mean of both axes). Cached
+    (read-only) for repeated syntheses of one shape."""
+    f0 = sfft.fftfreq(n0)
+    f1 = sfft.rfftfreq(n1)
+    a2 = np.add.outer(f0 * f0, f1 * f1)
+    a2[0, 0] = 1.0
+    np.power(a2, -(h + 1.0), out=a2)  # amp^2 = |f|^(-beta)
+    a2[0, 0] = 0.0
+    # Lag-1 variance along each axis of the real field irfft2(amp * W):
+    # (1/N) sum over the full spectrum of amp^2 * 2 (1 - cos(2 pi f)); in the
+    # half spectrum the columns 0 < k1 < n1/2 stand for two bins.
+    weight = np.full(f1.size, 2.0)
+    weight[0] = 1.0
     if n1 % 2 == 0:
-        weight[0, -1] = 1.0
-    a2 = amp**2 * weight
-    v0 = np.sum(a2 * 2 * (1 - np.cos(2 * np.pi * f0))) / (n0 * n1)
-    v1 = np.sum(a2 * 2 * (1 - np.cos(2 * np.pi * f1))) / (n0 * n1)
+        weight[-1] = 1.0
+    rows = a2 @ weight  # sum over k1 of w * a2
+    cols = weight * a2.sum(axis=0)
+    v0 = rows @ (2 * (1 - np.cos(2 * np.pi * f0))) / (n0 * n1)
+    v1 = cols @ (2 * (1 - np.cos(2 * np.pi * f1))) / (n0 * n1)
+    amp = np.sqrt(a2, out=a2)
     amp *= 1.0 / math.sqrt(0.5 * (v0 + v1))
+    amp.setflags(write=False)
     return amp
+
+
+def _white_noise_rfft2(n0, n1, seed, stream, n_threads):
+    """A random matrix with the distribution of ``rfft2`` of an (n0, n1) white
+    noise matrix (unit variance), drawn directly in the frequency domain.
+
+    Columns ``0 < k1 < n1/2`` are independent complex Gaussians with
+    ``E|W|^2 = n0 n1``; the self-conjugate columns (``k1 = 0`` and, for even
+    ``n1``, ``k1 = n1/2``) are FFTs along axis 0 of real white noise of
+    variance ``n1``, exactly as in ``rfft2``. This saves the forward FFT of
+    figure 3 without changing the distribution.
+    """
+    m = n1 // 2 + 1
+    z = _noise(2 * n0 * m, seed, stream, n_threads)
+    spec = np.empty((n0, m), dtype=np.complex128)
+    half = math.sqrt(n0 * n1 / 2.0)
+    spec.real = z[: n0 * m].reshape(n0, m)
+    spec.imag = z[n0 * m :].reshape(n0, m)
+    spec *= half
+    special = [0] + ([m - 1] if n1 % 2 == 0 else [])
+    for k, col in enumerate(special):
+        real_noise = spec.real[:, col] / half  # unit normals not used elsewhere
+        spec[:, col] = sfft.fft(real_noise * math.sqrt(n1))
+    return spec
 
 
 def _surface_spectral(rows, cols, h, seed, periodic, n_threads):
@@ -348,11 +382,9 @@ def _surface_spectral(rows, cols, h, seed, periodic, n_threads):
     else:
         n0 = sfft.next_fast_len(rows + max(rows, cols) // 4, real=True)
         n1 = sfft.next_fast_len(cols + max(rows, cols) // 4, real=True)
-    w = _noise(n0 * n1, seed, c.STREAM_SPECTRAL_2D, n_threads).reshape(n0, n1)
-    spec = sfft.rfft2(w, workers=_workers(n_threads))
-    del w
+    spec = _white_noise_rfft2(n0, n1, seed, c.STREAM_SPECTRAL_2D, n_threads)
     spec *= _spectral_amplitude(n0, n1, h)
-    z = sfft.irfft2(spec, s=(n0, n1), workers=_workers(n_threads))
+    z = sfft.irfft2(spec, s=(n0, n1), workers=_workers(n_threads), overwrite_x=True)
     if not periodic:
         z = np.ascontiguousarray(z[:rows, :cols])
     return z
