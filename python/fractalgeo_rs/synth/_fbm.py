@@ -127,17 +127,23 @@ def _davies_harte_sqrt_eig(m: int, hurst: float) -> np.ndarray:
 
 
 def _fbm_exact(n, h, seed, n_threads):
+    # Davies & Harte (1987) in the form of Wood & Chan (1994): a Hermitian
+    # random vector W with E|W_k|^2 = lambda_k / (2m) (lambda: eigenvalues of
+    # the circulant of size 2m holding the fGn autocovariance), whose FFT is
+    # real with exactly the fGn covariance on its first m entries.
     m = sfft.next_fast_len(n - 1, real=True)
-    m += m % 2  # even length keeps rfft bookkeeping simple
-    s = _davies_harte_sqrt_eig(m, h)  # length m + 1 (rfft of 2m)
-    z = _noise(4 * m, seed, c.STREAM_EXACT_1D, n_threads)
-    # Complex Gaussian of the full circulant spectrum, Hermitian-free:
-    w = np.empty(2 * m, dtype=np.complex128)
-    w.real = z[: 2 * m]
-    w.imag = z[2 * m :]
-    w *= np.concatenate([s, s[-2:0:-1]])
-    y = sfft.fft(w, workers=_workers(n_threads))
-    inc = y.real[: n - 1]
+    m += m % 2
+    s = _davies_harte_sqrt_eig(m, h)  # sqrt(lambda_k / (2m)), k = 0 .. m
+    z = _noise(2 * m, seed, c.STREAM_EXACT_1D, n_threads)
+    w = np.empty(m + 1, dtype=np.complex128)
+    w.real[0], w.imag[0] = z[0], 0.0
+    w.real[m], w.imag[m] = z[1], 0.0
+    w.real[1:m] = z[2 : m + 1]
+    w.imag[1:m] = z[m + 1 : 2 * m]
+    w[1:m] *= math.sqrt(0.5)
+    w *= s
+    inc = sfft.irfft(w, 2 * m, workers=_workers(n_threads))[: n - 1]
+    inc *= 2 * m  # irfft divides by the length
     x = np.empty(n)
     x[0] = 0.0
     np.cumsum(inc, out=x[1:])
