@@ -185,11 +185,11 @@ def main():
                 ds.write(dem.astype(np.float32), 1)
             out = os.path.join(d, "s.tif")
             g = best(lambda: subprocess.run(["gdaldem", "hillshade", "-q", src, out], check=True), rep)
-            row(f"hillshade {n}^2 (+byte encode)", best(lambda: fg.dem.shade_to_byte(fg.hillshade(dem, cell_size=30.0)), rep),
+            row(f"hillshade {n}^2 byte=True", best(lambda: fg.hillshade(dem, cell_size=30.0, byte=True), rep),
                 g, "gdaldem hillshade (incl. file I/O)")
             with rasterio.open(out) as ds:
                 ref = ds.read(1).astype(float)[1:-1, 1:-1]
-            mine = fg.dem.shade_to_byte(fg.hillshade(dem, cell_size=30.0)).astype(float)[1:-1, 1:-1]
+            mine = fg.hillshade(dem, cell_size=30.0, byte=True).astype(float)[1:-1, 1:-1]
             print(f"  gdaldem agreement: max |diff| = {np.abs(ref - mine).max():.0f} grey levels, "
                   f"corr = {np.corrcoef(ref.ravel(), mine.ravel())[0, 1]:.6f}")
     else:

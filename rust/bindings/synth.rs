@@ -115,6 +115,23 @@ fn hillshade_f64<'py>(
     Ok(v.into_pyarray(py))
 }
 
+/// GDAL's byte encoding of a reflectance array: round(1 + 254 L), 0 for NaN.
+#[pyfunction]
+#[pyo3(signature = (shade, n_threads=None))]
+fn shade_to_byte<'py>(
+    py: Python<'py>,
+    shade: PyReadonlyArray2<'py, f32>,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray2<u8>>> {
+    let a = shade.as_array();
+    let dim = a.dim();
+    let std = a.as_standard_layout();
+    let v = std.as_slice().ok_or_else(|| PyValueError::new_err("shade: internal: not contiguous"))?;
+    let b = py.detach(|| run_in_pool(n_threads, || Ok(hillshade::to_byte(v))))?;
+    let arr = Array2::from_shape_vec(dim, b).map_err(|_| PyValueError::new_err("internal: shape"))?;
+    Ok(arr.into_pyarray(py))
+}
+
 /// Read the "Y" (or only) channel of a float EXR as a 2D float32 array.
 #[pyfunction]
 fn read_exr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyArray2<f32>>> {
@@ -135,6 +152,7 @@ fn write_exr(py: Python<'_>, path: PathBuf, image: PyReadonlyArray2<'_, f32>) ->
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_exr, m)?)?;
+    m.add_function(wrap_pyfunction!(shade_to_byte, m)?)?;
     m.add_function(wrap_pyfunction!(write_exr, m)?)?;
     m.add_function(wrap_pyfunction!(normal_noise, m)?)?;
     m.add_function(wrap_pyfunction!(midpoint_refine_1d, m)?)?;

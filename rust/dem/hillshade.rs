@@ -60,27 +60,58 @@ pub fn hillshade(z: ArrayView2<f64>, dx: &[f64], dy: f64, p: &ShadeParams) -> Co
     let alt = p.altitude.to_radians();
     let (sin_alt, cos_alt) = alt.sin_cos();
     let zf = p.z_factor;
-    let shade_az = |az_deg: f64, gx: f64, gy: f64| -> f64 {
+    let sun = |az_deg: f64| -> (f64, f64) {
         let (s, c) = az_deg.to_radians().sin_cos();
-        (sin_alt - cos_alt * zf * (s * gx + c * gy)) / (1.0 + zf * zf * (gx * gx + gy * gy)).sqrt()
+        (cos_alt * zf * s, cos_alt * zf * c)
     };
-    let mut out = Array2::<f32>::zeros((rows, cols));
-    let slice = out.as_slice_mut().ok_or_else(|| CoreError::Internal("output not contiguous".into()))?;
-    slice.par_chunks_mut(cols).enumerate().for_each(|(i, row)| {
+    let main_sun = sun(p.azimuth);
+    let multi = [sun(225.0), sun(270.0), sun(315.0), sun(360.0)];
+    let zf2 = zf * zf;
+    let shade = |gx: f64, gy: f64| -> f64 {
+        let norm = 1.0 / (1.0 + zf2 * (gx * gx + gy * gy)).sqrt();
+        let one = |(a, b): (f64, f64)| (sin_alt - (a * gx + b * gy)) * norm;
+        let v = if p.multidirectional {
+            // GDAL: aspect = atan2(y, x) of its own gradient (x = -gx, y = gy).
+            let aspect = gy.atan2(-gx);
+            let (sa, ca) = aspect.sin_cos();
+            let w225 = 0.5 * (1.0 - 2.0 * sa * ca);
+            let w270 = ca * ca;
+            let w315 = 0.5 * (1.0 + 2.0 * sa * ca);
+            let w360 = sa * sa;
+            0.5 * (w225 * one(multi[0]).max(0.0)
+                + w270 * one(multi[1]).max(0.0)
+                + w315 * one(multi[2]).max(0.0)
+                + w360 * one(multi[3]).max(0.0))
+        } else {
+            one(main_sun)
+        };
+        v.clamp(0.0, 1.0)
+    };
+    let zs = z.as_standard_layout();
+    let zs = zs.as_slice().ok_or_else(|| CoreError::Internal("dem not contiguous".into()))?;
+    let mut out = vec![0.0f32; rows * cols];
+    out.par_chunks_mut(cols).enumerate().for_each(|(i, row)| {
         let inv_x = 1.0 / (8.0 * dx[i]);
         let inv_y = 1.0 / (8.0 * dy);
-        for (j, o) in row.iter_mut().enumerate() {
-            let e = z[[i, j]];
+        let cur = &zs[i * cols..(i + 1) * cols];
+        let interior_row = i > 0 && i + 1 < rows;
+        let (up, down) = if interior_row {
+            (&zs[(i - 1) * cols..i * cols], &zs[(i + 1) * cols..(i + 2) * cols])
+        } else {
+            (cur, cur)
+        };
+        // General path: missing neighbours (outside or NaN) take the centre value.
+        let slow = |j: usize| -> f32 {
+            let e = cur[j];
             if e.is_nan() {
-                *o = f32::NAN;
-                continue;
+                return f32::NAN;
             }
             let at = |di: isize, dj: isize| -> f64 {
                 let (ii, jj) = (i as isize + di, j as isize + dj);
                 if ii < 0 || jj < 0 || ii >= rows as isize || jj >= cols as isize {
                     return e;
                 }
-                let v = z[[ii as usize, jj as usize]];
+                let v = zs[ii as usize * cols + jj as usize];
                 if v.is_nan() { e } else { v }
             };
             let (a, b, c) = (at(-1, -1), at(-1, 0), at(-1, 1));
@@ -88,25 +119,31 @@ pub fn hillshade(z: ArrayView2<f64>, dx: &[f64], dy: f64, p: &ShadeParams) -> Co
             let (g, h, k) = (at(1, -1), at(1, 0), at(1, 1));
             let gx = ((c + 2.0 * f + k) - (a + 2.0 * d + g)) * inv_x;
             let gy = ((a + 2.0 * b + c) - (g + 2.0 * h + k)) * inv_y;
-            let v = if p.multidirectional {
-                // GDAL: aspect = atan2(y, x) of its own gradient (x = -gx, y = gy).
-                let aspect = gy.atan2(-gx);
-                let (sa, ca) = aspect.sin_cos();
-                let w225 = 0.5 * (1.0 - 2.0 * sa * ca);
-                let w270 = ca * ca;
-                let w315 = 0.5 * (1.0 + 2.0 * sa * ca);
-                let w360 = sa * sa;
-                0.5 * (w225 * shade_az(225.0, gx, gy).max(0.0)
-                    + w270 * shade_az(270.0, gx, gy).max(0.0)
-                    + w315 * shade_az(315.0, gx, gy).max(0.0)
-                    + w360 * shade_az(360.0, gx, gy).max(0.0))
-            } else {
-                shade_az(p.azimuth, gx, gy)
-            };
-            *o = v.clamp(0.0, 1.0) as f32;
+            shade(gx, gy) as f32
+        };
+        for j in 0..cols {
+            if !interior_row || j == 0 || j + 1 == cols {
+                row[j] = slow(j);
+                continue;
+            }
+            let (a, b, c) = (up[j - 1], up[j], up[j + 1]);
+            let (d, e, f) = (cur[j - 1], cur[j], cur[j + 1]);
+            let (g, h, k) = (down[j - 1], down[j], down[j + 1]);
+            let gx = ((c + 2.0 * f + k) - (a + 2.0 * d + g)) * inv_x;
+            let gy = ((a + 2.0 * b + c) - (g + 2.0 * h + k)) * inv_y;
+            // NaN anywhere in the window propagates to gx or gy.
+            row[j] = if gx.is_nan() || gy.is_nan() || e.is_nan() { slow(j) } else { shade(gx, gy) as f32 };
         }
     });
-    Ok(out)
+    Array2::from_shape_vec((rows, cols), out).map_err(|e| CoreError::Internal(e.to_string()))
+}
+
+/// GDAL's byte encoding of a reflectance: `round(1 + 254 L)`, 0 for NaN.
+pub fn to_byte(shade: &[f32]) -> Vec<u8> {
+    shade
+        .par_iter()
+        .map(|&v| if v.is_nan() { 0 } else { (1.0 + 254.0 * v.clamp(0.0, 1.0)).round() as u8 })
+        .collect()
 }
 
 #[cfg(test)]

@@ -44,7 +44,7 @@ def _pair(cell_size):
 
 
 def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0, nodata=None,
-              multidirectional=False, latitude=None, n_threads=None):
+              multidirectional=False, latitude=None, byte=False, n_threads=None):
     r"""Lambertian shaded relief with Horn's gradients (GDAL's conventions).
 
     For the 3 x 3 window ``a b c / d e f / g h i`` (row 0 to the north)
@@ -91,13 +91,16 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
         For geographic grids: latitude in degrees of the grid (scalar) or of
         each row's centre. ``cell_size`` is then in degrees and converted to
         metres per row with :func:`metres_per_degree` (WGS84).
+    byte : bool
+        Return GDAL's 8-bit encoding (:func:`shade_to_byte`) instead.
     n_threads : int or None
         Threads of the Rust kernel.
 
     Returns
     -------
     numpy.ndarray
-        float32 reflectance in [0, 1], NaN at nodata.
+        float32 reflectance in [0, 1], NaN at nodata; with ``byte=True``
+        uint8, ``1 + 254 L`` rounded, 0 at nodata.
 
     References
     ----------
@@ -117,7 +120,10 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
         raise ValueError(f"dem: expected a non-empty 2D array, got shape {z.shape}")
     if z.dtype == bool or not np.issubdtype(z.dtype, np.number):
         raise TypeError(f"dem: expected a numeric array, got dtype {z.dtype}")
-    z = np.array(z, dtype=np.float64)  # a copy: the caller's array is never touched
+    if nodata is None:
+        z = np.ascontiguousarray(z, dtype=np.float64)  # the kernel only reads it
+    else:
+        z = np.array(z, dtype=np.float64)  # a copy: the caller's array is never touched
     if nodata is not None:
         if not isinstance(nodata, numbers.Real) or isinstance(nodata, bool):
             raise TypeError(f"nodata: expected a number or None, got {nodata!r}")
@@ -140,14 +146,16 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
         m_lat, m_lon = metres_per_degree(lat)
         dx_rows = dx * m_lon
         dy = dy * float(np.mean(m_lat))
-    return _core.hillshade_f64(z, dx_rows.tolist(), float(dy), float(azimuth), float(altitude),
-                               float(z_factor), bool(multidirectional), check_n_threads(n_threads))
+    n_threads = check_n_threads(n_threads)
+    s = _core.hillshade_f64(z, dx_rows.tolist(), float(dy), float(azimuth), float(altitude),
+                            float(z_factor), bool(multidirectional), n_threads)
+    return _core.shade_to_byte(s, n_threads) if byte else s
 
 
 def shade_to_byte(shade):
-    """GDAL's byte encoding of a reflectance: ``round(1 + 254 L)``, 0 for nodata (NaN)."""
-    s = np.asarray(shade, dtype=np.float64)
-    out = np.zeros(s.shape, dtype=np.uint8)
-    ok = np.isfinite(s)
-    out[ok] = np.rint(1.0 + 254.0 * np.clip(s[ok], 0.0, 1.0)).astype(np.uint8)
-    return out
+    """GDAL's byte encoding of a reflectance: ``round(1 + 254 L)`` (halves away
+    from zero, as GDAL's float-to-byte copy), 0 for nodata (NaN)."""
+    s = as_array(shade, "shade")
+    if s.ndim != 2:
+        raise ValueError(f"shade: expected a 2D array, got shape {s.shape}")
+    return _core.shade_to_byte(np.asarray(s, dtype=np.float32))

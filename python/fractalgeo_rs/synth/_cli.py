@@ -46,7 +46,7 @@ def add_parsers(sub) -> None:
 
 
 def _run_synth(args: argparse.Namespace) -> int:
-    from fractalgeo_rs.dem import hillshade, shade_to_byte
+    from fractalgeo_rs.dem import hillshade
     from fractalgeo_rs.io import write_raster
     from fractalgeo_rs.synth import fbm, fbm_surface
 
@@ -67,13 +67,13 @@ def _run_synth(args: argparse.Namespace) -> int:
                     cell_size=args.cell_size, periodic=args.periodic, n_threads=args.n_threads)
     write_raster(args.output, z)
     if args.hillshade:
-        s = hillshade(z, azimuth=args.azimuth, cell_size=args.cell_size, n_threads=args.n_threads)
-        write_raster(args.hillshade, shade_to_byte(s))
+        s = hillshade(z, azimuth=args.azimuth, cell_size=args.cell_size, byte=True, n_threads=args.n_threads)
+        write_raster(args.hillshade, s)
     return 0
 
 
 def _run_hillshade(args: argparse.Namespace) -> int:
-    from fractalgeo_rs.dem import hillshade, shade_to_byte
+    from fractalgeo_rs.dem import hillshade
     from fractalgeo_rs.io import read_raster, write_raster
 
     z, prof = read_raster(args.dem)
@@ -91,7 +91,7 @@ def _run_hillshade(args: argparse.Namespace) -> int:
     if args.cell_size is not None:
         cell = args.cell_size
     s = hillshade(z, azimuth=args.azimuth, altitude=args.altitude, z_factor=args.z_factor, cell_size=cell,
-                  nodata=nodata, multidirectional=args.multidirectional, latitude=latitude,
+                  nodata=nodata, multidirectional=args.multidirectional, latitude=latitude, byte=True,
                   n_threads=args.n_threads)
-    write_raster(args.output, shade_to_byte(s))
+    write_raster(args.output, s)
     return 0
