@@ -47,7 +47,7 @@ pub fn read_exr_gray(path: &Path) -> CoreResult<(Vec<f32>, usize, usize)> {
     let list = &layer.channel_data.list;
     let chan = list
         .iter()
-        .find(|c| c.name == Text::from("Y"))
+        .find(|c| c.name == *"Y")
         .or(if list.len() == 1 { list.first() } else { None })
         .ok_or_else(|| CoreError::Io(format!("{}: no channel \"Y\" among {} channels", path.display(), list.len())))?;
     let values: Vec<f32> = chan.sample_data.values_as_f32().collect();
