@@ -36,6 +36,9 @@ from fractalgeo_rs.dimension import (
 # -- domain exports: each issue adds its own line below --
 from fractalgeo_rs.lsystem import IFS, LString, LSystem
 from fractalgeo_rs.transform import fractal_transform
+from fractalgeo_rs.synth import fbm, fbm_surface, validate_surface, SurfaceReport, synthetic_dem  # noqa: E402
+from fractalgeo_rs.dem import hillshade, lakes  # noqa: E402
+from fractalgeo_rs.io import read_raster, write_raster  # noqa: E402
 
 __all__ = [
     "__version__",
@@ -64,4 +67,14 @@ __all__ = [
     "LString",
     "LSystem",
     "fractal_transform",
+    # synth / dem / io
+    "fbm",
+    "fbm_surface",
+    "validate_surface",
+    "SurfaceReport",
+    "synthetic_dem",
+    "hillshade",
+    "lakes",
+    "read_raster",
+    "write_raster",
 ]

@@ -42,6 +42,45 @@ def read_image(path: str | PathLike[str]) -> np.ndarray: ...
 def write_png(path: str | PathLike[str], image: np.ndarray) -> None: ...
 
 # ---- synth / dem ----
+def normal_noise(
+    n: int, seed: int, stream: int, start: int = 0, n_threads: Optional[int] = None
+) -> npt.NDArray[np.float64]: ...
+def midpoint_refine_1d(
+    coarse: npt.NDArray[np.float64],
+    levels: int,
+    hurst: float,
+    sigma: float,
+    coarse_spacing: float,
+    additions: bool,
+    seed: int,
+    first_level: int = 0,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...
+def midpoint_refine_2d(
+    coarse: npt.NDArray[np.float64],
+    levels: int,
+    hurst: float,
+    sigma: float,
+    coarse_spacing: float,
+    additions: bool,
+    periodic: bool,
+    seed: int,
+    first_level: int = 0,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...
+def hillshade_f64(
+    dem: npt.NDArray[np.float64],
+    dx: Sequence[float],
+    dy: float,
+    azimuth: float,
+    altitude: float,
+    z_factor: float,
+    multidirectional: bool,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float32]: ...
+def shade_to_byte(shade: npt.NDArray[np.float32], n_threads: Optional[int] = None) -> npt.NDArray[np.uint8]: ...
+def read_exr(path: str | PathLike[str]) -> npt.NDArray[np.float32]: ...
+def write_exr(path: str | PathLike[str], image: npt.NDArray[np.float32]) -> None: ...
 
 # ---- lsystem ----
 _TurtleArgs = Tuple[

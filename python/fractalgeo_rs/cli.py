@@ -15,6 +15,7 @@ from typing import Optional, Sequence
 _DOMAIN_CLIS = (
     "fractalgeo_rs.dimension._cli",
     "fractalgeo_rs.lsystem._cli",
+    "fractalgeo_rs.synth._cli",
     # each issue adds its domain's _cli module here
 )
 

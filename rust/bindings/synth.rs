@@ -1,6 +1,162 @@
-//! Bindings of `crate::synth` and `crate::dem` (filled by the synthesis issue).
+//! Bindings of `crate::synth` and `crate::dem`.
+use crate::dem::hillshade::{self, ShadeParams};
+use crate::io::exr_io;
+use numpy::ndarray::Array2;
+use numpy::PyUntypedArrayMethods;
+use pyo3::exceptions::PyValueError;
+use std::path::PathBuf;
+use crate::parallel::run_in_pool;
+use crate::synth::midpoint::{self, RefineParams};
+use crate::synth::rng;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
-pub fn register(_m: &Bound<'_, PyModule>) -> PyResult<()> {
+/// `n` standard normals of stream `(seed, stream)` at indices `start ..`.
+#[pyfunction]
+#[pyo3(signature = (n, seed, stream, start=0, n_threads=None))]
+fn normal_noise<'py>(
+    py: Python<'py>,
+    n: usize,
+    seed: u64,
+    stream: u64,
+    start: u64,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let v = py.detach(|| {
+        run_in_pool(n_threads, || {
+            let mut v = vec![0.0; n];
+            rng::fill_normal(&mut v, seed, stream, start);
+            Ok(v)
+        })
+    })?;
+    Ok(v.into_pyarray(py))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn params(hurst: f64, sigma: f64, coarse_spacing: f64, additions: bool, periodic: bool, seed: u64, first_level: u32) -> RefineParams {
+    RefineParams {
+        hurst,
+        sigma,
+        coarse_spacing,
+        additions,
+        periodic,
+        seed,
+        level: first_level,
+        origin: (0, 0),
+        global_cols: 0,
+    }
+}
+
+/// Refine a 1D profile `levels` times by factors of 2 (midpoint displacement,
+/// optionally with random additions).
+#[pyfunction]
+#[pyo3(signature = (coarse, levels, hurst, sigma, coarse_spacing, additions, seed, first_level=0, n_threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn midpoint_refine_1d<'py>(
+    py: Python<'py>,
+    coarse: PyReadonlyArray1<'py, f64>,
+    levels: u32,
+    hurst: f64,
+    sigma: f64,
+    coarse_spacing: f64,
+    additions: bool,
+    seed: u64,
+    first_level: u32,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let c: Vec<f64> = coarse.as_array().to_vec();
+    let p = params(hurst, sigma, coarse_spacing, additions, false, seed, first_level);
+    let v = py.detach(|| run_in_pool(n_threads, || midpoint::refine_1d_levels(&c, levels, &p)))?;
+    Ok(v.into_pyarray(py))
+}
+
+/// Refine a 2D grid `levels` times by factors of 2 (diamond-square, optionally
+/// with random additions; periodic: torus).
+#[pyfunction]
+#[pyo3(signature = (coarse, levels, hurst, sigma, coarse_spacing, additions, periodic, seed, first_level=0, n_threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn midpoint_refine_2d<'py>(
+    py: Python<'py>,
+    coarse: PyReadonlyArray2<'py, f64>,
+    levels: u32,
+    hurst: f64,
+    sigma: f64,
+    coarse_spacing: f64,
+    additions: bool,
+    periodic: bool,
+    seed: u64,
+    first_level: u32,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let c = coarse.as_array();
+    let p = params(hurst, sigma, coarse_spacing, additions, periodic, seed, first_level);
+    let v = py.detach(|| run_in_pool(n_threads, || midpoint::refine_2d_levels(c, levels, &p)))?;
+    Ok(v.into_pyarray(py))
+}
+
+/// Hillshade in [0, 1] (NaN = nodata); `dx` per row, `dy` scalar.
+#[pyfunction]
+#[pyo3(signature = (dem, dx, dy, azimuth, altitude, z_factor, multidirectional, n_threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn hillshade_f64<'py>(
+    py: Python<'py>,
+    dem: PyReadonlyArray2<'py, f64>,
+    dx: Vec<f64>,
+    dy: f64,
+    azimuth: f64,
+    altitude: f64,
+    z_factor: f64,
+    multidirectional: bool,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let z = dem.as_array();
+    let p = ShadeParams { azimuth, altitude, z_factor, multidirectional };
+    let v = py.detach(|| run_in_pool(n_threads, || hillshade::hillshade(z, &dx, dy, &p)))?;
+    Ok(v.into_pyarray(py))
+}
+
+/// GDAL's byte encoding of a reflectance array: round(1 + 254 L), 0 for NaN.
+#[pyfunction]
+#[pyo3(signature = (shade, n_threads=None))]
+fn shade_to_byte<'py>(
+    py: Python<'py>,
+    shade: PyReadonlyArray2<'py, f32>,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray2<u8>>> {
+    let a = shade.as_array();
+    let dim = a.dim();
+    let std = a.as_standard_layout();
+    let v = std.as_slice().ok_or_else(|| PyValueError::new_err("shade: internal: not contiguous"))?;
+    let b = py.detach(|| run_in_pool(n_threads, || Ok(hillshade::to_byte(v))))?;
+    let arr = Array2::from_shape_vec(dim, b).map_err(|_| PyValueError::new_err("internal: shape"))?;
+    Ok(arr.into_pyarray(py))
+}
+
+/// Read the "Y" (or only) channel of a float EXR as a 2D float32 array.
+#[pyfunction]
+fn read_exr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let (v, rows, cols) = py.detach(|| exr_io::read_exr_gray(&path))?;
+    let a = Array2::from_shape_vec((rows, cols), v)
+        .map_err(|_| PyValueError::new_err("internal: EXR pixel count does not match its size"))?;
+    Ok(a.into_pyarray(py))
+}
+
+/// Write a 2D float32 array as a single-channel ("Y") float EXR, atomically.
+#[pyfunction]
+fn write_exr(py: Python<'_>, path: PathBuf, image: PyReadonlyArray2<'_, f32>) -> PyResult<()> {
+    let (rows, cols) = (image.shape()[0], image.shape()[1]);
+    let v: Vec<f32> = image.as_array().iter().copied().collect();
+    py.detach(|| exr_io::write_exr_gray(&path, v, rows, cols))?;
+    Ok(())
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(read_exr, m)?)?;
+    m.add_function(wrap_pyfunction!(shade_to_byte, m)?)?;
+    m.add_function(wrap_pyfunction!(write_exr, m)?)?;
+    m.add_function(wrap_pyfunction!(normal_noise, m)?)?;
+    m.add_function(wrap_pyfunction!(midpoint_refine_1d, m)?)?;
+    m.add_function(wrap_pyfunction!(midpoint_refine_2d, m)?)?;
+    m.add_function(wrap_pyfunction!(hillshade_f64, m)?)?;
     Ok(())
 }

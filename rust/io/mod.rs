@@ -1,3 +1,4 @@
 //! Raster input/output done in Rust: 8/16-bit PNG and TIFF through the `image`
-//! crate. GeoTIFF with georeferencing is read on the Python side (rasterio).
+//! crate, single-channel float EXR through `exr`. GeoTIFF with georeferencing is read on the Python side (rasterio).
+pub mod exr_io;
 pub mod image_io;

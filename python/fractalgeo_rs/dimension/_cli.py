@@ -54,7 +54,10 @@ def _run_dimension(args: argparse.Namespace) -> int:
     from fractalgeo_rs.dimension import dimension
     from fractalgeo_rs.io import read_raster
 
-    data, _profile = read_raster(args.path, band=args.band)
+    data, profile = read_raster(args.path, band=args.band)
+    nodata = (profile or {}).get("nodata")
+    if nodata is not None and not np.isnan(nodata):
+        data = np.where(data == nodata, np.nan, data.astype(np.float64))
     method = args.method
     if method is None:
         is_binary = data.dtype == bool or (

@@ -1,0 +1,370 @@
+//! Random midpoint displacement and Voss's successive random additions, as
+//! refinement kernels: a grid is refined by a factor 2 per level, the existing
+//! samples are kept (plain midpoint displacement) and the new ones are the mean
+//! of their neighbours plus a Gaussian displacement.
+//!
+//! Variance schedule (seed paper eq. 19-20; Peitgen & Saupe 1988, ch. 2): the
+//! displacement standard deviation at a level whose *coarse* spacing is `s`
+//! (length units) is `sigma * s^H * k`, so it shrinks by `2^-H` per level
+//! (`sigma_n^2 = sigma_{n-1}^2 / 2^{2H}`, eq. 20). The constant `k` makes the
+//! increments between neighbours have variance `sigma^2 * d^{2H}` (eq. 19)
+//! when the coarse grid has it:
+//!
+//! * 1D, midpoint: `k^2 = 1 - 2^{2H-2}` (exact for neighbours at every level);
+//! * 2D diamond-square, per half step: `k^2 = 2^{-H} - (2 + 2^H) / 8`, from
+//!   `Var(mean of 4 corners - corner) = (2 gamma(s) + gamma(s sqrt 2)) / 8`;
+//!   the square step uses the same `k` with the spacing `s / sqrt 2`;
+//! * with random additions (Voss 1985, 1988; Peitgen & Saupe 1988,
+//!   `AdditionsFM1D`/`MidPointFM2D` with addition): the new samples are the
+//!   mean of their neighbours, then every sample, old and new, receives an
+//!   independent Gaussian; the constant is divided by `sqrt 2` so the neighbour
+//!   increments keep the variance above (`v' = v/4 + 2 delta^2` in 1D).
+//!
+//! Random numbers are keyed by `(seed, stream = f(level, phase), global index
+//! in the refined grid)` (see [`super::rng`]), so the output does not depend on
+//! the number of threads, and the noise at a global position is the same
+//! whichever tile (`origin`) computes it.
+use super::rng::StreamKey;
+use crate::error::{CoreError, CoreResult};
+use ndarray::{Array2, ArrayView2};
+use rayon::prelude::*;
+
+/// Options of one refinement level.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RefineParams {
+    /// Hurst exponent in (0, 1).
+    pub hurst: f64,
+    /// Scale: the increment standard deviation at unit distance.
+    pub sigma: f64,
+    /// Spacing of the coarse grid in length units (the fine spacing is half).
+    pub coarse_spacing: f64,
+    /// Voss's random additions to all samples (existing samples then change).
+    pub additions: bool,
+    /// Treat the grid as a torus (coarse `n` -> fine `2n`), else `n` -> `2n - 1`.
+    pub periodic: bool,
+    /// Random seed.
+    pub seed: u64,
+    /// Level number, part of the random key (use distinct levels per call).
+    pub level: u32,
+    /// Global position of the fine grid's first sample (tiles).
+    pub origin: (u64, u64),
+    /// Number of columns of the global fine grid (the key's row stride).
+    pub global_cols: u64,
+}
+
+const PHASE_DISPLACE: u64 = 0;
+const PHASE_ADD: u64 = 1;
+const PHASE_DISPLACE_SQ: u64 = 2;
+const PHASE_ADD_SQ: u64 = 3;
+/// Streams below this are free for other uses of the seed.
+pub const STREAM_BASE: u64 = 1 << 20;
+
+fn key(p: &RefineParams, phase: u64) -> StreamKey {
+    StreamKey::new(p.seed, STREAM_BASE + (p.level as u64) * 8 + phase)
+}
+
+fn check(p: &RefineParams) -> CoreResult<()> {
+    if !(p.hurst > 0.0 && p.hurst < 1.0) {
+        return Err(CoreError::invalid("hurst", format!("expected a number in (0, 1), got {}", p.hurst)));
+    }
+    if !(p.sigma.is_finite() && p.sigma >= 0.0) {
+        return Err(CoreError::invalid("sigma", format!("expected a finite number >= 0, got {}", p.sigma)));
+    }
+    if !(p.coarse_spacing.is_finite() && p.coarse_spacing > 0.0) {
+        return Err(CoreError::invalid("coarse_spacing", format!("expected a positive number, got {}", p.coarse_spacing)));
+    }
+    Ok(())
+}
+
+/// Constant `k` of the 1D schedule (see the module docs).
+pub fn k1(hurst: f64, additions: bool) -> f64 {
+    let k2 = 1.0 - 2f64.powf(2.0 * hurst - 2.0);
+    (if additions { k2 / 2.0 } else { k2 }).sqrt()
+}
+
+/// Constant `k` of the 2D diamond-square schedule, per half step.
+pub fn k2(hurst: f64, additions: bool) -> f64 {
+    let k2 = 2f64.powf(-hurst) - (2.0 + 2f64.powf(hurst)) / 8.0;
+    (if additions { k2 / 2.0 } else { k2 }).max(0.0).sqrt()
+}
+
+/// Refine a 1D profile by a factor 2: samples `i` of `coarse` go to `2 i`.
+pub fn refine_1d(coarse: &[f64], p: &RefineParams) -> CoreResult<Vec<f64>> {
+    check(p)?;
+    let n = coarse.len();
+    if n < 1 || (!p.periodic && n < 2) {
+        return Err(CoreError::invalid("coarse", format!("need at least 2 samples, got {n}")));
+    }
+    let m = if p.periodic { 2 * n } else { 2 * n - 1 };
+    // delta = sigma * (s/2)^H * k: the new neighbour distance is s/2.
+    let delta = p.sigma * (p.coarse_spacing / 2.0).powf(p.hurst) * k1(p.hurst, p.additions);
+    let kd = key(p, PHASE_DISPLACE);
+    let ka = key(p, PHASE_ADD);
+    let o = p.origin.1;
+    let mut out = vec![0.0; m];
+    out.par_chunks_mut(1 << 12).enumerate().for_each(|(ci, chunk)| {
+        let base = ci << 12;
+        for (j, v) in chunk.iter_mut().enumerate() {
+            let i = base + j;
+            let g = o + i as u64;
+            let mut x = if i % 2 == 0 {
+                coarse[i / 2]
+            } else {
+                let a = coarse[i / 2];
+                let b = coarse[(i / 2 + 1) % n];
+                let mid = 0.5 * (a + b);
+                if p.additions { mid } else { mid + delta * kd.normal(g) }
+            };
+            if p.additions {
+                x += delta * ka.normal(g);
+            }
+            *v = x;
+        }
+    });
+    Ok(out)
+}
+
+/// Refine a 2D grid by a factor 2 with the diamond-square scheme.
+///
+/// Non-periodic: `(r, c)` -> `(2r - 1, 2c - 1)`; periodic: `(2r, 2c)`. The
+/// sample `(i, j)` of `coarse` goes to `(2i, 2j)` and is kept unchanged unless
+/// `additions` is set. Edge samples of the square step average the 3
+/// neighbours that exist (non-periodic).
+pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2<f64>> {
+    check(p)?;
+    let (r, c) = coarse.dim();
+    if !p.periodic && (r < 2 || c < 2) {
+        return Err(CoreError::invalid("coarse", format!("need at least 2 x 2 samples, got {r} x {c}")));
+    }
+    if p.periodic && (r < 1 || c < 1) {
+        return Err(CoreError::invalid("coarse", "empty grid"));
+    }
+    let coarse = coarse.as_standard_layout();
+    let cs: &[f64] = coarse.as_slice().ok_or_else(|| CoreError::Internal("coarse grid not contiguous".into()))?;
+    let (fr, fc) = if p.periodic { (2 * r, 2 * c) } else { (2 * r - 1, 2 * c - 1) };
+    let s = p.coarse_spacing;
+    let kk = k2(p.hurst, p.additions);
+    // Diamond step: the coarse side is s; square step: the lattice side is s / sqrt 2.
+    let delta_d = p.sigma * s.powf(p.hurst) * kk;
+    let delta_s = p.sigma * s.powf(p.hurst) * 2f64.powf(-p.hurst / 2.0) * kk;
+    let (kd, ka, ks, kas) = (key(p, PHASE_DISPLACE), key(p, PHASE_ADD), key(p, PHASE_DISPLACE_SQ), key(p, PHASE_ADD_SQ));
+    let (o0, o1, gc) = (p.origin.0, p.origin.1, p.global_cols.max((p.origin.1) + fc as u64));
+    let add = p.additions;
+
+    // Pass A (diamond step): old samples and cell centres, row by row.
+    let mut fine = vec![0.0f64; fr * fc];
+    fine.par_chunks_mut(fc).enumerate().for_each(|(i, row)| {
+        let gbase = (o0 + i as u64) * gc + o1;
+        let a = i / 2;
+        if i % 2 == 0 {
+            let crow = &cs[a * c..(a + 1) * c];
+            for (b, v) in crow.iter().enumerate() {
+                let j = 2 * b;
+                row[j] = if add { v + delta_d * ka.normal(gbase + j as u64) } else { *v };
+            }
+        } else {
+            let a1 = if a + 1 == r { 0 } else { a + 1 };
+            let (r0, r1) = (&cs[a * c..(a + 1) * c], &cs[a1 * c..(a1 + 1) * c]);
+            let mut j = 1;
+            while j < fc {
+                let b = j / 2;
+                let b1 = if b + 1 == c { 0 } else { b + 1 };
+                let mean = 0.25 * (r0[b] + r0[b1] + r1[b] + r1[b1]);
+                let g = gbase + j as u64;
+                row[j] = if add { mean + delta_d * ka.normal(g) } else { mean + delta_d * kd.normal(g) };
+                j += 2;
+            }
+        }
+    });
+
+    // Pass B (square step), in place: it writes only the samples with i + j
+    // odd and reads only samples with i + j even (written by pass A), so the
+    // rows can be processed in parallel through a shared pointer.
+    struct Shared(*mut f64);
+    unsafe impl Sync for Shared {}
+    unsafe impl Send for Shared {}
+    impl Shared {
+        fn get(&self) -> *mut f64 {
+            self.0
+        }
+    }
+    let ptr = Shared(fine.as_mut_ptr());
+    let periodic = p.periodic;
+    (0..fr).into_par_iter().for_each(|i| {
+        let base = ptr.get();
+        // SAFETY: reads target even-parity cells, writes odd-parity cells of
+        // row i only; both are inside the fr * fc buffer.
+        let get = |ii: usize, jj: usize| unsafe { *base.add(ii * fc + jj) };
+        let gbase = (o0 + i as u64) * gc + o1;
+        let up = if i > 0 { Some(i - 1) } else if periodic { Some(fr - 1) } else { None };
+        let down = if i + 1 < fr { Some(i + 1) } else if periodic { Some(0) } else { None };
+        let mut j = if i % 2 == 0 { 1 } else { 0 };
+        while j < fc {
+            let left = if j > 0 { Some(j - 1) } else if periodic { Some(fc - 1) } else { None };
+            let right = if j + 1 < fc { Some(j + 1) } else if periodic { Some(0) } else { None };
+            let mut sum = 0.0;
+            let mut cnt = 0.0;
+            if let Some(u) = up {
+                sum += get(u, j);
+                cnt += 1.0;
+            }
+            if let Some(d) = down {
+                sum += get(d, j);
+                cnt += 1.0;
+            }
+            if let Some(l) = left {
+                sum += get(i, l);
+                cnt += 1.0;
+            }
+            if let Some(rr) = right {
+                sum += get(i, rr);
+                cnt += 1.0;
+            }
+            let mean = sum / cnt;
+            let v = if add { mean } else { mean + delta_s * ks.normal(gbase + j as u64) };
+            unsafe { *base.add(i * fc + j) = v };
+            j += 2;
+        }
+    });
+
+    // Pass C: Voss's additions to every sample after the square step.
+    if add {
+        fine.par_chunks_mut(fc).enumerate().for_each(|(i, row)| {
+            let gbase = (o0 + i as u64) * gc + o1;
+            for (j, v) in row.iter_mut().enumerate() {
+                *v += delta_s * kas.normal(gbase + j as u64);
+            }
+        });
+    }
+    Array2::from_shape_vec((fr, fc), fine).map_err(|e| CoreError::Internal(e.to_string()))
+}
+
+/// Refine `levels` times (levels numbered `first_level ..`), each time halving
+/// the spacing. The global column count used for the keys is that of the
+/// final grid, so a window computed with its origin agrees with the whole.
+pub fn refine_2d_levels(
+    coarse: ArrayView2<f64>,
+    levels: u32,
+    base: &RefineParams,
+) -> CoreResult<Array2<f64>> {
+    let mut grid = coarse.to_owned();
+    let mut p = *base;
+    for l in 0..levels {
+        let (r, c) = grid.dim();
+        let (fr, fc) = if p.periodic { (2 * r, 2 * c) } else { (2 * r - 1, 2 * c - 1) };
+        let _ = fr;
+        p.level = base.level + l;
+        p.global_cols = fc as u64;
+        p.origin = (0, 0);
+        grid = refine_2d(grid.view(), &p)?;
+        p.coarse_spacing /= 2.0;
+    }
+    Ok(grid)
+}
+
+/// 1D counterpart of [`refine_2d_levels`].
+pub fn refine_1d_levels(coarse: &[f64], levels: u32, base: &RefineParams) -> CoreResult<Vec<f64>> {
+    let mut x = coarse.to_vec();
+    let mut p = *base;
+    for l in 0..levels {
+        p.level = base.level + l;
+        p.origin = (0, 0);
+        x = refine_1d(&x, &p)?;
+        p.coarse_spacing /= 2.0;
+    }
+    Ok(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::parallel::run_in_pool;
+
+    fn params(additions: bool, periodic: bool) -> RefineParams {
+        RefineParams {
+            hurst: 0.7,
+            sigma: 1.0,
+            coarse_spacing: 8.0,
+            additions,
+            periodic,
+            seed: 5,
+            level: 0,
+            origin: (0, 0),
+            global_cols: 0,
+        }
+    }
+
+    #[test]
+    fn midpoint_keeps_coarse_samples() {
+        let coarse = Array2::from_shape_fn((5, 7), |(i, j)| (i * 10 + j) as f64);
+        let f = refine_2d(coarse.view(), &params(false, false)).unwrap();
+        assert_eq!(f.dim(), (9, 13));
+        for i in 0..5 {
+            for j in 0..7 {
+                assert_eq!(f[[2 * i, 2 * j]], coarse[[i, j]]);
+            }
+        }
+        let x = refine_1d(&[1.0, 2.0, 5.0], &params(false, false)).unwrap();
+        assert_eq!((x.len(), x[0], x[2], x[4]), (5, 1.0, 2.0, 5.0));
+    }
+
+    #[test]
+    fn zero_sigma_is_interpolation() {
+        let coarse = Array2::from_shape_fn((3, 3), |(i, j)| (2 * i + 3 * j) as f64);
+        let mut p = params(true, false);
+        p.sigma = 0.0;
+        let f = refine_2d(coarse.view(), &p).unwrap();
+        // A plane is reproduced exactly by the 4-point means (interior).
+        assert!((f[[1, 1]] - (1.0 + 1.5)).abs() < 1e-12);
+        assert!((f[[2, 1]] - (2.0 + 1.5)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn thread_count_does_not_matter() {
+        let coarse = Array2::<f64>::zeros((3, 3));
+        let a = run_in_pool(Some(1), || refine_2d_levels(coarse.view(), 6, &params(true, false))).unwrap();
+        let b = run_in_pool(Some(2), || refine_2d_levels(coarse.view(), 6, &params(true, false))).unwrap();
+        assert_eq!(a, b);
+        assert_eq!(a.dim(), (129, 129));
+    }
+
+    #[test]
+    fn periodic_sizes() {
+        let coarse = Array2::<f64>::zeros((1, 1));
+        let f = refine_2d_levels(coarse.view(), 4, &params(false, true)).unwrap();
+        assert_eq!(f.dim(), (16, 16));
+    }
+
+    #[test]
+    fn one_d_neighbour_variance() {
+        // 1D midpoint: Var(x[i+1] - x[i]) = sigma^2 * d^{2H} at the finest level
+        // when the coarse profile has it (two points at distance 1024).
+        let h = 0.7;
+        let mut acc = 0.0;
+        let mut n = 0.0;
+        for seed in 0..200u64 {
+            let end = StreamKey::new(seed, 1).normal(0) * 1024f64.powf(h);
+            let mut p = params(false, false);
+            p.hurst = h;
+            p.seed = seed;
+            p.coarse_spacing = 1024.0;
+            let x = refine_1d_levels(&[0.0, end], 10, &p).unwrap();
+            for w in x.windows(2) {
+                acc += (w[1] - w[0]).powi(2);
+                n += 1.0;
+            }
+        }
+        // 204,800 increments: expected 1.0 (unit spacing); the standard error
+        // of the mean of squared Gaussians is sqrt(2/N_eff) with correlated
+        // increments, well below 0.05.
+        assert!((acc / n - 1.0).abs() < 0.05, "{}", acc / n);
+    }
+
+    #[test]
+    fn bad_hurst() {
+        let coarse = Array2::<f64>::zeros((2, 2));
+        let mut p = params(false, false);
+        p.hurst = 1.0;
+        assert!(matches!(refine_2d(coarse.view(), &p), Err(CoreError::InvalidArgument { .. })));
+    }
+}
