@@ -13,6 +13,10 @@ import numpy as np
 from fractalgeo_rs.data import kilauea_land_mask, sentinel1_vv_db, srtm_alps, srtm_po_plain
 from fractalgeo_rs.dimension import box_counting, differential_box_counting, self_affine_box_counting
 from fractalgeo_rs.fit import DimensionFit
+from fractalgeo_rs.transform import fractal_transform
+
+#: window of the demo's local-dimension map (pixels, 10 m each)
+MAP_WINDOW = 33
 
 
 def coastline(land: np.ndarray) -> np.ndarray:
@@ -61,6 +65,8 @@ def run_demo(out: str = "demo-output") -> Dict[str, DimensionFit]:
     from fractalgeo_rs.plotting import save_figure
 
     fits = compute()
+    vv, vv_info = sentinel1_vv_db()
+    dmap = fractal_transform(vv, MAP_WINDOW, method="variogram")
     for name, fit in fits.items():
         hurst = f"  H = {fit.extra['hurst']:.3f}" if "hurst" in fit.extra else ""
         lo, hi = fit.ci95
@@ -69,7 +75,7 @@ def run_demo(out: str = "demo-output") -> Dict[str, DimensionFit]:
     land, _ = kilauea_land_mask()
     alps, _ = srtm_alps()
     vv, _ = sentinel1_vv_db()
-    fig, axes = plt.subplots(2, 3, figsize=(13, 8))
+    fig, axes = plt.subplots(2, 4, figsize=(17, 8))
     axes[0, 0].imshow(coastline(land)[540:, :], cmap="gray_r", interpolation="nearest")
     axes[0, 0].set_title("Kilauea coastline (30 m), southern part")
     axes[0, 1].imshow(alps, cmap="terrain")
@@ -77,20 +83,42 @@ def run_demo(out: str = "demo-output") -> Dict[str, DimensionFit]:
     axes[0, 1].set_title("SRTM: Maritime Alps, 1200 m contour")
     axes[0, 2].imshow(vv, cmap="gray", vmin=-25, vmax=5)
     axes[0, 2].set_title("Sentinel-1 VV (dB)")
+    im = axes[0, 3].imshow(dmap, cmap="magma", vmin=np.nanpercentile(dmap, 2), vmax=np.nanpercentile(dmap, 98))
+    axes[0, 3].set_title(f"local dimension, {MAP_WINDOW}x{MAP_WINDOW} windows")
+    fig.colorbar(im, ax=axes[0, 3], shrink=0.8)
     for ax in axes[0]:
         ax.set_xticks([])
         ax.set_yticks([])
+    axes[1, 3].hist(dmap[np.isfinite(dmap)].ravel(), bins=60, color="C4")
+    axes[1, 3].set_xlabel("local dimension D")
+    axes[1, 3].set_ylabel("pixels")
     names = list(fits)
     fits[names[0]].plot(ax=axes[1, 0], label="Kilauea coast")
     fits[names[1]].plot(ax=axes[1, 0], label="Alps 1200 m contour")
     fits[names[2]].plot(ax=axes[1, 1], label="Alps")
     fits[names[3]].plot(ax=axes[1, 1], label="Po plain")
     fits[names[5]].plot(ax=axes[1, 2], label="VV")
-    fig.suptitle("fractalgeo_rs demo: box-counting dimensions of real data")
+    fig.suptitle("fractalgeo_rs demo: fractal dimensions of real data (bundled samples)")
     fig.tight_layout()
     os.makedirs(out, exist_ok=True)
     path = os.path.join(out, "fractalgeo_demo.png")
     save_figure(fig, path)
     plt.close(fig)
     print(f"figure: {path}")
+    os.makedirs(out, exist_ok=True)
+    map_path = os.path.join(out, "s1_vv_local_dimension.tif")
+    try:
+        from fractalgeo_rs.io import write_raster
+
+        write_raster(map_path, dmap, crs=vv_info["crs"], transform=vv_info["transform"], nodata=float("nan"))
+    except OSError:  # no rasterio: keep the map as .npy
+        map_path = os.path.join(out, "s1_vv_local_dimension.npy")
+        from fractalgeo_rs.io import write_raster
+
+        write_raster(map_path, dmap)
+    print(
+        f"local dimension map ({MAP_WINDOW}x{MAP_WINDOW} variogram windows) of the Sentinel-1 VV scene: "
+        f"mean {np.nanmean(dmap):.3f}, 5-95 % range {np.nanpercentile(dmap, 5):.3f}-{np.nanpercentile(dmap, 95):.3f}"
+    )
+    print(f"map: {map_path}")
     return fits

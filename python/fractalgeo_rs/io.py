@@ -155,7 +155,7 @@ def write_raster(path, data, *, profile: Optional[dict] = None, crs=None, transf
     if ext in (".tif", ".tiff"):
         rio = _rasterio()
         if rio is None:
-            raise ImportError("path: writing GeoTIFF needs rasterio (pip install 'fractalgeo_rs[geo]')")
+            raise OSError("path: writing GeoTIFF needs rasterio (pip install 'fractalgeo_rs[geo]')")
         prof = {"driver": "GTiff"}
         if profile:
             prof.update({k: v for k, v in profile.items() if k not in ("blockxsize", "blockysize", "tiled")})
@@ -163,7 +163,8 @@ def write_raster(path, data, *, profile: Optional[dict] = None, crs=None, transf
         if crs is not None:
             prof["crs"] = crs
         if transform is not None:
-            prof["transform"] = transform
+            # a plain 6-tuple is read in rasterio.Affine order (a, b, c, d, e, f)
+            prof["transform"] = transform if isinstance(transform, rio.Affine) else rio.Affine(*transform)
         if nodata is not None:
             prof["nodata"] = nodata
         if a.dtype == bool:

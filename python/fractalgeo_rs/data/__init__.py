@@ -2,8 +2,8 @@
 this file for provenance and licences).
 
 Each loader returns ``(array, info)`` where ``info`` is a dict with
-``description``, ``attribution``, ``crs``, ``transform`` (GDAL order
-``(a, b, c, d, e, f)``) and, where it applies, ``cell_size`` in metres and
+``description``, ``attribution``, ``crs``, ``transform`` (affine
+coefficients ``(a, b, c, d, e, f)`` in ``rasterio.Affine`` order) and, where it applies, ``cell_size`` in metres and
 ``nodata``.
 """
 from __future__ import annotations
