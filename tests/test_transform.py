@@ -115,3 +115,46 @@ def test_bad_images():
         fg.fractal_transform(np.full((30, 30), np.nan), 9)
     out = fg.fractal_transform(np.zeros((2, 30, 30)) + np.indices((30, 30)).sum(0), 9, band=1)
     assert out.shape == (30, 30)
+
+
+def test_segment_otsu_and_kmeans():
+    rng = np.random.default_rng(0)
+    a = np.where(np.arange(100)[:, None] < 40, 2.2, 2.6) + rng.normal(0, 0.02, (100, 80))
+    a[0, 0] = np.nan
+    lab = fg.segment(a)
+    assert lab[0, 0] == -1 and lab.dtype == np.int8
+    assert np.mean(lab[1:40] == 0) > 0.99 and np.mean(lab[40:] == 1) > 0.99
+    b = rng.normal(size=a.shape)
+    k1 = fg.segment([a, b], method="kmeans", n_classes=2, seed=3)
+    k2 = fg.segment([a, b], method="kmeans", n_classes=2, seed=3)
+    assert np.array_equal(k1, k2)
+    # classes are ordered by the first feature: low-D region is class 0
+    assert np.mean(k1[1:40] == 0) > 0.95 and np.mean(k1[40:] == 1) > 0.95
+    with pytest.raises(ValueError, match="method"):
+        fg.segment([a, b], method="otsu")
+    with pytest.raises(ValueError, match="features"):
+        fg.segment([a, b[:10]])
+    with pytest.raises(ValueError, match="n_classes"):
+        fg.segment(a, method="kmeans", n_classes=1)
+
+
+def test_transform_cli_geotiff(tmp_path, capsys):
+    rasterio = pytest.importorskip("rasterio")
+    pytest.importorskip("dask")
+    from rasterio.transform import from_origin
+
+    from fractalgeo_rs.cli import main
+
+    z = spectral_surface(128, 0.5, 9).astype(np.float32)
+    src = tmp_path / "in.tif"
+    with rasterio.open(src, "w", driver="GTiff", width=128, height=128, count=1, dtype="float32",
+                       crs="EPSG:32633", transform=from_origin(500000, 4000000, 10, 10)) as dst:
+        dst.write(z, 1)
+    for extra in ([], ["--chunks", "40"]):
+        out = tmp_path / f"out{len(extra)}.tif"
+        assert main(["transform", str(src), str(out), "--window", "9", *extra]) == 0
+        with rasterio.open(out) as r:
+            assert r.crs.to_epsg() == 32633 and r.transform == from_origin(500000, 4000000, 10, 10)
+            got = r.read(1)
+        assert np.allclose(got, fg.fractal_transform(z, 9), atol=1e-6, equal_nan=True)
+    assert "local dimension" in capsys.readouterr().out

@@ -16,6 +16,7 @@ _DOMAIN_CLIS = (
     "fractalgeo_rs.dimension._cli",
     "fractalgeo_rs.lsystem._cli",
     "fractalgeo_rs.synth._cli",
+    "fractalgeo_rs.transform._cli",
     # each issue adds its domain's _cli module here
 )
 

@@ -15,7 +15,9 @@ import numpy as np
 from fractalgeo_rs import _core
 from fractalgeo_rs._validation import as_array, check_choice, check_n_threads, check_positive_int
 
-__all__ = ["fractal_transform", "TRANSFORM_METHODS"]
+from fractalgeo_rs.transform.segment import segment
+
+__all__ = ["fractal_transform", "segment", "TRANSFORM_METHODS"]
 
 TRANSFORM_METHODS = {
     # name: (power p, square increments)
