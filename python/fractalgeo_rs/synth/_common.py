@@ -6,6 +6,8 @@ import secrets
 
 import numpy as np
 
+from fractalgeo_rs._validation import check_positive_float
+
 # Random streams of the counter-based generator (one per use of a seed), so
 # that no two parts of one synthesis ever share random numbers.
 STREAM_SPECTRAL_1D = 11
@@ -63,9 +65,4 @@ def check_shape(shape, minimum: int = 2) -> tuple:
 
 
 def check_cell_size(cell_size) -> float:
-    if isinstance(cell_size, bool) or not isinstance(cell_size, numbers.Real):
-        raise TypeError(f"cell_size: expected a positive number, got {cell_size!r}")
-    c = float(cell_size)
-    if not np.isfinite(c) or c <= 0:
-        raise ValueError(f"cell_size: expected a positive finite number, got {cell_size}")
-    return c
+    return check_positive_float(cell_size, "cell_size")
