@@ -24,7 +24,7 @@ pub enum Increments {
     Square,
 }
 
-/// Output rows per band (fixed, so results do not depend on threads).
+/// Fewest output rows per band.
 const BAND: usize = 64;
 
 /// Options of [`variation_transform`].
@@ -91,16 +91,29 @@ pub fn variation_transform(z: &[f64], rows: usize, cols: usize, opt: &VariationO
     let xm = xs.iter().sum::<f64>() / xs.len() as f64;
     let sxx: f64 = xs.iter().map(|x| (x - xm) * (x - xm)).sum();
     let min_pixels = (opt.min_valid * (w * w) as f64).ceil().max(1.0);
-    let n_bands = rows.div_ceil(BAND);
+    // rows per band: a fixed function of the window (never of the thread
+    // count), large enough that the halo of w - 1 rows is a small overhead
+    let band_rows = BAND.max(4 * w);
+    let n_bands = rows.div_ceil(band_rows);
+    let p = opt.p;
+    let power = move |d: f64| -> f64 {
+        if p == 2.0 {
+            d * d
+        } else if p == 1.0 {
+            d.abs()
+        } else {
+            d.abs().powf(p)
+        }
+    };
     let mut dim = vec![f32::NAN; rows * cols];
     let mut r2 = vec![f32::NAN; rows * cols];
-    dim.par_chunks_mut(BAND * cols)
-        .zip(r2.par_chunks_mut(BAND * cols))
+    dim.par_chunks_mut(band_rows * cols)
+        .zip(r2.par_chunks_mut(band_rows * cols))
         .enumerate()
         .for_each(|(band, (dout, rout))| {
             debug_assert!(band < n_bands);
-            let o0 = band * BAND; // first output row
-            let o1 = (o0 + BAND).min(rows);
+            let o0 = band * band_rows; // first output row
+            let o1 = (o0 + band_rows).min(rows);
             // input rows a window of the band can touch
             let i0 = o0.saturating_sub(h);
             let i1 = (o1 + h).min(rows);
@@ -128,7 +141,7 @@ pub fn variation_transform(z: &[f64], rows: usize, cols: usize, opt: &VariationO
                                     Increments::Square => get(r + u, c + u) - get(r + u, c) - get(r, c + u) + get(r, c),
                                 };
                                 if !d.is_nan() {
-                                    pw[r * cols + c] = d.abs().powf(opt.p);
+                                    pw[r * cols + c] = power(d);
                                     ct[r * cols + c] = 1.0;
                                 }
                             }
