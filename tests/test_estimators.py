@@ -256,3 +256,36 @@ def test_height_unit_conventions():
     # ... and without telling the blanket about the units, the answer changes
     assert abs(fg.blanket(c * z).dimension - b1.dimension) > 0.05
     assert fg.surface_variation(c * z).dimension == pytest.approx(fg.surface_variation(z).dimension, abs=1e-12)
+
+
+def dragon_boundary(n=16):
+    """Boundary pixels of the Heighway dragon (level n, edges drawn at twice
+    the resolution and the enclosed cells filled). The boundary of the
+    dragon has dimension 1.5236 (log2 of the real root of x^3 - x^2 - 2)."""
+    from scipy import ndimage
+
+    from fractalgeo_rs.lsystem import turtle_2d
+
+    s = fg.LSystem("FX", {"X": "X+YF+", "Y": "-FX-Y"}).derive(n)
+    xy = np.round(turtle_2d(s, angle=90, step=1).xy).astype(int)
+    xy -= xy.min(axis=0)
+    img = np.zeros((2 * xy[:, 1].max() + 1, 2 * xy[:, 0].max() + 1), bool)
+    p = 2 * xy
+    img[p[:, 1], p[:, 0]] = True
+    mid = (p[1:] + p[:-1]) // 2
+    img[mid[:, 1], mid[:, 0]] = True
+    filled = ndimage.binary_fill_holes(ndimage.binary_closing(img, structure=np.ones((3, 3))))
+    return filled & ndimage.binary_dilation(~filled, structure=np.ones((3, 3)))
+
+
+def test_dragon_curve_boundary():
+    root = np.roots([1, -1, 0, -2])
+    d = float(np.log2(root[np.isreal(root)].real[0]))
+    assert d == pytest.approx(1.5236, abs=1e-4)
+    bd = dragon_boundary(16)
+    # measured: Minkowski 1.518, mass 1.517, box counting 1.559 on boxes 4..128;
+    # boxes of 1-2 pixels see the raster line (local slope 1.0), so the box
+    # fit starts above the construction's resolution
+    assert fg.minkowski(bd).dimension == pytest.approx(d, abs=0.02)
+    assert fg.mass_dimension(bd).dimension == pytest.approx(d, abs=0.02)
+    assert fg.box_counting(bd, scale_range=(4, 128)).dimension == pytest.approx(d, abs=0.05)
