@@ -158,3 +158,17 @@ def test_transform_cli_geotiff(tmp_path, capsys):
             got = r.read(1)
         assert np.allclose(got, fg.fractal_transform(z, 9), atol=1e-6, equal_nan=True)
     assert "local dimension" in capsys.readouterr().out
+
+
+def test_dask_distributed_two_worker_processes():
+    """Two worker processes (started by dask.distributed) run the Rust kernel;
+    each call builds its own thread pool, so no rayon state crosses a fork."""
+    distributed = pytest.importorskip("distributed")
+    da = pytest.importorskip("dask.array")
+    z = spectral_surface(128, 0.5, 5)
+    ref = fg.fractal_transform(z, 9)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        out = fg.fractal_transform(da.from_array(z, chunks=(40, 64)), 9, n_threads=1)
+        got = client.compute(out).result()
+    assert np.allclose(got, ref, atol=1e-6, equal_nan=True)

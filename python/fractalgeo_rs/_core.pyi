@@ -8,6 +8,37 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
+__all__ = [
+    "LSystemCore",
+    "ModuleString",
+    "__version__",
+    "box_count_binary",
+    "box_count_points",
+    "column_ranges",
+    "dbc_count",
+    "hillshade_f64",
+    "ifs_chaos_game",
+    "ifs_check",
+    "ifs_iterate",
+    "ifs_preset",
+    "ifs_rasterize",
+    "lsystem_parse_text",
+    "midpoint_refine_1d",
+    "midpoint_refine_2d",
+    "moran_dimension",
+    "normal_noise",
+    "plants_on_terrain",
+    "read_exr",
+    "read_image",
+    "shade_to_byte",
+    "turtle_mesh",
+    "turtle_polylines",
+    "turtle_segments",
+    "variation_transform_map",
+    "write_exr",
+    "write_mesh",
+    "write_png",
+]
 
 # ---- dimension ----
 def box_count_binary(

@@ -156,7 +156,7 @@ def box_counting(
     >>> i, j = np.indices((n, n))
     >>> triangle = (i & j) == 0          # Sierpinski triangle (Pascal mod 2)
     >>> fit = fg.box_counting(triangle)
-    >>> round(fit.dimension, 6), round(np.log(3) / np.log(2), 6)
+    >>> round(fit.dimension, 6), round(float(np.log(3) / np.log(2)), 6)
     (1.584963, 1.584963)
     """
     b, transposed = _binary_bytes(data)

@@ -228,9 +228,9 @@ def validate_surface(z, hurst=None, *, lags=None, periodic=None, coastline=True)
     Examples
     --------
     >>> import fractalgeo_rs as fg
-    >>> r = fg.validate_surface(fg.fbm_surface(256, 0.5, method="spectral", seed=1), 0.5)
-    >>> abs(r.hurst_variogram - 0.5) < 0.1
-    True
+    >>> r = fg.validate_surface(fg.fbm_surface(256, 0.5, method="exact", seed=1), 0.5)
+    >>> round(r.hurst_variogram, 2)  # lags 8-64 of one 256 x 256 field: spread about 0.05
+    0.47
     """
     z = as_array(z, "z")
     if z.ndim != 2 or min(z.shape) < 32:
