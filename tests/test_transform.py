@@ -42,7 +42,7 @@ def test_map_equals_per_window_estimator_with_holes(method):
 def test_real_sar_window():
     vv, _ = fg.data.sentinel1_vv_db()
     z = vv[100:160, 200:250]
-    d = fg.fractal_transform(z, 9)
+    d = fg.fractal_transform(z, 9, method="variogram")
     ref = per_window(z, 9, "variogram")
     assert np.allclose(d, ref, atol=1e-5, equal_nan=True)
 
@@ -81,10 +81,10 @@ def test_xarray_keeps_coords_and_attrs():
 
 def test_plane_is_two_in_the_interior_and_rough_is_higher():
     i, j = np.indices((80, 80))
-    d = fg.fractal_transform(0.2 * i + 0.5 * j, 9)
+    d = fg.fractal_transform(0.2 * i + 0.5 * j, 9, method="variogram")
     assert np.allclose(d[4:-4, 4:-4], 2.0, atol=1e-5)
-    rough = fg.fractal_transform(spectral_surface(128, 0.2, 1), 17)
-    smooth = fg.fractal_transform(spectral_surface(128, 0.8, 1), 17)
+    rough = fg.fractal_transform(spectral_surface(128, 0.2, 1), 17, method="variogram")
+    smooth = fg.fractal_transform(spectral_surface(128, 0.8, 1), 17, method="variogram")
     assert np.nanmean(rough) > np.nanmean(smooth) + 0.3
 
 
@@ -94,9 +94,12 @@ def test_plane_is_two_in_the_interior_and_rough_is_higher():
         (dict(window_size=8), ValueError, "window_size"),
         (dict(window_size=1), ValueError, "window_size"),
         (dict(window_size=201), ValueError, "window_size"),
-        (dict(window_size=9, method="mass"), ValueError, "method"),
-        (dict(window_size=9, lags=(1,)), ValueError, "lags"),
-        (dict(window_size=9, lags=(1, 9)), ValueError, "lags"),
+        (dict(window_size=9, method="dbc"), ValueError, "method"),
+        (dict(window_size=9, box_sizes=[3, 4]), ValueError, "box_sizes"),
+        (dict(window_size=9, box_sizes=[3, 11]), ValueError, "box_sizes"),
+        (dict(window_size=9, z_scale=0), ValueError, "z_scale"),
+        (dict(window_size=9, method="variogram", lags=(1,)), ValueError, "lags"),
+        (dict(window_size=9, method="variogram", lags=(1, 9)), ValueError, "lags"),
         (dict(window_size=9, min_valid=2), ValueError, "min_valid"),
         (dict(window_size=9, n_threads=0), ValueError, "n_threads"),
     ],
@@ -172,3 +175,59 @@ def test_dask_distributed_two_worker_processes():
         out = fg.fractal_transform(da.from_array(z, chunks=(40, 64)), 9, n_threads=1)
         got = client.compute(out).result()
     assert np.allclose(got, ref, atol=1e-6, equal_nan=True)
+
+
+def mass_reference(z, w, sizes, z_scale, min_valid=0.5):
+    """P(m, L) map from its definition: m_p(L) counts the image's valid pixels
+    in the box of side L around p (heights in z_scale units); each window
+    averages 1 / m_p over its valid pixels; D = -slope of log N vs log L."""
+    rows, cols = z.shape
+    ok = ~np.isnan(z)
+    inv = []
+    for L in sizes:
+        k = L // 2
+        m = np.zeros(z.shape)
+        for i in range(rows):
+            for j in range(cols):
+                if not ok[i, j]:
+                    continue
+                blk = z[max(0, i - k): i + k + 1, max(0, j - k): j + k + 1]
+                m[i, j] = np.count_nonzero(np.abs(blk - z[i, j]) <= (k + 0.5) * z_scale)
+        inv.append(np.where(ok, 1.0 / np.where(m > 0, m, 1), 0.0))
+    h = w // 2
+    out = np.full(z.shape, np.nan)
+    x = np.log(sizes)
+    for i in range(rows):
+        for j in range(cols):
+            sl = (slice(max(0, i - h), i + h + 1), slice(max(0, j - h), j + h + 1))
+            n = np.count_nonzero(ok[sl])
+            if n < min_valid * w * w:
+                continue
+            y = np.log([a[sl].sum() / n for a in inv])
+            out[i, j] = -np.polyfit(x, y, 1)[0]
+    return out
+
+
+def test_mass_map_equals_definition_with_holes():
+    rng = np.random.default_rng(7)
+    vv, _ = fg.data.sentinel1_vv_db()
+    z = vv[300:336, 50:81].astype(np.float64)
+    z[rng.random(z.shape) < 0.07] = np.nan
+    z[2:6, 20:27] = np.nan
+    for sizes, zs in [((3, 5, 7), 1.0), ((3, 5), 2.5)]:
+        d = fg.fractal_transform(z, 9, method="mass", box_sizes=sizes, z_scale=zs)
+        ref = mass_reference(z, 9, sizes, zs)
+        assert np.array_equal(np.isnan(d), np.isnan(ref))
+        assert np.allclose(d[~np.isnan(ref)], ref[~np.isnan(ref)], atol=1e-5)
+
+
+def test_mass_map_flat_is_two_and_dask_matches():
+    da = pytest.importorskip("dask.array")
+    d = fg.fractal_transform(np.full((60, 60), 4.0), 15, method="mass")
+    assert np.allclose(d[12:-12, 12:-12], 2.0, atol=1e-5)
+    vv, _ = fg.data.sentinel1_vv_db()
+    z = vv[:150, :130]
+    ref = fg.fractal_transform(z, 17)
+    for chunks in [(50, 65), (7, 130), (150, 30)]:
+        out = fg.fractal_transform(da.from_array(z, chunks=chunks), 17).compute()
+        assert np.allclose(out, ref, atol=1e-6, equal_nan=True), chunks

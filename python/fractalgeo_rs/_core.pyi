@@ -23,6 +23,7 @@ __all__ = [
     "ifs_preset",
     "ifs_rasterize",
     "lsystem_parse_text",
+    "mass_transform_map",
     "midpoint_refine_1d",
     "midpoint_refine_2d",
     "moran_dimension",
@@ -211,6 +212,14 @@ def variation_transform_map(
     lags: Sequence[int],
     p: float,
     square: bool,
+    min_valid: float,
+    n_threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
+def mass_transform_map(
+    image: npt.NDArray[np.float64],
+    window_size: int,
+    box_sizes: Sequence[int],
+    z_scale: float,
     min_valid: float,
     n_threads: Optional[int] = None,
 ) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...

@@ -1,5 +1,6 @@
 //! Bindings of `crate::transform`.
 use crate::parallel::run_in_pool;
+use crate::transform::mass::{mass_transform, MassOptions};
 use crate::transform::variation::{variation_transform, Increments, VariationOptions};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
@@ -38,7 +39,32 @@ fn variation_transform_map<'py>(
     ))
 }
 
+/// Moving-window P(m, L) mass dimension. Returns (dimension, r_squared) float32 maps.
+#[pyfunction]
+#[pyo3(signature = (image, window_size, box_sizes, z_scale, min_valid, n_threads=None))]
+#[allow(clippy::type_complexity)]
+fn mass_transform_map<'py>(
+    py: Python<'py>,
+    image: PyReadonlyArray2<'py, f64>,
+    window_size: usize,
+    box_sizes: Vec<usize>,
+    z_scale: f64,
+    min_valid: f64,
+    n_threads: Option<usize>,
+) -> PyResult<(Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>)> {
+    let (rows, cols) = (image.shape()[0], image.shape()[1]);
+    let z = image.as_slice().map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
+    let opt = MassOptions { window: window_size, box_sizes, z_scale, min_valid };
+    let (d, r2) = py.detach(|| run_in_pool(n_threads, || mass_transform(z, rows, cols, &opt)))?;
+    let bad = |_| PyValueError::new_err("internal: map size");
+    Ok((
+        Array2::from_shape_vec((rows, cols), d).map_err(bad)?.into_pyarray(py),
+        Array2::from_shape_vec((rows, cols), r2).map_err(bad)?.into_pyarray(py),
+    ))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(variation_transform_map, m)?)?;
+    m.add_function(wrap_pyfunction!(mass_transform_map, m)?)?;
     Ok(())
 }

@@ -4,5 +4,7 @@
 //! * [`variation`]: increment estimators (variogram, madogram, square
 //!   increments) with summed-area tables, so the cost per pixel does not grow
 //!   with the window.
+//! * [`mass`]: Voss's P(m, L) mass dimension, boxes counted over the image.
 
+pub mod mass;
 pub mod variation;

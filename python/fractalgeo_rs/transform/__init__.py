@@ -1,10 +1,10 @@
 """Fractal transform: maps of local fractal dimension (paper section 4.2,
 figure 10).
 
-This release has the increment estimators (variogram, madogram, square
-increments) computed with summed-area tables in Rust, so the time per pixel
-does not grow with the window; the P(m, L) mass, DBC and blanket maps of the
-roadmap come next.
+This release has Voss's P(m, L) mass dimension (the paper's method, the
+default) and the increment estimators (variogram, madogram, square
+increments), computed with summed-area tables in Rust so that the time per
+pixel does not grow with the window; DBC and blanket maps come next.
 """
 from __future__ import annotations
 
@@ -20,7 +20,8 @@ from fractalgeo_rs.transform.segment import segment
 __all__ = ["fractal_transform", "segment", "TRANSFORM_METHODS"]
 
 TRANSFORM_METHODS = {
-    # name: (power p, square increments)
+    # name: (power p, square increments); "mass" has its own kernel
+    "mass": (None, None),
     "variogram": (2.0, False),
     "madogram": (1.0, False),
     "square": (2.0, True),
@@ -36,8 +37,11 @@ def _check_window(window_size, shape) -> int:
     return w
 
 
-def _transform_numpy(z: np.ndarray, w: int, lags, p, square, min_valid, n_threads):
+def _transform_numpy(z: np.ndarray, w: int, lags, p, square, min_valid, n_threads, mass=None):
     z = np.ascontiguousarray(z, dtype=np.float64)
+    if mass is not None:
+        sizes, z_scale = mass
+        return _core.mass_transform_map(z, w, list(sizes), z_scale, min_valid, n_threads)
     return _core.variation_transform_map(z, w, list(lags), p, square, min_valid, n_threads)
 
 
@@ -45,8 +49,10 @@ def fractal_transform(
     image,
     window_size: int,
     *,
-    method: str = "variogram",
+    method: str = "mass",
     lags: Sequence[int] = (1, 2),
+    box_sizes: Optional[Sequence[int]] = None,
+    z_scale: float = 1.0,
     nodata: Optional[float] = None,
     min_valid: float = 0.5,
     band: Optional[int] = None,
@@ -56,16 +62,28 @@ def fractal_transform(
     """Map of local fractal dimension over a moving window.
 
     Each output pixel is the dimension of the ``window_size`` x
-    ``window_size`` window centred on it, estimated exactly as
-    :func:`fractalgeo_rs.surface_variation` would on that window:
+    ``window_size`` window centred on it:
 
+    ``"mass"`` (default)
+        Voss's P(m, L) dimension of the point set ``(i, j, z / z_scale)``
+        (the paper's eq. 13 and its SAR transform): for box sides ``L`` in
+        ``box_sizes``, ``m_p(L)`` counts the valid pixels ``q`` of the image
+        with ``|i_q - i_p|, |j_q - j_p| <= (L - 1) / 2`` and
+        ``|z_q - z_p| <= L z_scale / 2``; the window's value is
+        ``N(L) = mean over its valid pixels of 1 / m_p(L)`` and
+        ``D = -slope`` of ``log N`` against ``log L``. Boxes count every pixel
+        of the image, not only the window's, so a point's mass does not
+        depend on where the window sits (and the cost does not grow with the
+        window). Heights are in ``z_scale`` units per pixel: the estimate
+        depends on this unit (see docs/transform.md).
     ``"variogram"`` / ``"madogram"``
         first differences along rows and columns, pooled, power 2 / 1;
     ``"square"``
         square increments ``z(i+u, j+u) - z(i+u, j) - z(i, j+u) + z(i, j)``,
         power 2 (accurate for smooth surfaces, H >= 0.7);
 
-    and ``D = 3 - slope / p`` over ``lags``.
+    and ``D = 3 - slope / p`` over ``lags``, exactly as
+    :func:`fractalgeo_rs.surface_variation` on the window.
 
     Parameters
     ----------
@@ -74,9 +92,14 @@ def fractal_transform(
         ``nodata`` are missing samples.
     window_size : int
         Odd window side in pixels (>= 3, at most the image side).
-    method : {"variogram", "madogram", "square"}
+    method : {"mass", "variogram", "madogram", "square"}
     lags : sequence of int, default (1, 2)
-        Dilations in pixels, each smaller than the window.
+        Increment methods: dilations in pixels, each smaller than the window.
+    box_sizes : sequence of int, optional
+        ``"mass"``: odd box sides, default ``3, 5, 7, 9`` (those not larger
+        than the window).
+    z_scale : float, default 1
+        ``"mass"``: height units per pixel (e.g. 1 grey level or 1 dB).
     min_valid : float, default 0.5
         Output NaN where fewer than this fraction of the window's pixels are
         valid.
@@ -98,12 +121,17 @@ def fractal_transform(
     inside the image (the image is taken as padded with NaN), so the map has
     the input's shape and every value is the estimator on the clipped window.
     On Dask the map is computed chunk by chunk with ``map_overlap`` and a
-    NaN-filled halo of ``window_size // 2``, which is the same edge policy,
+    NaN-filled halo of ``window_size // 2`` (plus ``(max(box_sizes) - 1) / 2``
+    for ``"mass"``), which is the same edge policy,
     so results agree with the in-memory call (to 1e-6: window sums come from
     summed-area tables built per block).
     """
     check_choice(method, "method", tuple(TRANSFORM_METHODS))
     p, square = TRANSFORM_METHODS[method]
+    if method == "mass":
+        if isinstance(z_scale, bool) or not np.isscalar(z_scale) or not (np.isfinite(z_scale) and z_scale > 0):
+            raise ValueError(f"z_scale: expected a positive number, got {z_scale!r}")
+        z_scale = float(z_scale)
     n_threads = check_n_threads(n_threads)
     if isinstance(min_valid, bool) or not np.isscalar(min_valid) or not (0.0 <= float(min_valid) <= 1.0):
         raise ValueError(f"min_valid: expected a fraction in [0, 1], got {min_valid!r}")
@@ -139,20 +167,33 @@ def fractal_transform(
     if 0 in arr.shape:
         raise ValueError(f"image: array is empty (shape {arr.shape})")
     w = _check_window(window_size, arr.shape)
-    if len(lags) < 2 or lags[0] < 1 or lags[-1] >= w:
+    if method == "mass":
+        if box_sizes is None:
+            sizes = [L for L in (3, 5, 7, 9) if L <= w]
+        else:
+            try:
+                sizes = sorted(set(int(v) for v in box_sizes))
+            except (TypeError, ValueError):
+                raise TypeError(f"box_sizes: expected a sequence of odd ints, got {box_sizes!r}") from None
+        if len(sizes) < 2 or any(L < 3 or L % 2 == 0 or L > w for L in sizes):
+            raise ValueError(f"box_sizes: need at least 2 distinct odd sides in [3, {w}], got {sizes}")
+    elif len(lags) < 2 or lags[0] < 1 or lags[-1] >= w:
         raise ValueError(f"lags: need at least 2 distinct lags in [1, {w}), got {lags}")
 
     def kernel(block):
         z = np.asarray(block, dtype=np.float64)
         if nodata is not None:
             z = np.where(z == nodata, np.nan, z)
-        d, r2 = _transform_numpy(z, w, lags, p, square, min_valid, n_threads)
+        d, r2 = _transform_numpy(z, w, lags, p, square, min_valid, n_threads,
+                                 mass=(sizes, z_scale) if method == "mass" else None)
         return np.stack([d, r2]) if return_fit else d
 
     if is_dask:
         import dask.array as da
 
-        half = w // 2
+        # a window needs its half-width; the mass method's boxes reach
+        # (L_max - 1) / 2 further
+        half = w // 2 + (max(sizes) // 2 if method == "mass" else 0)
         chunks = arr.chunks
         if min(min(c) for c in chunks) < half:
             # every chunk must hold the halo its neighbours need
