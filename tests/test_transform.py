@@ -231,3 +231,25 @@ def test_mass_map_flat_is_two_and_dask_matches():
     for chunks in [(50, 65), (7, 130), (150, 30)]:
         out = fg.fractal_transform(da.from_array(z, chunks=chunks), 17).compute()
         assert np.allclose(out, ref, atol=1e-6, equal_nan=True), chunks
+
+
+def test_lacunarity_map_equals_per_window_lacunarity():
+    rng = np.random.default_rng(11)
+    z = rng.gamma(2.0, 1.0, size=(31, 27))
+    z[rng.random(z.shape) < 0.05] = np.nan
+    w, sizes = 9, [1, 2, 3, 5]
+    lmap = fg.lacunarity_map(z, w, sizes, min_valid=0.3)
+    zp = np.pad(z, w // 2, constant_values=np.nan)
+    win = np.lib.stride_tricks.sliding_window_view(zp, (w, w))
+    for i in range(z.shape[0]):
+        for j in range(z.shape[1]):
+            a = win[i, j]
+            if np.count_nonzero(~np.isnan(a)) < 0.3 * w * w:
+                assert np.isnan(lmap[:, i, j]).all()
+                continue
+            ref = fg.lacunarity(a, sizes).lacunarity
+            assert np.allclose(lmap[:, i, j], ref, rtol=1e-6, equal_nan=True), (i, j)
+    with pytest.raises(ValueError, match="image"):
+        fg.lacunarity_map(z - 5, 9)
+    with pytest.raises(ValueError, match="box_sizes"):
+        fg.lacunarity_map(z, 9, [10])

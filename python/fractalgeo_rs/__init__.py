@@ -35,7 +35,7 @@ from fractalgeo_rs.dimension import (
 
 # -- domain exports: each issue adds its own line below --
 from fractalgeo_rs.lsystem import IFS, LString, LSystem
-from fractalgeo_rs.transform import fractal_transform, segment
+from fractalgeo_rs.transform import fractal_transform, lacunarity_map, segment
 from fractalgeo_rs.synth import fbm, fbm_surface, validate_surface, SurfaceReport, synthetic_dem  # noqa: E402
 from fractalgeo_rs.dem import hillshade, lakes  # noqa: E402
 from fractalgeo_rs.io import read_raster, write_raster  # noqa: E402
@@ -67,6 +67,7 @@ __all__ = [
     "LString",
     "LSystem",
     "fractal_transform",
+    "lacunarity_map",
     "segment",
     # synth / dem / io
     "fbm",

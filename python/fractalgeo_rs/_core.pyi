@@ -22,6 +22,7 @@ __all__ = [
     "ifs_iterate",
     "ifs_preset",
     "ifs_rasterize",
+    "lacunarity_transform_map",
     "lsystem_parse_text",
     "mass_transform_map",
     "midpoint_refine_1d",
@@ -223,3 +224,10 @@ def mass_transform_map(
     min_valid: float,
     n_threads: Optional[int] = None,
 ) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
+def lacunarity_transform_map(
+    image: npt.NDArray[np.float64],
+    window_size: int,
+    box_sizes: Sequence[int],
+    min_valid: float,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float32]: ...

@@ -1,6 +1,9 @@
 //! Bindings of `crate::transform`.
 use crate::parallel::run_in_pool;
+use crate::transform::lacunarity::lacunarity_transform;
 use crate::transform::mass::{mass_transform, MassOptions};
+use numpy::ndarray::Array3;
+use numpy::PyArray3;
 use crate::transform::variation::{variation_transform, Increments, VariationOptions};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
@@ -63,7 +66,28 @@ fn mass_transform_map<'py>(
     ))
 }
 
+/// Moving-window gliding-box lacunarity, shape (n_sizes, rows, cols) float32.
+#[pyfunction]
+#[pyo3(signature = (image, window_size, box_sizes, min_valid, n_threads=None))]
+fn lacunarity_transform_map<'py>(
+    py: Python<'py>,
+    image: PyReadonlyArray2<'py, f64>,
+    window_size: usize,
+    box_sizes: Vec<usize>,
+    min_valid: f64,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray3<f32>>> {
+    let (rows, cols) = (image.shape()[0], image.shape()[1]);
+    let z = image.as_slice().map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
+    let n = box_sizes.len();
+    let l = py.detach(|| run_in_pool(n_threads, || lacunarity_transform(z, rows, cols, window_size, &box_sizes, min_valid)))?;
+    Ok(Array3::from_shape_vec((n, rows, cols), l)
+        .map_err(|_| PyValueError::new_err("internal: map size"))?
+        .into_pyarray(py))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(lacunarity_transform_map, m)?)?;
     m.add_function(wrap_pyfunction!(variation_transform_map, m)?)?;
     m.add_function(wrap_pyfunction!(mass_transform_map, m)?)?;
     Ok(())

@@ -4,7 +4,9 @@
 //! * [`variation`]: increment estimators (variogram, madogram, square
 //!   increments) with summed-area tables, so the cost per pixel does not grow
 //!   with the window.
+//! * [`lacunarity`]: gliding-box lacunarity per window.
 //! * [`mass`]: Voss's P(m, L) mass dimension, boxes counted over the image.
 
+pub mod lacunarity;
 pub mod mass;
 pub mod variation;
