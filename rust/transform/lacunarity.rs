@@ -7,25 +7,10 @@
 //! validity are summed over windows with summed-area tables per band, so the
 //! cost per pixel does not grow with the window.
 use crate::error::{CoreError, CoreResult};
+use super::sat::{band_rows, check_window, rect, sat};
 use rayon::prelude::*;
 
-fn sat(values: &[f64], rows: usize, cols: usize) -> Vec<f64> {
-    let w = cols + 1;
-    let mut s = vec![0.0f64; (rows + 1) * w];
-    for r in 0..rows {
-        let mut run = 0.0;
-        for c in 0..cols {
-            run += values[r * cols + c];
-            s[(r + 1) * w + c + 1] = s[r * w + c + 1] + run;
-        }
-    }
-    s
-}
 
-#[inline]
-fn rect(s: &[f64], w: usize, r0: usize, r1: usize, c0: usize, c1: usize) -> f64 {
-    s[r1 * w + c1] - s[r0 * w + c1] - s[r1 * w + c0] + s[r0 * w + c0]
-}
 
 /// Lacunarity maps, layout `[size][row][col]` (NaN where the window holds no
 /// complete valid box or fewer valid pixels than `min_valid * w * w`).
@@ -38,21 +23,12 @@ pub fn lacunarity_transform(
     min_valid: f64,
 ) -> CoreResult<Vec<f32>> {
     let w = window;
-    if rows * cols == 0 || z.len() != rows * cols {
-        return Err(CoreError::invalid("image", "image is empty"));
-    }
-    if w < 3 || w % 2 == 0 || w > rows.max(cols) {
-        return Err(CoreError::invalid("window_size", format!("expected an odd integer in [3, {}], got {w}", rows.max(cols))));
-    }
+    let min_pixels = check_window(z.len(), rows, cols, w, min_valid)?;
     if box_sizes.is_empty() || box_sizes.iter().any(|&r| r == 0 || r > w) {
         return Err(CoreError::invalid("box_sizes", format!("box sides must be in [1, {w}], got {box_sizes:?}")));
     }
-    if !(0.0..=1.0).contains(&min_valid) {
-        return Err(CoreError::invalid("min_valid", format!("expected a fraction in [0, 1], got {min_valid}")));
-    }
     let h = w / 2;
-    let band_rows = 64usize.max(4 * w);
-    let min_pixels = (min_valid * (w * w) as f64).ceil().max(1.0);
+    let band_rows = band_rows(w);
     let plane = rows * cols;
     let mut out = vec![f32::NAN; box_sizes.len() * plane];
     // bands of output rows; each band writes its rows of every size plane

@@ -16,6 +16,7 @@
 //! window sums come from summed-area tables: the cost per pixel is the box
 //! neighbourhood (`L_max^2`), independent of the window.
 use crate::error::{CoreError, CoreResult};
+use super::sat::{band_rows, check_window, rect, sat};
 use rayon::prelude::*;
 
 /// Options of [`mass_transform`].
@@ -27,8 +28,6 @@ pub struct MassOptions {
     pub z_scale: f64,
     pub min_valid: f64,
 }
-
-const BAND: usize = 64;
 
 /// `m_p(L)` for every pixel of rows `[r0, r1)` and every box size; invalid
 /// pixels get 0. Layout: `[size][row - r0][col]`.
@@ -84,37 +83,13 @@ pub fn box_masses(z: &[f64], rows: usize, cols: usize, r0: usize, r1: usize, ks:
     out
 }
 
-fn sat(values: &[f64], rows: usize, cols: usize) -> Vec<f64> {
-    let w = cols + 1;
-    let mut s = vec![0.0f64; (rows + 1) * w];
-    for r in 0..rows {
-        let mut run = 0.0;
-        for c in 0..cols {
-            run += values[r * cols + c];
-            s[(r + 1) * w + c + 1] = s[r * w + c + 1] + run;
-        }
-    }
-    s
-}
 
-#[inline]
-fn rect(s: &[f64], w: usize, r0: usize, r1: usize, c0: usize, c1: usize) -> f64 {
-    s[r1 * w + c1] - s[r0 * w + c1] - s[r1 * w + c0] + s[r0 * w + c0]
-}
 
 /// Local P(m, L) dimension and r² maps (row-major; NaN where the window has
 /// fewer valid pixels than `min_valid * w * w`).
 pub fn mass_transform(z: &[f64], rows: usize, cols: usize, opt: &MassOptions) -> CoreResult<(Vec<f32>, Vec<f32>)> {
     let w = opt.window;
-    if rows * cols == 0 || z.len() != rows * cols {
-        return Err(CoreError::invalid("image", "image is empty"));
-    }
-    if w < 3 || w % 2 == 0 {
-        return Err(CoreError::invalid("window_size", format!("expected an odd integer >= 3, got {w}")));
-    }
-    if w > rows.max(cols) {
-        return Err(CoreError::invalid("window_size", format!("window {w} is larger than the image ({rows} x {cols})")));
-    }
+    let min_pixels = check_window(z.len(), rows, cols, w, opt.min_valid)?;
     let mut sizes = opt.box_sizes.clone();
     sizes.sort_unstable();
     sizes.dedup();
@@ -127,16 +102,12 @@ pub fn mass_transform(z: &[f64], rows: usize, cols: usize, opt: &MassOptions) ->
     if !(opt.z_scale.is_finite() && opt.z_scale > 0.0) {
         return Err(CoreError::invalid("z_scale", format!("expected a positive number, got {}", opt.z_scale)));
     }
-    if !(0.0..=1.0).contains(&opt.min_valid) {
-        return Err(CoreError::invalid("min_valid", format!("expected a fraction in [0, 1], got {}", opt.min_valid)));
-    }
     let ks: Vec<usize> = sizes.iter().map(|l| l / 2).collect();
     let xs: Vec<f64> = sizes.iter().map(|&l| (l as f64).ln()).collect();
     let xm = xs.iter().sum::<f64>() / xs.len() as f64;
     let sxx: f64 = xs.iter().map(|x| (x - xm) * (x - xm)).sum();
     let h = w / 2;
-    let min_pixels = (opt.min_valid * (w * w) as f64).ceil().max(1.0);
-    let band_rows = BAND.max(4 * w);
+    let band_rows = band_rows(w);
     let mut dim = vec![f32::NAN; rows * cols];
     let mut r2 = vec![f32::NAN; rows * cols];
     dim.par_chunks_mut(band_rows * cols).zip(r2.par_chunks_mut(band_rows * cols)).enumerate().for_each(

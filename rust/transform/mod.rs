@@ -9,4 +9,5 @@
 
 pub mod lacunarity;
 pub mod mass;
+mod sat;
 pub mod variation;

@@ -15,6 +15,7 @@
 //! so the cost per pixel is independent of `w` and the result does not
 //! depend on the thread count.
 use crate::error::{CoreError, CoreResult};
+use super::sat::{band_rows, check_window, rect, sat};
 use rayon::prelude::*;
 
 /// Which increments.
@@ -23,9 +24,6 @@ pub enum Increments {
     First,
     Square,
 }
-
-/// Fewest output rows per band.
-const BAND: usize = 64;
 
 /// Options of [`variation_transform`].
 #[derive(Debug, Clone)]
@@ -38,42 +36,13 @@ pub struct VariationOptions {
     pub min_valid: f64,
 }
 
-/// Summed-area table (rows+1) x (cols+1) of f64 values.
-fn sat(values: &[f64], rows: usize, cols: usize) -> Vec<f64> {
-    let w = cols + 1;
-    let mut s = vec![0.0f64; (rows + 1) * w];
-    for r in 0..rows {
-        let mut run = 0.0;
-        for c in 0..cols {
-            run += values[r * cols + c];
-            s[(r + 1) * w + c + 1] = s[r * w + c + 1] + run;
-        }
-    }
-    s
-}
 
-/// Sum over rows [r0, r1) x cols [c0, c1) from a summed-area table.
-#[inline]
-fn rect(s: &[f64], w: usize, r0: usize, r1: usize, c0: usize, c1: usize) -> f64 {
-    if r1 <= r0 || c1 <= c0 {
-        return 0.0;
-    }
-    s[r1 * w + c1] - s[r0 * w + c1] - s[r1 * w + c0] + s[r0 * w + c0]
-}
 
 /// Local dimension and r² maps (row-major, `rows x cols`, NaN where the
 /// window has too few valid pixels or a lag has no valid increment).
 pub fn variation_transform(z: &[f64], rows: usize, cols: usize, opt: &VariationOptions) -> CoreResult<(Vec<f32>, Vec<f32>)> {
     let w = opt.window;
-    if rows * cols == 0 || z.len() != rows * cols {
-        return Err(CoreError::invalid("image", "image is empty"));
-    }
-    if w < 3 || w % 2 == 0 {
-        return Err(CoreError::invalid("window_size", format!("expected an odd integer >= 3, got {w}")));
-    }
-    if w > rows.max(cols) {
-        return Err(CoreError::invalid("window_size", format!("window {w} is larger than the image ({rows} x {cols})")));
-    }
+    let min_pixels = check_window(z.len(), rows, cols, w, opt.min_valid)?;
     let mut lags = opt.lags.clone();
     lags.sort_unstable();
     lags.dedup();
@@ -83,17 +52,11 @@ pub fn variation_transform(z: &[f64], rows: usize, cols: usize, opt: &VariationO
     if !(opt.p.is_finite() && opt.p > 0.0) {
         return Err(CoreError::invalid("p", format!("expected a positive number, got {}", opt.p)));
     }
-    if !(0.0..=1.0).contains(&opt.min_valid) {
-        return Err(CoreError::invalid("min_valid", format!("expected a fraction in [0, 1], got {}", opt.min_valid)));
-    }
     let h = w / 2;
     let xs: Vec<f64> = lags.iter().map(|&u| (u as f64).ln()).collect();
     let xm = xs.iter().sum::<f64>() / xs.len() as f64;
     let sxx: f64 = xs.iter().map(|x| (x - xm) * (x - xm)).sum();
-    let min_pixels = (opt.min_valid * (w * w) as f64).ceil().max(1.0);
-    // rows per band: a fixed function of the window (never of the thread
-    // count), large enough that the halo of w - 1 rows is a small overhead
-    let band_rows = BAND.max(4 * w);
+    let band_rows = band_rows(w);
     let n_bands = rows.div_ceil(band_rows);
     let p = opt.p;
     let power = move |d: f64| -> f64 {

@@ -1,0 +1,51 @@
+//! Summed-area tables and the argument checks shared by the moving-window
+//! kernels.
+use crate::error::{CoreError, CoreResult};
+
+/// Summed-area table `(rows + 1) x (cols + 1)` of row-major `values`.
+pub(crate) fn sat(values: &[f64], rows: usize, cols: usize) -> Vec<f64> {
+    let w = cols + 1;
+    let mut s = vec![0.0f64; (rows + 1) * w];
+    for r in 0..rows {
+        let mut run = 0.0;
+        for c in 0..cols {
+            run += values[r * cols + c];
+            s[(r + 1) * w + c + 1] = s[r * w + c + 1] + run;
+        }
+    }
+    s
+}
+
+/// Sum over rows `[r0, r1)` x cols `[c0, c1)` of a table of row width `w`
+/// (`cols + 1`); empty ranges sum to 0.
+#[inline]
+pub(crate) fn rect(s: &[f64], w: usize, r0: usize, r1: usize, c0: usize, c1: usize) -> f64 {
+    if r1 <= r0 || c1 <= c0 {
+        return 0.0;
+    }
+    s[r1 * w + c1] - s[r0 * w + c1] - s[r1 * w + c0] + s[r0 * w + c0]
+}
+
+/// Check the image buffer, the window (odd, >= 3, not larger than the image)
+/// and `min_valid` (a fraction); returns the fewest valid pixels a window needs.
+pub(crate) fn check_window(z_len: usize, rows: usize, cols: usize, w: usize, min_valid: f64) -> CoreResult<f64> {
+    if rows * cols == 0 || z_len != rows * cols {
+        return Err(CoreError::invalid("image", "image is empty"));
+    }
+    if w < 3 || w % 2 == 0 {
+        return Err(CoreError::invalid("window_size", format!("expected an odd integer >= 3, got {w}")));
+    }
+    if w > rows.max(cols) {
+        return Err(CoreError::invalid("window_size", format!("window {w} is larger than the image ({rows} x {cols})")));
+    }
+    if !(0.0..=1.0).contains(&min_valid) {
+        return Err(CoreError::invalid("min_valid", format!("expected a fraction in [0, 1], got {min_valid}")));
+    }
+    Ok((min_valid * (w * w) as f64).ceil().max(1.0))
+}
+
+/// Output rows per band: a function of the window only (never of the thread
+/// count), at least 64 and four windows, so the halo is a small overhead.
+pub(crate) fn band_rows(w: usize) -> usize {
+    64usize.max(4 * w)
+}
