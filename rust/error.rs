@@ -22,6 +22,9 @@ pub type CoreResult<T> = Result<T, CoreError>;
 impl CoreError {
     /// Build an [`CoreError::InvalidArgument`] naming the parameter.
     pub fn invalid(param: &str, message: impl Into<String>) -> Self {
-        CoreError::InvalidArgument { param: param.to_string(), message: message.into() }
+        CoreError::InvalidArgument {
+            param: param.to_string(),
+            message: message.into(),
+        }
     }
 }

@@ -10,7 +10,9 @@ use crate::error::{CoreError, CoreResult};
 pub fn resolve_threads(n_threads: Option<usize>) -> usize {
     match n_threads {
         Some(n) if n > 0 => n,
-        _ => std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
+        _ => std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1),
     }
 }
 
@@ -49,7 +51,10 @@ mod tests {
 
     #[test]
     fn pool_runs_and_catches_panics() {
-        assert_eq!(run_in_pool(Some(2), || Ok(rayon::current_num_threads())).unwrap(), 2);
+        assert_eq!(
+            run_in_pool(Some(2), || Ok(rayon::current_num_threads())).unwrap(),
+            2
+        );
         let r: CoreResult<()> = run_in_pool(Some(1), || panic!("boom"));
         assert_eq!(r, Err(CoreError::Internal("boom".into())));
     }

@@ -2,12 +2,15 @@
 use crate::dimension::{affine, boxcount, dbc, points};
 use crate::parallel::run_in_pool;
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyReadonlyArrayDyn, PyUntypedArrayMethods,
+};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
 fn contiguous<'a, T: numpy::Element>(a: &'a PyReadonlyArrayDyn<'_, T>) -> PyResult<&'a [T]> {
-    a.as_slice().map_err(|_| PyValueError::new_err("data: internal: array must be C-contiguous"))
+    a.as_slice()
+        .map_err(|_| PyValueError::new_err("data: internal: array must be C-contiguous"))
 }
 
 fn counts_array<T: Copy>(counts: &[Vec<T>]) -> Array2<T> {
@@ -28,11 +31,21 @@ fn box_count_binary<'py>(
     offsets: usize,
     anchor_bbox: bool,
     n_threads: Option<usize>,
-) -> PyResult<(Bound<'py, PyArray1<u64>>, Bound<'py, PyArray2<u64>>, u64, Vec<usize>, Vec<usize>)> {
+) -> PyResult<(
+    Bound<'py, PyArray1<u64>>,
+    Bound<'py, PyArray2<u64>>,
+    u64,
+    Vec<usize>,
+    Vec<usize>,
+)> {
     let dims = data.shape().to_vec();
     let slice = contiguous(&data)?;
     let ndim = dims.len();
-    let anchor = if anchor_bbox { boxcount::Anchor::BoundingBox } else { boxcount::Anchor::Array };
+    let anchor = if anchor_bbox {
+        boxcount::Anchor::BoundingBox
+    } else {
+        boxcount::Anchor::Array
+    };
     let r = py.detach(|| {
         run_in_pool(n_threads, || {
             let vol = boxcount::ByteVolume::new(slice, &dims)?;
@@ -42,7 +55,13 @@ fn box_count_binary<'py>(
     let sizes: Vec<u64> = r.box_sizes.iter().map(|&s| s as u64).collect();
     let lo = r.bbox_min[3 - ndim..].to_vec();
     let hi = r.bbox_max[3 - ndim..].to_vec();
-    Ok((sizes.into_pyarray(py), counts_array(&r.counts).into_pyarray(py), r.n_foreground, lo, hi))
+    Ok((
+        sizes.into_pyarray(py),
+        counts_array(&r.counts).into_pyarray(py),
+        r.n_foreground,
+        lo,
+        hi,
+    ))
 }
 
 /// Box counts of an (N, d) point set. Returns (box_sizes, counts[n_sizes, n_lattices]).
@@ -56,9 +75,18 @@ fn box_count_points<'py>(
     n_threads: Option<usize>,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<u64>>)> {
     let (n, d) = (points.shape()[0], points.shape()[1]);
-    let slice = points.as_slice().map_err(|_| PyValueError::new_err("points: internal: must be C-contiguous"))?;
-    let r = py.detach(|| run_in_pool(n_threads, || points::point_box_count(slice, n, d, &box_sizes, offsets)))?;
-    Ok((r.box_sizes.into_pyarray(py), counts_array(&r.counts).into_pyarray(py)))
+    let slice = points
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("points: internal: must be C-contiguous"))?;
+    let r = py.detach(|| {
+        run_in_pool(n_threads, || {
+            points::point_box_count(slice, n, d, &box_sizes, offsets)
+        })
+    })?;
+    Ok((
+        r.box_sizes.into_pyarray(py),
+        counts_array(&r.counts).into_pyarray(py),
+    ))
 }
 
 /// Differential box counts of a 2D float32 or float64 image (NaN = nodata).
@@ -76,17 +104,34 @@ fn dbc_count<'py>(
 ) -> PyResult<(Bound<'py, PyArray1<u64>>, Bound<'py, PyArray2<f64>>)> {
     let r = if let Ok(a) = data.extract::<PyReadonlyArray2<'py, f32>>() {
         let (rows, cols) = (a.shape()[0], a.shape()[1]);
-        let s = a.as_slice().map_err(|_| PyValueError::new_err("data: internal: must be C-contiguous"))?;
-        py.detach(|| run_in_pool(n_threads, || dbc::dbc_count(s, rows, cols, &box_sizes, offsets, z0, z_unit)))?
+        let s = a
+            .as_slice()
+            .map_err(|_| PyValueError::new_err("data: internal: must be C-contiguous"))?;
+        py.detach(|| {
+            run_in_pool(n_threads, || {
+                dbc::dbc_count(s, rows, cols, &box_sizes, offsets, z0, z_unit)
+            })
+        })?
     } else if let Ok(a) = data.extract::<PyReadonlyArray2<'py, f64>>() {
         let (rows, cols) = (a.shape()[0], a.shape()[1]);
-        let s = a.as_slice().map_err(|_| PyValueError::new_err("data: internal: must be C-contiguous"))?;
-        py.detach(|| run_in_pool(n_threads, || dbc::dbc_count(s, rows, cols, &box_sizes, offsets, z0, z_unit)))?
+        let s = a
+            .as_slice()
+            .map_err(|_| PyValueError::new_err("data: internal: must be C-contiguous"))?;
+        py.detach(|| {
+            run_in_pool(n_threads, || {
+                dbc::dbc_count(s, rows, cols, &box_sizes, offsets, z0, z_unit)
+            })
+        })?
     } else {
-        return Err(PyTypeError::new_err("data: expected a 2D float32 or float64 array"));
+        return Err(PyTypeError::new_err(
+            "data: expected a 2D float32 or float64 array",
+        ));
     };
     let sizes: Vec<u64> = r.box_sizes.iter().map(|&s| s as u64).collect();
-    Ok((sizes.into_pyarray(py), counts_array(&r.counts).into_pyarray(py)))
+    Ok((
+        sizes.into_pyarray(py),
+        counts_array(&r.counts).into_pyarray(py),
+    ))
 }
 
 /// Mean height range of complete columns (profile: shape (1, n)).
@@ -100,8 +145,14 @@ fn column_ranges<'py>(
     n_threads: Option<usize>,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<u64>>)> {
     let (rows, cols) = (data.shape()[0], data.shape()[1]);
-    let s = data.as_slice().map_err(|_| PyValueError::new_err("data: internal: must be C-contiguous"))?;
-    let (m, n) = py.detach(|| run_in_pool(n_threads, || affine::column_ranges(s, rows, cols, &box_sizes)))?;
+    let s = data
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("data: internal: must be C-contiguous"))?;
+    let (m, n) = py.detach(|| {
+        run_in_pool(n_threads, || {
+            affine::column_ranges(s, rows, cols, &box_sizes)
+        })
+    })?;
     Ok((m.into_pyarray(py), n.into_pyarray(py)))
 }
 

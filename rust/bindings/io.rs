@@ -14,9 +14,21 @@ fn read_image(py: Python<'_>, path: PathBuf) -> PyResult<Py<PyAny>> {
     let shape = (r.rows, r.cols, r.channels);
     let bad = |_| PyValueError::new_err("internal: pixel buffer does not match the image shape");
     Ok(match r.pixels {
-        Pixels::U8(v) => Array3::from_shape_vec(shape, v).map_err(bad)?.into_pyarray(py).into_any().unbind(),
-        Pixels::U16(v) => Array3::from_shape_vec(shape, v).map_err(bad)?.into_pyarray(py).into_any().unbind(),
-        Pixels::F32(v) => Array3::from_shape_vec(shape, v).map_err(bad)?.into_pyarray(py).into_any().unbind(),
+        Pixels::U8(v) => Array3::from_shape_vec(shape, v)
+            .map_err(bad)?
+            .into_pyarray(py)
+            .into_any()
+            .unbind(),
+        Pixels::U16(v) => Array3::from_shape_vec(shape, v)
+            .map_err(bad)?
+            .into_pyarray(py)
+            .into_any()
+            .unbind(),
+        Pixels::F32(v) => Array3::from_shape_vec(shape, v)
+            .map_err(bad)?
+            .into_pyarray(py)
+            .into_any()
+            .unbind(),
     })
 }
 
@@ -24,11 +36,21 @@ fn read_image(py: Python<'_>, path: PathBuf) -> PyResult<Py<PyAny>> {
 #[pyfunction]
 fn write_png(py: Python<'_>, path: PathBuf, image: &Bound<'_, PyAny>) -> PyResult<()> {
     let (pixels, rows, cols) = if let Ok(a) = image.extract::<PyReadonlyArray2<'_, u8>>() {
-        (Pixels::U8(a.as_array().iter().copied().collect()), a.shape()[0], a.shape()[1])
+        (
+            Pixels::U8(a.as_array().iter().copied().collect()),
+            a.shape()[0],
+            a.shape()[1],
+        )
     } else if let Ok(a) = image.extract::<PyReadonlyArray2<'_, u16>>() {
-        (Pixels::U16(a.as_array().iter().copied().collect()), a.shape()[0], a.shape()[1])
+        (
+            Pixels::U16(a.as_array().iter().copied().collect()),
+            a.shape()[0],
+            a.shape()[1],
+        )
     } else {
-        return Err(PyTypeError::new_err("image: expected a 2D uint8 or uint16 array"));
+        return Err(PyTypeError::new_err(
+            "image: expected a 2D uint8 or uint16 array",
+        ));
     };
     py.detach(|| image_io::write_png_gray(&path, &pixels, rows, cols))?;
     Ok(())

@@ -11,7 +11,9 @@ use crate::lsystem::{export, ifs};
 use crate::parallel::run_in_pool;
 use glam::DVec3;
 use numpy::ndarray::{Array1, Array2};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods,
+};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use std::path::PathBuf;
@@ -19,7 +21,18 @@ use std::sync::Arc;
 
 /// Turtle options as passed from Python:
 /// (angle, step, width, width_factor, tropism, elasticity, heading, left, draw, moves).
-type TurtleArgs = (f64, f64, f64, f64, [f64; 3], f64, [f64; 3], [f64; 3], String, String);
+type TurtleArgs = (
+    f64,
+    f64,
+    f64,
+    f64,
+    [f64; 3],
+    f64,
+    [f64; 3],
+    [f64; 3],
+    String,
+    String,
+);
 
 fn turtle_params(t: TurtleArgs) -> TurtleParams {
     TurtleParams {
@@ -67,14 +80,28 @@ pub struct ModuleString {
 impl LSystemCore {
     #[new]
     #[pyo3(signature = (axiom, rules, ignore, seed, max_length))]
-    fn new(axiom: &str, rules: Vec<String>, ignore: &str, seed: u64, max_length: usize) -> PyResult<Self> {
-        let l = run_in_pool(Some(1), || LSystem::new(axiom, &rules, ignore, seed, max_length))?;
+    fn new(
+        axiom: &str,
+        rules: Vec<String>,
+        ignore: &str,
+        seed: u64,
+        max_length: usize,
+    ) -> PyResult<Self> {
+        let l = run_in_pool(Some(1), || {
+            LSystem::new(axiom, &rules, ignore, seed, max_length)
+        })?;
         Ok(LSystemCore { inner: Arc::new(l) })
     }
 
     /// Derive `n` steps with `seed` (the system's seed when None).
     #[pyo3(signature = (n, seed=None, n_threads=None))]
-    fn derive(&self, py: Python<'_>, n: usize, seed: Option<u64>, n_threads: Option<usize>) -> PyResult<ModuleString> {
+    fn derive(
+        &self,
+        py: Python<'_>,
+        n: usize,
+        seed: Option<u64>,
+        n_threads: Option<usize>,
+    ) -> PyResult<ModuleString> {
         let l = self.inner.clone();
         let seed = seed.unwrap_or(l.seed);
         let s = py.detach(|| run_in_pool(n_threads, || l.derive_with_seed(n, seed)))?;
@@ -93,7 +120,9 @@ impl LSystemCore {
 
     #[getter]
     fn axiom(&self) -> ModuleString {
-        ModuleString { inner: Arc::new(self.inner.axiom.clone()) }
+        ModuleString {
+            inner: Arc::new(self.inner.axiom.clone()),
+        }
     }
 }
 
@@ -102,7 +131,9 @@ impl ModuleString {
     /// Parse a module string such as `"F(1)[+A(2,3)]"` (constant parameters).
     #[staticmethod]
     fn parse(text: &str) -> PyResult<Self> {
-        Ok(ModuleString { inner: Arc::new(run_in_pool(Some(1), || parse_module_string(text, "text"))?) })
+        Ok(ModuleString {
+            inner: Arc::new(run_in_pool(Some(1), || parse_module_string(text, "text"))?),
+        })
     }
     fn __len__(&self) -> usize {
         self.inner.len()
@@ -123,9 +154,16 @@ impl ModuleString {
     }
     /// (parameters (P,), offsets (N+1,)): parameters of module i are
     /// params[offsets[i]:offsets[i+1]].
-    fn parameters<'py>(&self, py: Python<'py>) -> (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<u64>>) {
+    fn parameters<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<u64>>) {
         let s = &self.inner;
-        let off: Vec<u64> = if s.pstart.is_empty() { vec![0; s.len() + 1] } else { s.pstart.iter().map(|&v| v as u64).collect() };
+        let off: Vec<u64> = if s.pstart.is_empty() {
+            vec![0; s.len() + 1]
+        } else {
+            s.pstart.iter().map(|&v| v as u64).collect()
+        };
         (s.params.clone().into_pyarray(py), off.into_pyarray(py))
     }
 }
@@ -133,7 +171,9 @@ impl ModuleString {
 /// Parse the rule text format: (axiom, ignore or None, rules, directives).
 #[pyfunction]
 #[allow(clippy::type_complexity)]
-fn lsystem_parse_text(text: &str) -> PyResult<(String, Option<String>, Vec<String>, Vec<(String, String)>)> {
+fn lsystem_parse_text(
+    text: &str,
+) -> PyResult<(String, Option<String>, Vec<String>, Vec<(String, String)>)> {
     let t = run_in_pool(Some(1), || parse_rule_text(text))?;
     Ok((t.axiom.unwrap_or_default(), t.ignore, t.rules, t.directives))
 }
@@ -145,13 +185,23 @@ fn turtle_polylines<'py>(
     py: Python<'py>,
     lstring: &ModuleString,
     turtle: TurtleArgs,
-) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u64>>)> {
+) -> PyResult<(
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<u64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<u64>>,
+)> {
     let s = lstring.inner.clone();
     let p = turtle_params(turtle);
     let r = py.detach(|| run_in_pool(Some(1), || polylines(&s, &p)))?;
     let off: Vec<u64> = r.offsets.iter().map(|&v| v as u64).collect();
     let (pp, po) = flat_polys(r.polygons);
-    Ok((rows(r.xy).into_pyarray(py), off.into_pyarray(py), pp.into_pyarray(py), po.into_pyarray(py)))
+    Ok((
+        rows(r.xy).into_pyarray(py),
+        off.into_pyarray(py),
+        pp.into_pyarray(py),
+        po.into_pyarray(py),
+    ))
 }
 
 /// 3D turtle: (starts (N,3), ends (N,3), widths (N,), colors (N,),
@@ -224,12 +274,21 @@ fn turtle_mesh<'py>(
     Ok(mesh_arrays(py, m))
 }
 
-fn to_rows<T: numpy::Element + Copy, const N: usize>(a: &PyReadonlyArray2<'_, T>, name: &str) -> PyResult<Vec<[T; N]>> {
+fn to_rows<T: numpy::Element + Copy, const N: usize>(
+    a: &PyReadonlyArray2<'_, T>,
+    name: &str,
+) -> PyResult<Vec<[T; N]>> {
     let v = a.as_array();
     if v.ncols() != N {
-        return Err(PyValueError::new_err(format!("{name}: expected shape (n, {N}), got {:?}", a.shape())));
+        return Err(PyValueError::new_err(format!(
+            "{name}: expected shape (n, {N}), got {:?}",
+            a.shape()
+        )));
     }
-    Ok(v.rows().into_iter().map(|r| std::array::from_fn(|k| r[k])).collect())
+    Ok(v.rows()
+        .into_iter()
+        .map(|r| std::array::from_fn(|k| r[k]))
+        .collect())
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -272,11 +331,17 @@ fn write_mesh(
     colors: PyReadonlyArray1<'_, u32>,
     instances: PyReadonlyArray1<'_, u32>,
 ) -> PyResult<()> {
-    let m = mesh_from_arrays(vertices, normals, uvs, faces, part_ids, kinds, colors, instances)?;
+    let m = mesh_from_arrays(
+        vertices, normals, uvs, faces, part_ids, kinds, colors, instances,
+    )?;
     match format {
         "obj" => py.detach(|| run_in_pool(Some(1), || export::write_obj(&m, &path)))?,
         "ply" => py.detach(|| run_in_pool(Some(1), || export::write_ply(&m, &path)))?,
-        _ => return Err(PyValueError::new_err(format!("format: expected 'obj' or 'ply', got {format:?}"))),
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "format: expected 'obj' or 'ply', got {format:?}"
+            )))
+        }
     }
     Ok(())
 }
@@ -302,14 +367,28 @@ fn plants_on_terrain<'py>(
     let (r, c) = (dem.shape()[0], dem.shape()[1]);
     let z: Vec<f64> = dem.as_array().iter().copied().collect();
     let l = lsystem.inner.clone();
-    let p = SceneParams { n, turtle: turtle_params(turtle), sides, cell_size, density, seed, scale, max_plants };
+    let p = SceneParams {
+        n,
+        turtle: turtle_params(turtle),
+        sides,
+        cell_size,
+        density,
+        seed,
+        scale,
+        max_plants,
+    };
     let (m, bases) = py.detach(|| run_in_pool(n_threads, || scene_kernel(&l, &z, r, c, &p)))?;
     Ok((mesh_arrays(py, m), rows(bases).into_pyarray(py)))
 }
 
-fn ifs_from(maps: &PyReadonlyArray2<'_, f64>, probabilities: Option<Vec<f64>>) -> PyResult<ifs::Ifs> {
+fn ifs_from(
+    maps: &PyReadonlyArray2<'_, f64>,
+    probabilities: Option<Vec<f64>>,
+) -> PyResult<ifs::Ifs> {
     let rows_: Vec<[f64; 6]> = to_rows(maps, "maps")?;
-    Ok(run_in_pool(Some(1), || ifs::Ifs::new(&rows_, probabilities.as_deref()))?)
+    Ok(run_in_pool(Some(1), || {
+        ifs::Ifs::new(&rows_, probabilities.as_deref())
+    })?)
 }
 
 /// Validate an IFS: returns (maps (k,6), probabilities (k,), similarity dimension or None).
@@ -320,17 +399,36 @@ fn ifs_check<'py>(
     py: Python<'py>,
     maps: PyReadonlyArray2<'py, f64>,
     probabilities: Option<Vec<f64>>,
-) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Option<f64>)> {
+) -> PyResult<(
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Option<f64>,
+)> {
     let f = ifs_from(&maps, probabilities)?;
-    Ok((rows(f.rows()).into_pyarray(py), f.probs.clone().into_pyarray(py), f.similarity_dimension()))
+    Ok((
+        rows(f.rows()).into_pyarray(py),
+        f.probs.clone().into_pyarray(py),
+        f.similarity_dimension(),
+    ))
 }
 
 /// A preset IFS: (maps (k,6), probabilities (k,), exact dimension or None).
 #[pyfunction]
 #[allow(clippy::type_complexity)]
-fn ifs_preset<'py>(py: Python<'py>, name: &str) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Option<f64>)> {
+fn ifs_preset<'py>(
+    py: Python<'py>,
+    name: &str,
+) -> PyResult<(
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Option<f64>,
+)> {
     let (f, d) = run_in_pool(Some(1), || ifs::preset(name))?;
-    Ok((rows(f.rows()).into_pyarray(py), f.probs.clone().into_pyarray(py), d))
+    Ok((
+        rows(f.rows()).into_pyarray(py),
+        f.probs.clone().into_pyarray(py),
+        d,
+    ))
 }
 
 /// Chaos game points (n_points, 2).

@@ -1,15 +1,15 @@
 //! Bindings of `crate::synth` and `crate::dem`.
 use crate::dem::hillshade::{self, ShadeParams};
 use crate::io::exr_io;
-use numpy::ndarray::Array2;
-use numpy::PyUntypedArrayMethods;
-use pyo3::exceptions::PyValueError;
-use std::path::PathBuf;
 use crate::parallel::run_in_pool;
 use crate::synth::midpoint::{self, RefineParams};
 use crate::synth::rng;
+use numpy::ndarray::Array2;
+use numpy::PyUntypedArrayMethods;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use std::path::PathBuf;
 
 /// `n` standard normals of stream `(seed, stream)` at indices `start ..`.
 #[pyfunction]
@@ -33,7 +33,15 @@ fn normal_noise<'py>(
 }
 
 #[allow(clippy::too_many_arguments)]
-fn params(hurst: f64, sigma: f64, coarse_spacing: f64, additions: bool, periodic: bool, seed: u64, first_level: u32) -> RefineParams {
+fn params(
+    hurst: f64,
+    sigma: f64,
+    coarse_spacing: f64,
+    additions: bool,
+    periodic: bool,
+    seed: u64,
+    first_level: u32,
+) -> RefineParams {
     RefineParams {
         hurst,
         sigma,
@@ -65,7 +73,15 @@ fn midpoint_refine_1d<'py>(
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let c: Vec<f64> = coarse.as_array().to_vec();
-    let p = params(hurst, sigma, coarse_spacing, additions, false, seed, first_level);
+    let p = params(
+        hurst,
+        sigma,
+        coarse_spacing,
+        additions,
+        false,
+        seed,
+        first_level,
+    );
     let v = py.detach(|| run_in_pool(n_threads, || midpoint::refine_1d_levels(&c, levels, &p)))?;
     Ok(v.into_pyarray(py))
 }
@@ -89,7 +105,15 @@ fn midpoint_refine_2d<'py>(
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let c = coarse.as_array();
-    let p = params(hurst, sigma, coarse_spacing, additions, periodic, seed, first_level);
+    let p = params(
+        hurst,
+        sigma,
+        coarse_spacing,
+        additions,
+        periodic,
+        seed,
+        first_level,
+    );
     let v = py.detach(|| run_in_pool(n_threads, || midpoint::refine_2d_levels(c, levels, &p)))?;
     Ok(v.into_pyarray(py))
 }
@@ -110,7 +134,12 @@ fn hillshade_f64<'py>(
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let z = dem.as_array();
-    let p = ShadeParams { azimuth, altitude, z_factor, multidirectional };
+    let p = ShadeParams {
+        azimuth,
+        altitude,
+        z_factor,
+        multidirectional,
+    };
     let v = py.detach(|| run_in_pool(n_threads, || hillshade::hillshade(z, &dx, dy, &p)))?;
     Ok(v.into_pyarray(py))
 }
@@ -126,9 +155,12 @@ fn shade_to_byte<'py>(
     let a = shade.as_array();
     let dim = a.dim();
     let std = a.as_standard_layout();
-    let v = std.as_slice().ok_or_else(|| PyValueError::new_err("shade: internal: not contiguous"))?;
+    let v = std
+        .as_slice()
+        .ok_or_else(|| PyValueError::new_err("shade: internal: not contiguous"))?;
     let b = py.detach(|| run_in_pool(n_threads, || Ok(hillshade::to_byte(v))))?;
-    let arr = Array2::from_shape_vec(dim, b).map_err(|_| PyValueError::new_err("internal: shape"))?;
+    let arr =
+        Array2::from_shape_vec(dim, b).map_err(|_| PyValueError::new_err("internal: shape"))?;
     Ok(arr.into_pyarray(py))
 }
 

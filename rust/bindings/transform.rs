@@ -2,10 +2,10 @@
 use crate::parallel::run_in_pool;
 use crate::transform::lacunarity::lacunarity_transform;
 use crate::transform::mass::{mass_transform, MassOptions};
-use numpy::ndarray::Array3;
-use numpy::PyArray3;
 use crate::transform::variation::{variation_transform, Increments, VariationOptions};
 use numpy::ndarray::Array2;
+use numpy::ndarray::Array3;
+use numpy::PyArray3;
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -25,20 +25,31 @@ fn variation_transform_map<'py>(
     n_threads: Option<usize>,
 ) -> PyResult<(Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>)> {
     let (rows, cols) = (image.shape()[0], image.shape()[1]);
-    let z = image.as_slice().map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
+    let z = image
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
     let opt = VariationOptions {
         window: window_size,
         lags,
         p,
-        increments: if square { Increments::Square } else { Increments::First },
+        increments: if square {
+            Increments::Square
+        } else {
+            Increments::First
+        },
         min_valid,
     };
-    let (d, r2) = py.detach(|| run_in_pool(n_threads, || variation_transform(z, rows, cols, &opt)))?;
+    let (d, r2) =
+        py.detach(|| run_in_pool(n_threads, || variation_transform(z, rows, cols, &opt)))?;
     let shape = (rows, cols);
     let bad = |_| PyValueError::new_err("internal: map size");
     Ok((
-        Array2::from_shape_vec(shape, d).map_err(bad)?.into_pyarray(py),
-        Array2::from_shape_vec(shape, r2).map_err(bad)?.into_pyarray(py),
+        Array2::from_shape_vec(shape, d)
+            .map_err(bad)?
+            .into_pyarray(py),
+        Array2::from_shape_vec(shape, r2)
+            .map_err(bad)?
+            .into_pyarray(py),
     ))
 }
 
@@ -56,13 +67,24 @@ fn mass_transform_map<'py>(
     n_threads: Option<usize>,
 ) -> PyResult<(Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>)> {
     let (rows, cols) = (image.shape()[0], image.shape()[1]);
-    let z = image.as_slice().map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
-    let opt = MassOptions { window: window_size, box_sizes, z_scale, min_valid };
+    let z = image
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
+    let opt = MassOptions {
+        window: window_size,
+        box_sizes,
+        z_scale,
+        min_valid,
+    };
     let (d, r2) = py.detach(|| run_in_pool(n_threads, || mass_transform(z, rows, cols, &opt)))?;
     let bad = |_| PyValueError::new_err("internal: map size");
     Ok((
-        Array2::from_shape_vec((rows, cols), d).map_err(bad)?.into_pyarray(py),
-        Array2::from_shape_vec((rows, cols), r2).map_err(bad)?.into_pyarray(py),
+        Array2::from_shape_vec((rows, cols), d)
+            .map_err(bad)?
+            .into_pyarray(py),
+        Array2::from_shape_vec((rows, cols), r2)
+            .map_err(bad)?
+            .into_pyarray(py),
     ))
 }
 
@@ -78,9 +100,15 @@ fn lacunarity_transform_map<'py>(
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
     let (rows, cols) = (image.shape()[0], image.shape()[1]);
-    let z = image.as_slice().map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
+    let z = image
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
     let n = box_sizes.len();
-    let l = py.detach(|| run_in_pool(n_threads, || lacunarity_transform(z, rows, cols, window_size, &box_sizes, min_valid)))?;
+    let l = py.detach(|| {
+        run_in_pool(n_threads, || {
+            lacunarity_transform(z, rows, cols, window_size, &box_sizes, min_valid)
+        })
+    })?;
     Ok(Array3::from_shape_vec((n, rows, cols), l)
         .map_err(|_| PyValueError::new_err("internal: map size"))?
         .into_pyarray(py))

@@ -37,25 +37,45 @@ pub struct ShadeParams {
 /// (so geographic grids have their metres-per-degree at each latitude) and a
 /// row spacing `dy`, both positive. Returns the reflectance in [0, 1], NaN
 /// where the centre is nodata.
-pub fn hillshade(z: ArrayView2<f64>, dx: &[f64], dy: f64, p: &ShadeParams) -> CoreResult<Array2<f32>> {
+pub fn hillshade(
+    z: ArrayView2<f64>,
+    dx: &[f64],
+    dy: f64,
+    p: &ShadeParams,
+) -> CoreResult<Array2<f32>> {
     let (rows, cols) = z.dim();
     if rows == 0 || cols == 0 {
         return Err(CoreError::invalid("dem", "empty grid"));
     }
     if dx.len() != rows {
-        return Err(CoreError::invalid("cell_size", format!("need {rows} row spacings, got {}", dx.len())));
+        return Err(CoreError::invalid(
+            "cell_size",
+            format!("need {rows} row spacings, got {}", dx.len()),
+        ));
     }
     if dx.iter().any(|v| !(v.is_finite() && *v > 0.0)) || !(dy.is_finite() && dy > 0.0) {
-        return Err(CoreError::invalid("cell_size", "expected positive finite cell sizes"));
+        return Err(CoreError::invalid(
+            "cell_size",
+            "expected positive finite cell sizes",
+        ));
     }
     if !(p.altitude.is_finite() && (0.0..=90.0).contains(&p.altitude)) {
-        return Err(CoreError::invalid("altitude", format!("expected degrees in [0, 90], got {}", p.altitude)));
+        return Err(CoreError::invalid(
+            "altitude",
+            format!("expected degrees in [0, 90], got {}", p.altitude),
+        ));
     }
     if !p.azimuth.is_finite() {
-        return Err(CoreError::invalid("azimuth", format!("expected a finite number of degrees, got {}", p.azimuth)));
+        return Err(CoreError::invalid(
+            "azimuth",
+            format!("expected a finite number of degrees, got {}", p.azimuth),
+        ));
     }
     if !p.z_factor.is_finite() {
-        return Err(CoreError::invalid("z_factor", format!("expected a finite number, got {}", p.z_factor)));
+        return Err(CoreError::invalid(
+            "z_factor",
+            format!("expected a finite number, got {}", p.z_factor),
+        ));
     }
     let alt = p.altitude.to_radians();
     let (sin_alt, cos_alt) = alt.sin_cos();
@@ -88,7 +108,9 @@ pub fn hillshade(z: ArrayView2<f64>, dx: &[f64], dy: f64, p: &ShadeParams) -> Co
         v.clamp(0.0, 1.0)
     };
     let zs = z.as_standard_layout();
-    let zs = zs.as_slice().ok_or_else(|| CoreError::Internal("dem not contiguous".into()))?;
+    let zs = zs
+        .as_slice()
+        .ok_or_else(|| CoreError::Internal("dem not contiguous".into()))?;
     let mut out = vec![0.0f32; rows * cols];
     out.par_chunks_mut(cols).enumerate().for_each(|(i, row)| {
         let inv_x = 1.0 / (8.0 * dx[i]);
@@ -96,7 +118,10 @@ pub fn hillshade(z: ArrayView2<f64>, dx: &[f64], dy: f64, p: &ShadeParams) -> Co
         let cur = &zs[i * cols..(i + 1) * cols];
         let interior_row = i > 0 && i + 1 < rows;
         let (up, down) = if interior_row {
-            (&zs[(i - 1) * cols..i * cols], &zs[(i + 1) * cols..(i + 2) * cols])
+            (
+                &zs[(i - 1) * cols..i * cols],
+                &zs[(i + 1) * cols..(i + 2) * cols],
+            )
         } else {
             (cur, cur)
         };
@@ -112,7 +137,11 @@ pub fn hillshade(z: ArrayView2<f64>, dx: &[f64], dy: f64, p: &ShadeParams) -> Co
                     return e;
                 }
                 let v = zs[ii as usize * cols + jj as usize];
-                if v.is_nan() { e } else { v }
+                if v.is_nan() {
+                    e
+                } else {
+                    v
+                }
             };
             let (a, b, c) = (at(-1, -1), at(-1, 0), at(-1, 1));
             let (d, f) = (at(0, -1), at(0, 1));
@@ -132,7 +161,11 @@ pub fn hillshade(z: ArrayView2<f64>, dx: &[f64], dy: f64, p: &ShadeParams) -> Co
             let gx = ((c + 2.0 * f + k) - (a + 2.0 * d + g)) * inv_x;
             let gy = ((a + 2.0 * b + c) - (g + 2.0 * h + k)) * inv_y;
             // NaN anywhere in the window propagates to gx or gy.
-            row[j] = if gx.is_nan() || gy.is_nan() || e.is_nan() { slow(j) } else { shade(gx, gy) as f32 };
+            row[j] = if gx.is_nan() || gy.is_nan() || e.is_nan() {
+                slow(j)
+            } else {
+                shade(gx, gy) as f32
+            };
         }
     });
     Array2::from_shape_vec((rows, cols), out).map_err(|e| CoreError::Internal(e.to_string()))
@@ -142,7 +175,13 @@ pub fn hillshade(z: ArrayView2<f64>, dx: &[f64], dy: f64, p: &ShadeParams) -> Co
 pub fn to_byte(shade: &[f32]) -> Vec<u8> {
     shade
         .par_iter()
-        .map(|&v| if v.is_nan() { 0 } else { (1.0 + 254.0 * v.clamp(0.0, 1.0)).round() as u8 })
+        .map(|&v| {
+            if v.is_nan() {
+                0
+            } else {
+                (1.0 + 254.0 * v.clamp(0.0, 1.0)).round() as u8
+            }
+        })
         .collect()
 }
 
@@ -151,14 +190,21 @@ mod tests {
     use super::*;
 
     fn params(az: f64) -> ShadeParams {
-        ShadeParams { azimuth: az, altitude: 45.0, z_factor: 1.0, multidirectional: false }
+        ShadeParams {
+            azimuth: az,
+            altitude: 45.0,
+            z_factor: 1.0,
+            multidirectional: false,
+        }
     }
 
     #[test]
     fn flat_is_sin_altitude() {
         let z = Array2::<f64>::from_elem((4, 5), 10.0);
         let s = hillshade(z.view(), &[1.0; 4], 1.0, &params(315.0)).unwrap();
-        assert!(s.iter().all(|v| (*v as f64 - 45f64.to_radians().sin()).abs() < 1e-6));
+        assert!(s
+            .iter()
+            .all(|v| (*v as f64 - 45f64.to_radians().sin()).abs() < 1e-6));
     }
 
     #[test]
@@ -170,7 +216,12 @@ mod tests {
         // gradient: dz/dx = 1, dz/dy = -1 (north is row 0): |grad| = sqrt 2,
         // slope 54.7356 deg, normal towards azimuth 315.
         let slope = 2f64.sqrt().atan().to_degrees();
-        let p = ShadeParams { azimuth: 315.0, altitude: 90.0 - slope, z_factor: 1.0, multidirectional: false };
+        let p = ShadeParams {
+            azimuth: 315.0,
+            altitude: 90.0 - slope,
+            z_factor: 1.0,
+            multidirectional: false,
+        };
         let s = hillshade(z.view(), &[1.0; 6], 1.0, &p).unwrap();
         assert!((s[[2, 2]] - 1.0).abs() < 1e-6, "{}", s[[2, 2]]);
         // From the opposite side the slope is in shadow.

@@ -18,7 +18,12 @@ use rayon::prelude::*;
 ///
 /// `data` is row-major `rows x cols`; a profile has `rows == 1`. NaN values are
 /// skipped; columns with fewer than two valid samples are not used.
-pub fn column_ranges(data: &[f64], rows: usize, cols: usize, box_sizes: &[usize]) -> CoreResult<(Vec<f64>, Vec<u64>)> {
+pub fn column_ranges(
+    data: &[f64],
+    rows: usize,
+    cols: usize,
+    box_sizes: &[usize],
+) -> CoreResult<(Vec<f64>, Vec<u64>)> {
     if rows * cols == 0 || data.len() != rows * cols {
         return Err(CoreError::invalid("data", "array is empty"));
     }
@@ -27,7 +32,10 @@ pub fn column_ranges(data: &[f64], rows: usize, cols: usize, box_sizes: &[usize]
     let mut counts = Vec::with_capacity(box_sizes.len());
     for &s in box_sizes {
         if s == 0 {
-            return Err(CoreError::invalid("box_sizes", "box sizes must be positive integers"));
+            return Err(CoreError::invalid(
+                "box_sizes",
+                "box sizes must be positive integers",
+            ));
         }
         let nc = (cols - 1) / s;
         let nr = if profile { 1 } else { (rows - 1) / s };
@@ -40,7 +48,11 @@ pub fn column_ranges(data: &[f64], rows: usize, cols: usize, box_sizes: &[usize]
         let (sum, n) = (0..nr)
             .into_par_iter()
             .map(|bi| {
-                let (r0, r1) = if profile { (0, 1) } else { (bi * s, bi * s + s + 1) };
+                let (r0, r1) = if profile {
+                    (0, 1)
+                } else {
+                    (bi * s, bi * s + s + 1)
+                };
                 let mut sum = 0.0f64;
                 let mut n = 0u64;
                 for bj in 0..nc {
@@ -63,7 +75,10 @@ pub fn column_ranges(data: &[f64], rows: usize, cols: usize, box_sizes: &[usize]
             })
             .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
         if n == 0 {
-            return Err(CoreError::invalid("data", format!("no column of width {s} has two valid samples")));
+            return Err(CoreError::invalid(
+                "data",
+                format!("no column of width {s} has two valid samples"),
+            ));
         }
         means.push(sum / n as f64);
         counts.push(n);
@@ -86,7 +101,9 @@ mod tests {
     #[test]
     fn plane_surface_range() {
         let (rows, cols) = (9usize, 17usize);
-        let z: Vec<f64> = (0..rows * cols).map(|p| (p / cols) as f64 + 2.0 * (p % cols) as f64).collect();
+        let z: Vec<f64> = (0..rows * cols)
+            .map(|p| (p / cols) as f64 + 2.0 * (p % cols) as f64)
+            .collect();
         let (m, n) = column_ranges(&z, rows, cols, &[1, 2, 4]).unwrap();
         assert_eq!(m, vec![3.0, 6.0, 12.0]);
         assert_eq!(n, vec![8 * 16, 4 * 8, 2 * 4]);

@@ -39,13 +39,20 @@ impl<'a> ByteVolume<'a> {
     /// Wrap a contiguous buffer of 1, 2 or 3 axes (`dims`), padding to 3 axes.
     pub fn new(data: &'a [u8], dims: &[usize]) -> CoreResult<Self> {
         if dims.is_empty() || dims.len() > 3 {
-            return Err(CoreError::invalid("data", format!("expected 1, 2 or 3 dimensions, got {}", dims.len())));
+            return Err(CoreError::invalid(
+                "data",
+                format!("expected 1, 2 or 3 dimensions, got {}", dims.len()),
+            ));
         }
         let mut shape = [1usize; 3];
         shape[3 - dims.len()..].copy_from_slice(dims);
         let n: usize = shape.iter().product();
         if n != data.len() {
-            return Err(CoreError::Internal(format!("buffer of {} bytes for shape {:?}", data.len(), dims)));
+            return Err(CoreError::Internal(format!(
+                "buffer of {} bytes for shape {:?}",
+                data.len(),
+                dims
+            )));
         }
         if n == 0 {
             return Err(CoreError::invalid("data", "array is empty"));
@@ -96,7 +103,10 @@ fn first_nonzero(row: &[u8]) -> Option<usize> {
             return Some(k * 8 + (v.trailing_zeros() / 8) as usize);
         }
     }
-    row[rem_start..].iter().position(|&v| v != 0).map(|p| rem_start + p)
+    row[rem_start..]
+        .iter()
+        .position(|&v| v != 0)
+        .map(|p| rem_start + p)
 }
 
 /// Index of the last nonzero byte, scanning eight bytes at a time from the end.
@@ -304,7 +314,14 @@ fn reduce_or(src: &Src, m: Shape3, c: Shape3) -> (Grid, u64, u64) {
             },
         )
         .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
-    (Grid { data: out, shape: out_shape }, count, src_count)
+    (
+        Grid {
+            data: out,
+            shape: out_shape,
+        },
+        count,
+        src_count,
+    )
 }
 
 /// Default box sizes for a set whose bounding box spans `extent` samples along
@@ -321,11 +338,18 @@ pub fn default_box_sizes(extent: usize) -> Vec<usize> {
     let limit = (extent / DEFAULT_MIN_BOXES).max(1);
     let mut divisors = vec![];
     for d in 1..=limit {
-        if extent % d == 0 && divisors.last().is_none_or(|&last: &usize| d as f64 >= 1.4 * last as f64) {
+        if extent % d == 0
+            && divisors
+                .last()
+                .is_none_or(|&last: &usize| d as f64 >= 1.4 * last as f64)
+        {
             divisors.push(d);
         }
     }
-    let max_gap = divisors.windows(2).map(|w| w[1] as f64 / w[0] as f64).fold(1.0, f64::max);
+    let max_gap = divisors
+        .windows(2)
+        .map(|w| w[1] as f64 / w[0] as f64)
+        .fold(1.0, f64::max);
     if divisors.len() >= 3 && divisors[divisors.len() - 1] >= 8 * divisors[0] && max_gap <= 4.0 {
         return divisors;
     }
@@ -363,7 +387,10 @@ pub fn box_count(
         validate_box_sizes(box_sizes, max_len)?;
     }
     let Some((bmin, bmax)) = scan(vol) else {
-        return Err(CoreError::invalid("data", "the set is empty (no foreground sample)"));
+        return Err(CoreError::invalid(
+            "data",
+            "the set is empty (no foreground sample)",
+        ));
     };
     // the number of foreground samples (the count at size 1) comes from the
     // first reduction of the data, which reads every sample once
@@ -431,11 +458,19 @@ pub fn box_count(
             grids.push(grid);
         }
     }
-    let n_fg = n_fg.ok_or_else(|| CoreError::Internal("no reduction of the data was made".into()))?;
+    let n_fg =
+        n_fg.ok_or_else(|| CoreError::Internal("no reduction of the data was made".into()))?;
     if sizes[0] == 1 {
         counts[0].iter_mut().for_each(|c| *c = n_fg);
     }
-    Ok(BoxCounts { box_sizes: sizes, shifts, counts, n_foreground: n_fg, bbox_min: bmin, bbox_max: bmax })
+    Ok(BoxCounts {
+        box_sizes: sizes,
+        shifts,
+        counts,
+        n_foreground: n_fg,
+        bbox_min: bmin,
+        bbox_max: bmax,
+    })
 }
 
 #[cfg(test)]
@@ -446,7 +481,11 @@ mod tests {
     fn naive(data: &[u8], dims: &[usize], s: usize, g: Shape3, anchor: Anchor) -> u64 {
         let vol = ByteVolume::new(data, dims).unwrap();
         let (bmin, _) = scan(&vol).unwrap();
-        let lo = if anchor == Anchor::BoundingBox { bmin } else { [0; 3] };
+        let lo = if anchor == Anchor::BoundingBox {
+            bmin
+        } else {
+            [0; 3]
+        };
         let mut set = std::collections::HashSet::new();
         let [n0, n1, n2] = vol.shape;
         for i in 0..n0 {
@@ -467,7 +506,9 @@ mod tests {
     }
 
     fn lcg(seed: &mut u64) -> u64 {
-        *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        *seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         *seed >> 33
     }
 
@@ -476,20 +517,31 @@ mod tests {
         let mut seed = 7u64;
         for trial in 0..40 {
             let ndim = 1 + trial % 3;
-            let dims: Vec<usize> = (0..ndim).map(|_| 3 + (lcg(&mut seed) % 30) as usize).collect();
+            let dims: Vec<usize> = (0..ndim)
+                .map(|_| 3 + (lcg(&mut seed) % 30) as usize)
+                .collect();
             let n: usize = dims.iter().product();
             let density = 1 + lcg(&mut seed) % 20;
-            let mut data: Vec<u8> = (0..n).map(|_| (lcg(&mut seed) % 100 < density) as u8).collect();
+            let mut data: Vec<u8> = (0..n)
+                .map(|_| (lcg(&mut seed) % 100 < density) as u8)
+                .collect();
             data[n / 2] = 1;
             let vol = ByteVolume::new(&data, &dims).unwrap();
             let maxlen = *dims.iter().max().unwrap();
-            let sizes: Vec<usize> = vec![1, 2, 3, 4, 6, 8, 12].into_iter().filter(|&s| s <= maxlen).collect();
+            let sizes: Vec<usize> = vec![1, 2, 3, 4, 6, 8, 12]
+                .into_iter()
+                .filter(|&s| s <= maxlen)
+                .collect();
             for anchor in [Anchor::BoundingBox, Anchor::Array] {
                 for offs in [1usize, 2, 3] {
                     let r = box_count(&vol, ndim, &sizes, offs, anchor).unwrap();
                     for (i, &s) in r.box_sizes.iter().enumerate() {
                         for (j, g) in r.shifts.iter().enumerate() {
-                            assert_eq!(r.counts[i][j], naive(&data, &dims, s, *g, anchor), "s={s} g={g:?} dims={dims:?}");
+                            assert_eq!(
+                                r.counts[i][j],
+                                naive(&data, &dims, s, *g, anchor),
+                                "s={s} g={g:?} dims={dims:?}"
+                            );
                         }
                     }
                 }
@@ -515,11 +567,15 @@ mod tests {
     fn thread_count_does_not_change_counts() {
         let mut seed = 3u64;
         let dims = [301usize, 257];
-        let data: Vec<u8> = (0..dims[0] * dims[1]).map(|_| (lcg(&mut seed) % 7 == 0) as u8).collect();
+        let data: Vec<u8> = (0..dims[0] * dims[1])
+            .map(|_| (lcg(&mut seed) % 7 == 0) as u8)
+            .collect();
         let vol = ByteVolume::new(&data, &dims).unwrap();
         let run = |t| {
-            crate::parallel::run_in_pool(Some(t), || box_count(&vol, 2, &[1, 2, 3, 5, 8, 16, 64], 3, Anchor::BoundingBox))
-                .unwrap()
+            crate::parallel::run_in_pool(Some(t), || {
+                box_count(&vol, 2, &[1, 2, 3, 5, 8, 16, 64], 3, Anchor::BoundingBox)
+            })
+            .unwrap()
         };
         assert_eq!(run(1), run(2));
         assert_eq!(run(1), run(5));
@@ -541,7 +597,11 @@ mod tests {
                         .map(|b| {
                             let (lo, hi) = box_range(b, 2, c, len);
                             let v = row[lo..hi].iter().fold(0, |a, &x| a | x);
-                            if first { v } else { v | prev[b] }
+                            if first {
+                                v
+                            } else {
+                                v | prev[b]
+                            }
                         })
                         .collect()
                 };
@@ -570,7 +630,10 @@ mod tests {
     fn bad_input_is_an_error() {
         let data = vec![0u8; 16];
         let vol = ByteVolume::new(&data, &[4, 4]).unwrap();
-        assert!(matches!(box_count(&vol, 2, &[1, 2, 4], 1, Anchor::BoundingBox), Err(CoreError::InvalidArgument { .. })));
+        assert!(matches!(
+            box_count(&vol, 2, &[1, 2, 4], 1, Anchor::BoundingBox),
+            Err(CoreError::InvalidArgument { .. })
+        ));
         assert!(ByteVolume::new(&[], &[0]).is_err());
         assert!(ByteVolume::new(&data, &[2, 2, 2, 2]).is_err());
     }

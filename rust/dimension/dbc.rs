@@ -45,20 +45,23 @@ where
     let shape = [n_boxes(rows, m, c[0]), n_boxes(cols, m, c[1])];
     let mut lo = vec![f64::INFINITY; shape[0] * shape[1]];
     let mut hi = vec![f64::NEG_INFINITY; shape[0] * shape[1]];
-    lo.par_chunks_mut(shape[1]).zip(hi.par_chunks_mut(shape[1])).enumerate().for_each(|(b0, (lrow, hrow))| {
-        let (r0, r1) = box_range(b0, m, c[0], rows);
-        for b1 in 0..shape[1] {
-            let (c0, c1) = box_range(b1, m, c[1], cols);
-            let (mut a, mut b) = (f64::INFINITY, f64::NEG_INFINITY);
-            for r in r0..r1 {
-                let (x, y) = read(r, c0, c1);
-                a = a.min(x);
-                b = b.max(y);
+    lo.par_chunks_mut(shape[1])
+        .zip(hi.par_chunks_mut(shape[1]))
+        .enumerate()
+        .for_each(|(b0, (lrow, hrow))| {
+            let (r0, r1) = box_range(b0, m, c[0], rows);
+            for b1 in 0..shape[1] {
+                let (c0, c1) = box_range(b1, m, c[1], cols);
+                let (mut a, mut b) = (f64::INFINITY, f64::NEG_INFINITY);
+                for r in r0..r1 {
+                    let (x, y) = read(r, c0, c1);
+                    a = a.min(x);
+                    b = b.max(y);
+                }
+                lrow[b1] = a;
+                hrow[b1] = b;
             }
-            lrow[b1] = a;
-            hrow[b1] = b;
-        }
-    });
+        });
     MinMax { lo, hi, shape }
 }
 
@@ -106,10 +109,16 @@ pub fn dbc_count<T: Sample>(
         return Err(CoreError::invalid("data", "image is empty"));
     }
     if !(z_unit.is_finite() && z_unit > 0.0) {
-        return Err(CoreError::invalid("z_scale", format!("must be a positive finite number, got {z_unit}")));
+        return Err(CoreError::invalid(
+            "z_scale",
+            format!("must be a positive finite number, got {z_unit}"),
+        ));
     }
     if !z0.is_finite() {
-        return Err(CoreError::invalid("data", "no valid (non-NaN, finite) value"));
+        return Err(CoreError::invalid(
+            "data",
+            "no valid (non-NaN, finite) value",
+        ));
     }
     if n_offsets == 0 {
         return Err(CoreError::invalid("offsets", "must be a positive integer"));
@@ -125,14 +134,20 @@ pub fn dbc_count<T: Sample>(
             let m = s / t;
             let c = [((g[1] % s) - (g[1] % t)) / t, ((g[2] % s) - (g[2] % t)) / t];
             let mm = if t == 1 {
-                reduce_minmax(rows, cols, m, c, |r, c0, c1| nan_minmax(&data[r * cols + c0..r * cols + c1]))
+                reduce_minmax(rows, cols, m, c, |r, c0, c1| {
+                    nan_minmax(&data[r * cols + c0..r * cols + c1])
+                })
             } else {
                 let k = done.iter().position(|&d| d == t).unwrap();
                 let src = &grids[k];
                 let w = src.shape[1];
                 reduce_minmax(src.shape[0], w, m, c, |r, c0, c1| {
-                    let lo = src.lo[r * w + c0..r * w + c1].iter().fold(f64::INFINITY, |a, &b| a.min(b));
-                    let hi = src.hi[r * w + c0..r * w + c1].iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b));
+                    let lo = src.lo[r * w + c0..r * w + c1]
+                        .iter()
+                        .fold(f64::INFINITY, |a, &b| a.min(b));
+                    let hi = src.hi[r * w + c0..r * w + c1]
+                        .iter()
+                        .fold(f64::NEG_INFINITY, |a, &b| a.max(b));
                     (lo, hi)
                 })
             };
@@ -148,7 +163,11 @@ pub fn dbc_count<T: Sample>(
             grids.push(mm);
         }
     }
-    Ok(DbcCounts { box_sizes: sizes, shifts, counts })
+    Ok(DbcCounts {
+        box_sizes: sizes,
+        shifts,
+        counts,
+    })
 }
 
 #[cfg(test)]
@@ -197,7 +216,11 @@ mod tests {
             let sizes: Vec<usize> = sizes.into_iter().filter(|&s| s <= rows.max(cols)).collect();
             let r = dbc_count(&data, rows, cols, &sizes, 1, 0.0, 0.7).unwrap();
             for (i, &s) in r.box_sizes.iter().enumerate() {
-                assert_eq!(r.counts[i][0], naive(&data, rows, cols, s, 0.0, 0.7), "s={s} {rows}x{cols}");
+                assert_eq!(
+                    r.counts[i][0],
+                    naive(&data, rows, cols, s, 0.0, 0.7),
+                    "s={s} {rows}x{cols}"
+                );
             }
         }
     }

@@ -63,19 +63,27 @@ pub fn validate_box_sizes(box_sizes: &[usize], max_len: usize) -> CoreResult<Vec
     v.sort_unstable();
     v.dedup();
     if v.first() == Some(&0) {
-        return Err(CoreError::invalid("box_sizes", "box sizes must be positive integers"));
+        return Err(CoreError::invalid(
+            "box_sizes",
+            "box sizes must be positive integers",
+        ));
     }
     if v.len() < 3 {
         return Err(CoreError::invalid(
             "box_sizes",
-            format!("need at least 3 distinct box sizes for a fit, got {}", v.len()),
+            format!(
+                "need at least 3 distinct box sizes for a fit, got {}",
+                v.len()
+            ),
         ));
     }
     if let Some(&s) = v.last() {
         if s > max_len {
             return Err(CoreError::invalid(
                 "box_sizes",
-                format!("box size {s} is larger than the data (largest axis has {max_len} samples)"),
+                format!(
+                    "box size {s} is larger than the data (largest axis has {max_len} samples)"
+                ),
             ));
         }
     }
@@ -85,7 +93,11 @@ pub fn validate_box_sizes(box_sizes: &[usize], max_len: usize) -> CoreResult<Vec
 /// For box size `s`, among already computed sizes `done` (ascending), the
 /// largest `t < s` that divides `s`; 1 (the data themselves) if none.
 pub fn best_source(s: usize, done: &[usize]) -> usize {
-    done.iter().rev().copied().find(|&t| t < s && s % t == 0).unwrap_or(1)
+    done.iter()
+        .rev()
+        .copied()
+        .find(|&t| t < s && s % t == 0)
+        .unwrap_or(1)
 }
 
 #[cfg(test)]
@@ -141,6 +153,9 @@ mod tests {
         assert!(validate_box_sizes(&[1, 2], 10).is_err());
         assert!(validate_box_sizes(&[0, 1, 2], 10).is_err());
         assert!(validate_box_sizes(&[1, 2, 20], 10).is_err());
-        assert_eq!(validate_box_sizes(&[4, 1, 2, 2], 10).unwrap(), vec![1, 2, 4]);
+        assert_eq!(
+            validate_box_sizes(&[4, 1, 2, 2], 10).unwrap(),
+            vec![1, 2, 4]
+        );
     }
 }

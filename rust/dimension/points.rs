@@ -17,27 +17,45 @@ pub struct PointCounts {
 }
 
 /// Count occupied boxes of an `n x d` row-major coordinate array.
-pub fn point_box_count(coords: &[f64], n: usize, d: usize, box_sizes: &[f64], n_offsets: usize) -> CoreResult<PointCounts> {
+pub fn point_box_count(
+    coords: &[f64],
+    n: usize,
+    d: usize,
+    box_sizes: &[f64],
+    n_offsets: usize,
+) -> CoreResult<PointCounts> {
     if n == 0 || d == 0 || coords.len() != n * d {
         return Err(CoreError::invalid("data", "point set is empty"));
     }
     if d > 16 {
-        return Err(CoreError::invalid("data", format!("at most 16 coordinates per point, got {d}")));
+        return Err(CoreError::invalid(
+            "data",
+            format!("at most 16 coordinates per point, got {d}"),
+        ));
     }
     if coords.iter().any(|v| !v.is_finite()) {
-        return Err(CoreError::invalid("data", "coordinates must be finite (no NaN or inf)"));
+        return Err(CoreError::invalid(
+            "data",
+            "coordinates must be finite (no NaN or inf)",
+        ));
     }
     if n_offsets == 0 {
         return Err(CoreError::invalid("offsets", "must be a positive integer"));
     }
     let mut sizes: Vec<f64> = box_sizes.to_vec();
     if sizes.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
-        return Err(CoreError::invalid("box_sizes", "box sizes must be positive finite numbers"));
+        return Err(CoreError::invalid(
+            "box_sizes",
+            "box sizes must be positive finite numbers",
+        ));
     }
     sizes.sort_by(|a, b| a.partial_cmp(b).unwrap());
     sizes.dedup();
     if sizes.len() < 3 {
-        return Err(CoreError::invalid("box_sizes", format!("need at least 3 distinct box sizes, got {}", sizes.len())));
+        return Err(CoreError::invalid(
+            "box_sizes",
+            format!("need at least 3 distinct box sizes, got {}", sizes.len()),
+        ));
     }
     let mut mins = vec![f64::INFINITY; d];
     let mut maxs = vec![f64::NEG_INFINITY; d];
@@ -67,21 +85,35 @@ pub fn point_box_count(coords: &[f64], n: usize, d: usize, box_sizes: &[f64], n_
             // keys: box index per axis packed in a Vec<u64> row (d words per point)
             let mut keys: Vec<Vec<u64>> = coords
                 .par_chunks_exact(d)
-                .map(|p| (0..d).map(|a| ((p[a] - mins[a] + g[a] % s) / s).floor() as u64).collect())
+                .map(|p| {
+                    (0..d)
+                        .map(|a| ((p[a] - mins[a] + g[a] % s) / s).floor() as u64)
+                        .collect()
+                })
                 .collect();
             keys.par_sort_unstable();
             keys.dedup();
             counts[i][j] = keys.len() as u64;
         }
     }
-    Ok(PointCounts { box_sizes: sizes, shifts, counts })
+    Ok(PointCounts {
+        box_sizes: sizes,
+        shifts,
+        counts,
+    })
 }
 
 /// Largest extent of the set over its axes (for default box sizes).
 pub fn extent(coords: &[f64], d: usize) -> f64 {
     let mut e = 0.0f64;
     for a in 0..d {
-        let (lo, hi) = coords.iter().skip(a).step_by(d).fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)));
+        let (lo, hi) = coords
+            .iter()
+            .skip(a)
+            .step_by(d)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+                (l.min(v), h.max(v))
+            });
         e = e.max(hi - lo);
     }
     e

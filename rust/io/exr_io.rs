@@ -11,7 +11,10 @@ use std::path::Path;
 /// Write `data` (row-major, `rows` x `cols`) as a float EXR, atomically.
 pub fn write_exr_gray(path: &Path, data: Vec<f32>, rows: usize, cols: usize) -> CoreResult<()> {
     if rows == 0 || cols == 0 || data.len() != rows * cols {
-        return Err(CoreError::invalid("image", format!("bad image shape ({rows}, {cols})")));
+        return Err(CoreError::invalid(
+            "image",
+            format!("bad image shape ({rows}, {cols})"),
+        ));
     }
     let channel = AnyChannel::new("Y", FlatSamples::F32(data));
     let layer = Layer::new(
@@ -24,7 +27,10 @@ pub fn write_exr_gray(path: &Path, data: Vec<f32>, rows: usize, cols: usize) -> 
     let tmp = temp_path(path);
     if let Err(e) = image.write().to_file(&tmp) {
         let _ = std::fs::remove_file(&tmp);
-        return Err(CoreError::Io(format!("cannot write {}: {e}", path.display())));
+        return Err(CoreError::Io(format!(
+            "cannot write {}: {e}",
+            path.display()
+        )));
     }
     std::fs::rename(&tmp, path).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
@@ -49,7 +55,13 @@ pub fn read_exr_gray(path: &Path) -> CoreResult<(Vec<f32>, usize, usize)> {
         .iter()
         .find(|c| c.name == *"Y")
         .or(if list.len() == 1 { list.first() } else { None })
-        .ok_or_else(|| CoreError::Io(format!("{}: no channel \"Y\" among {} channels", path.display(), list.len())))?;
+        .ok_or_else(|| {
+            CoreError::Io(format!(
+                "{}: no channel \"Y\" among {} channels",
+                path.display(),
+                list.len()
+            ))
+        })?;
     let values: Vec<f32> = chan.sample_data.values_as_f32().collect();
     Ok((values, size.height(), size.width()))
 }
@@ -63,7 +75,11 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("fg_exr_{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let p = dir.join("a.exr");
-        let data: Vec<f32> = (0..35).map(|i| i as f32 * 0.37 - 3.0).chain([f32::NAN]).take(35).collect();
+        let data: Vec<f32> = (0..35)
+            .map(|i| i as f32 * 0.37 - 3.0)
+            .chain([f32::NAN])
+            .take(35)
+            .collect();
         write_exr_gray(&p, data.clone(), 5, 7).unwrap();
         let (back, r, c) = read_exr_gray(&p).unwrap();
         assert_eq!((r, c), (5, 7));

@@ -29,7 +29,9 @@ pub fn read_image(path: &Path) -> CoreResult<Raster> {
         .map_err(|e| CoreError::Io(format!("cannot open {}: {e}", path.display())))?
         .with_guessed_format()
         .map_err(|e| CoreError::Io(format!("cannot read {}: {e}", path.display())))?;
-    let img = reader.decode().map_err(|e| CoreError::Io(format!("cannot decode {}: {e}", path.display())))?;
+    let img = reader
+        .decode()
+        .map_err(|e| CoreError::Io(format!("cannot decode {}: {e}", path.display())))?;
     let (cols, rows) = (img.width() as usize, img.height() as usize);
     let channels = img.color().channel_count() as usize;
     let pixels = match img {
@@ -43,9 +45,20 @@ pub fn read_image(path: &Path) -> CoreResult<Raster> {
         DynamicImage::ImageRgba16(b) => Pixels::U16(b.into_raw()),
         DynamicImage::ImageRgb32F(b) => Pixels::F32(b.into_raw()),
         DynamicImage::ImageRgba32F(b) => Pixels::F32(b.into_raw()),
-        other => return Err(CoreError::Io(format!("unsupported pixel type {:?} in {}", other.color(), path.display()))),
+        other => {
+            return Err(CoreError::Io(format!(
+                "unsupported pixel type {:?} in {}",
+                other.color(),
+                path.display()
+            )))
+        }
     };
-    Ok(Raster { pixels, rows, cols, channels })
+    Ok(Raster {
+        pixels,
+        rows,
+        cols,
+        channels,
+    })
 }
 
 /// Write a single-band 8- or 16-bit PNG atomically (temporary file in the
@@ -54,7 +67,12 @@ pub fn write_png_gray(path: &Path, pixels: &Pixels, rows: usize, cols: usize) ->
     let (w, h) = (u32::try_from(cols), u32::try_from(rows));
     let (w, h) = match (w, h) {
         (Ok(w), Ok(h)) if w > 0 && h > 0 => (w, h),
-        _ => return Err(CoreError::invalid("image", format!("bad image shape ({rows}, {cols})"))),
+        _ => {
+            return Err(CoreError::invalid(
+                "image",
+                format!("bad image shape ({rows}, {cols})"),
+            ))
+        }
     };
     let tmp = temp_path(path);
     let result = match pixels {
@@ -64,11 +82,19 @@ pub fn write_png_gray(path: &Path, pixels: &Pixels, rows: usize, cols: usize) ->
         Pixels::U16(v) => ImageBuffer::<Luma<u16>, _>::from_raw(w, h, v.clone())
             .ok_or_else(|| CoreError::Internal("buffer size".into()))?
             .save_with_format(&tmp, image::ImageFormat::Png),
-        Pixels::F32(_) => return Err(CoreError::invalid("image", "PNG holds 8- or 16-bit integers, not float")),
+        Pixels::F32(_) => {
+            return Err(CoreError::invalid(
+                "image",
+                "PNG holds 8- or 16-bit integers, not float",
+            ))
+        }
     };
     if let Err(e) = result {
         let _ = std::fs::remove_file(&tmp);
-        return Err(CoreError::Io(format!("cannot write {}: {e}", path.display())));
+        return Err(CoreError::Io(format!(
+            "cannot write {}: {e}",
+            path.display()
+        )));
     }
     std::fs::rename(&tmp, path).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
@@ -78,7 +104,10 @@ pub fn write_png_gray(path: &Path, pixels: &Pixels, rows: usize, cols: usize) ->
 
 /// A temporary name beside `path` (same filesystem, so rename is atomic).
 pub fn temp_path(path: &Path) -> std::path::PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }
 

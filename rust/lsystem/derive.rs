@@ -75,7 +75,13 @@ impl LSystem {
     /// Compile an L-system from its axiom, production lines (see
     /// [`super::grammar`]), the symbols ignored by context matching, a seed
     /// and a size limit.
-    pub fn new(axiom: &str, rules: &[String], ignore: &str, seed: u64, max_length: usize) -> CoreResult<Self> {
+    pub fn new(
+        axiom: &str,
+        rules: &[String],
+        ignore: &str,
+        seed: u64,
+        max_length: usize,
+    ) -> CoreResult<Self> {
         if max_length == 0 {
             return Err(CoreError::invalid("max_length", "must be positive"));
         }
@@ -99,9 +105,15 @@ impl LSystem {
             }
         }
         let needs_mates = rules.iter().any(|r| r.has_context());
-        let parametric = !axiom.pstart.is_empty() || rules.iter().any(|r| r.successors.iter().any(|s| s.parametric));
+        let parametric = !axiom.pstart.is_empty()
+            || rules
+                .iter()
+                .any(|r| r.successors.iter().any(|s| s.parametric));
         let max_slots = rules.iter().map(|r| r.n_slots).max().unwrap_or(0);
-        let simple_ok = !parametric && rules.iter().all(|r| !r.has_context() && r.cond.is_none() && r.pred.arity.is_none());
+        let simple_ok = !parametric
+            && rules
+                .iter()
+                .all(|r| !r.has_context() && r.cond.is_none() && r.pred.arity.is_none());
         let simple = simple_ok.then(|| {
             let mut t = vec![u32::MAX; 128];
             let mut o = HashMap::new();
@@ -121,9 +133,27 @@ impl LSystem {
             axiom.pstart = vec![0; axiom.len() + 1];
         }
         if axiom.len() > max_length {
-            return Err(CoreError::invalid("max_length", format!("the axiom has {} modules, more than max_length={max_length}", axiom.len())));
+            return Err(CoreError::invalid(
+                "max_length",
+                format!(
+                    "the axiom has {} modules, more than max_length={max_length}",
+                    axiom.len()
+                ),
+            ));
         }
-        Ok(LSystem { axiom, rules, ignore, seed, max_length, ascii, other, needs_mates, parametric, max_slots, simple })
+        Ok(LSystem {
+            axiom,
+            rules,
+            ignore,
+            seed,
+            max_length,
+            ascii,
+            other,
+            needs_mates,
+            parametric,
+            max_slots,
+            simple,
+        })
     }
 
     /// True when some production is stochastic.
@@ -162,7 +192,14 @@ impl LSystem {
         }
     }
 
-    fn left_matches(&self, rule: &Rule, s: &ModString, mates: &[u32], i: usize, vars: &mut [f64]) -> bool {
+    fn left_matches(
+        &self,
+        rule: &Rule,
+        s: &ModString,
+        mates: &[u32],
+        i: usize,
+        vars: &mut [f64],
+    ) -> bool {
         let mut pos = i as isize - 1;
         for p in rule.left.iter().rev() {
             loop {
@@ -186,7 +223,14 @@ impl LSystem {
         true
     }
 
-    fn right_matches(&self, rule: &Rule, s: &ModString, mates: &[u32], i: usize, vars: &mut [f64]) -> bool {
+    fn right_matches(
+        &self,
+        rule: &Rule,
+        s: &ModString,
+        mates: &[u32],
+        i: usize,
+        vars: &mut [f64],
+    ) -> bool {
         let n = s.len();
         let mut pos = i + 1;
         for p in &rule.right {
@@ -203,7 +247,11 @@ impl LSystem {
                 ']' => {
                     // skip to the end of the current branch
                     while pos < n && s.syms[pos] != ']' {
-                        pos = if s.syms[pos] == '[' { mates[pos] as usize + 1 } else { pos + 1 };
+                        pos = if s.syms[pos] == '[' {
+                            mates[pos] as usize + 1
+                        } else {
+                            pos + 1
+                        };
                     }
                     if pos >= n {
                         return false;
@@ -234,8 +282,20 @@ impl LSystem {
         true
     }
 
-    fn rewrite_range(&self, s: &ModString, mates: &[u32], lo: usize, hi: usize, generation: u64, seed: u64) -> CoreResult<Piece> {
-        let mut out = Piece { syms: Vec::with_capacity(2 * (hi - lo)), counts: Vec::new(), params: Vec::new() };
+    fn rewrite_range(
+        &self,
+        s: &ModString,
+        mates: &[u32],
+        lo: usize,
+        hi: usize,
+        generation: u64,
+        seed: u64,
+    ) -> CoreResult<Piece> {
+        let mut out = Piece {
+            syms: Vec::with_capacity(2 * (hi - lo)),
+            counts: Vec::new(),
+            params: Vec::new(),
+        };
         let mut vars = vec![0.0f64; self.max_slots.max(1)];
         for i in lo..hi {
             let c = s.syms[i];
@@ -260,7 +320,10 @@ impl LSystem {
                     0
                 } else {
                     let u = unit3(seed, generation, i as u64);
-                    rule.cum_weights.iter().position(|&w| u < w).unwrap_or(rule.cum_weights.len() - 1)
+                    rule.cum_weights
+                        .iter()
+                        .position(|&w| u < w)
+                        .unwrap_or(rule.cum_weights.len() - 1)
                 };
                 let succ = &rule.successors[k];
                 if self.parametric {
@@ -312,12 +375,21 @@ impl LSystem {
 
     /// One parallel derivation step of `s` (step number `generation`,
     /// counted from 0) with the given seed. Runs in the current rayon pool.
-    pub fn step_with_seed(&self, s: &ModString, generation: u64, seed: u64) -> CoreResult<ModString> {
+    pub fn step_with_seed(
+        &self,
+        s: &ModString,
+        generation: u64,
+        seed: u64,
+    ) -> CoreResult<ModString> {
         if let Some(table) = &self.simple {
             return self.step_simple(table, s, generation, seed);
         }
         let n = s.len();
-        let mates = if self.needs_mates { s.bracket_mates("axiom")? } else { Vec::new() };
+        let mates = if self.needs_mates {
+            s.bracket_mates("axiom")?
+        } else {
+            Vec::new()
+        };
         let threads = rayon::current_num_threads().max(1);
         let chunk = (n / (4 * threads)).clamp(8192, 1 << 20);
         let starts: Vec<usize> = (0..n).step_by(chunk).collect();
@@ -333,7 +405,11 @@ impl LSystem {
         if total > self.max_length {
             return Err(self.too_long(generation));
         }
-        let mut out = ModString { syms: Vec::with_capacity(total), pstart: Vec::new(), params: Vec::new() };
+        let mut out = ModString {
+            syms: Vec::with_capacity(total),
+            pstart: Vec::new(),
+            params: Vec::new(),
+        };
         for p in &pieces {
             out.syms.extend_from_slice(&p.syms);
         }
@@ -360,10 +436,20 @@ impl LSystem {
     /// Context-free, non-parametric step: count the output length of every
     /// chunk, then write each chunk straight into its place in the result
     /// (a stochastic choice is drawn twice from the same hash: same result).
-    fn step_simple(&self, table: &SimpleTable, s: &ModString, generation: u64, seed: u64) -> CoreResult<ModString> {
+    fn step_simple(
+        &self,
+        table: &SimpleTable,
+        s: &ModString,
+        generation: u64,
+        seed: u64,
+    ) -> CoreResult<ModString> {
         let (ascii, other) = table;
         let succ = |i: usize, c: char| -> Option<&[char]> {
-            let r = if (c as u32) < 128 { ascii[c as usize] } else { other.get(&c).copied().unwrap_or(u32::MAX) };
+            let r = if (c as u32) < 128 {
+                ascii[c as usize]
+            } else {
+                other.get(&c).copied().unwrap_or(u32::MAX)
+            };
             if r == u32::MAX {
                 return None;
             }
@@ -372,7 +458,10 @@ impl LSystem {
                 0
             } else {
                 let u = unit3(seed, generation, i as u64);
-                rule.cum_weights.iter().position(|&w| u < w).unwrap_or(rule.cum_weights.len() - 1)
+                rule.cum_weights
+                    .iter()
+                    .position(|&w| u < w)
+                    .unwrap_or(rule.cum_weights.len() - 1)
             };
             Some(&rule.successors[k].syms)
         };
@@ -383,7 +472,12 @@ impl LSystem {
             .syms
             .par_chunks(chunk)
             .enumerate()
-            .map(|(b, c)| c.iter().enumerate().map(|(j, &x)| succ(b * chunk + j, x).map_or(1, |v| v.len())).sum())
+            .map(|(b, c)| {
+                c.iter()
+                    .enumerate()
+                    .map(|(j, &x)| succ(b * chunk + j, x).map_or(1, |v| v.len()))
+                    .sum()
+            })
             .collect();
         let total: usize = sizes.iter().sum();
         if total > self.max_length {
@@ -397,22 +491,30 @@ impl LSystem {
             slices.push(a);
             rest = b;
         }
-        s.syms.par_chunks(chunk).zip(slices.into_par_iter()).enumerate().for_each(|(b, (src, dst))| {
-            let mut o = 0;
-            for (j, &c) in src.iter().enumerate() {
-                match succ(b * chunk + j, c) {
-                    Some(v) => {
-                        dst[o..o + v.len()].copy_from_slice(v);
-                        o += v.len();
-                    }
-                    None => {
-                        dst[o] = c;
-                        o += 1;
+        s.syms
+            .par_chunks(chunk)
+            .zip(slices.into_par_iter())
+            .enumerate()
+            .for_each(|(b, (src, dst))| {
+                let mut o = 0;
+                for (j, &c) in src.iter().enumerate() {
+                    match succ(b * chunk + j, c) {
+                        Some(v) => {
+                            dst[o..o + v.len()].copy_from_slice(v);
+                            o += v.len();
+                        }
+                        None => {
+                            dst[o] = c;
+                            o += 1;
+                        }
                     }
                 }
-            }
-        });
-        Ok(ModString { syms: out, pstart: Vec::new(), params: Vec::new() })
+            });
+        Ok(ModString {
+            syms: out,
+            pstart: Vec::new(),
+            params: Vec::new(),
+        })
     }
 
     /// Derive `n` steps from the axiom with the system's seed.
@@ -423,7 +525,10 @@ impl LSystem {
     /// Derive `n` steps from the axiom with another seed.
     pub fn derive_with_seed(&self, n: usize, seed: u64) -> CoreResult<ModString> {
         if n > MAX_STEPS {
-            return Err(CoreError::invalid("n", format!("at most {MAX_STEPS} derivation steps, got {n}")));
+            return Err(CoreError::invalid(
+                "n",
+                format!("at most {MAX_STEPS} derivation steps, got {n}"),
+            ));
         }
         let mut s = self.axiom.clone();
         for g in 0..n {
@@ -439,7 +544,14 @@ mod tests {
     use crate::parallel::run_in_pool;
 
     fn ls(axiom: &str, rules: &[&str]) -> LSystem {
-        LSystem::new(axiom, &rules.iter().map(|s| s.to_string()).collect::<Vec<_>>(), "", 1, DEFAULT_MAX_LENGTH).unwrap()
+        LSystem::new(
+            axiom,
+            &rules.iter().map(|s| s.to_string()).collect::<Vec<_>>(),
+            "",
+            1,
+            DEFAULT_MAX_LENGTH,
+        )
+        .unwrap()
     }
 
     #[test]
@@ -463,7 +575,12 @@ mod tests {
         // p2: A(x,y): y>3 -> B(x)A(x/y,0); p3: B(x): x<1 -> C; p4: B(x): x>=1 -> B(x-1)
         let l = ls(
             "B(2)A(4,4)",
-            &["A(x,y) : y <= 3 -> A(x*2, x+y)", "A(x,y) : y > 3 -> B(x)A(x/y, 0)", "B(x) : x < 1 -> C", "B(x) : x >= 1 -> B(x-1)"],
+            &[
+                "A(x,y) : y <= 3 -> A(x*2, x+y)",
+                "A(x,y) : y > 3 -> B(x)A(x/y, 0)",
+                "B(x) : x < 1 -> C",
+                "B(x) : x >= 1 -> B(x-1)",
+            ],
         );
         let g: Vec<String> = (0..5).map(|n| l.derive(n).unwrap().to_text()).collect();
         assert_eq!(g[1], "B(1)B(4)A(1,0)");
@@ -499,14 +616,22 @@ mod tests {
         assert_eq!(l.derive(9).unwrap().len(), 512);
         let e = l.derive(10).unwrap_err();
         assert!(e.to_string().starts_with("max_length:"), "{e}");
-        assert!(l.derive(MAX_STEPS + 1).unwrap_err().to_string().starts_with("n:"));
+        assert!(l
+            .derive(MAX_STEPS + 1)
+            .unwrap_err()
+            .to_string()
+            .starts_with("n:"));
     }
 
     #[test]
     fn stochastic_same_for_any_thread_count() {
         let l = LSystem::new(
             "F",
-            &["F -(1)-> F[+F]F[-F]F".to_string(), "F -(1)-> F[+F]F".to_string(), "F -(1)-> F[-F]F".to_string()],
+            &[
+                "F -(1)-> F[+F]F[-F]F".to_string(),
+                "F -(1)-> F[+F]F".to_string(),
+                "F -(1)-> F[-F]F".to_string(),
+            ],
             "",
             42,
             DEFAULT_MAX_LENGTH,
@@ -522,7 +647,11 @@ mod tests {
 
     #[test]
     fn fast_and_general_paths_agree() {
-        let base = vec!["F -(1)-> F[+F]F[-F]F".to_string(), "F -(2)-> F[+F]F".to_string(), "X -> F-X".to_string()];
+        let base = vec![
+            "F -(1)-> F[+F]F[-F]F".to_string(),
+            "F -(2)-> F[+F]F".to_string(),
+            "X -> F-X".to_string(),
+        ];
         let fast = LSystem::new("FX", &base, "", 11, DEFAULT_MAX_LENGTH).unwrap();
         assert!(fast.simple.is_some());
         let mut with_ctx = base.clone();

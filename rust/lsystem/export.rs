@@ -14,10 +14,16 @@ fn io_err(path: &Path, e: std::io::Error) -> CoreError {
     CoreError::Io(format!("{}: {e}", path.display()))
 }
 
-fn atomic<F: FnOnce(&mut BufWriter<File>) -> std::io::Result<()>>(path: &Path, f: F) -> CoreResult<()> {
+fn atomic<F: FnOnce(&mut BufWriter<File>) -> std::io::Result<()>>(
+    path: &Path,
+    f: F,
+) -> CoreResult<()> {
     if let Some(dir) = path.parent() {
         if !dir.as_os_str().is_empty() && !dir.is_dir() {
-            return Err(CoreError::Io(format!("{}: folder does not exist", path.display())));
+            return Err(CoreError::Io(format!(
+                "{}: folder does not exist",
+                path.display()
+            )));
         }
     }
     let tmp = temp_path(path);
@@ -44,7 +50,12 @@ fn atomic<F: FnOnce(&mut BufWriter<File>) -> std::io::Result<()>>(path: &Path, f
 pub fn write_obj(mesh: &Mesh, path: &Path) -> CoreResult<()> {
     check(mesh)?;
     atomic(path, |w| {
-        writeln!(w, "# fractalgeo_rs L-system mesh: {} vertices, {} triangles", mesh.vertices.len(), mesh.faces.len())?;
+        writeln!(
+            w,
+            "# fractalgeo_rs L-system mesh: {} vertices, {} triangles",
+            mesh.vertices.len(),
+            mesh.faces.len()
+        )?;
         for v in &mesh.vertices {
             writeln!(w, "v {} {} {}", v[0], v[1], v[2])?;
         }
@@ -59,7 +70,12 @@ pub fn write_obj(mesh: &Mesh, path: &Path) -> CoreResult<()> {
                 continue;
             }
             writeln!(w, "g {name}")?;
-            for (f, _) in mesh.faces.iter().zip(&mesh.kinds).filter(|(_, &k)| k == kind) {
+            for (f, _) in mesh
+                .faces
+                .iter()
+                .zip(&mesh.kinds)
+                .filter(|(_, &k)| k == kind)
+            {
                 let (a, b, c) = (f[0] + 1, f[1] + 1, f[2] + 1);
                 writeln!(w, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}")?;
             }
@@ -85,7 +101,11 @@ pub fn write_ply(mesh: &Mesh, path: &Path) -> CoreResult<()> {
         let mut buf = Vec::with_capacity(32);
         for i in 0..mesh.vertices.len() {
             buf.clear();
-            for x in mesh.vertices[i].iter().chain(&mesh.normals[i]).chain(&mesh.uvs[i]) {
+            for x in mesh.vertices[i]
+                .iter()
+                .chain(&mesh.normals[i])
+                .chain(&mesh.uvs[i])
+            {
                 buf.extend_from_slice(&x.to_le_bytes());
             }
             w.write_all(&buf)?;
@@ -109,13 +129,26 @@ pub fn write_ply(mesh: &Mesh, path: &Path) -> CoreResult<()> {
 fn check(mesh: &Mesh) -> CoreResult<()> {
     let (nv, nf) = (mesh.vertices.len(), mesh.faces.len());
     if mesh.normals.len() != nv || mesh.uvs.len() != nv {
-        return Err(CoreError::invalid("mesh", "normals and uvs must have one row per vertex"));
+        return Err(CoreError::invalid(
+            "mesh",
+            "normals and uvs must have one row per vertex",
+        ));
     }
-    if mesh.part_ids.len() != nf || mesh.kinds.len() != nf || mesh.colors.len() != nf || mesh.instances.len() != nf {
-        return Err(CoreError::invalid("mesh", "part_ids, kinds, colors and instances must have one entry per face"));
+    if mesh.part_ids.len() != nf
+        || mesh.kinds.len() != nf
+        || mesh.colors.len() != nf
+        || mesh.instances.len() != nf
+    {
+        return Err(CoreError::invalid(
+            "mesh",
+            "part_ids, kinds, colors and instances must have one entry per face",
+        ));
     }
     if mesh.faces.iter().flatten().any(|&i| i as usize >= nv) {
-        return Err(CoreError::invalid("mesh", "a face refers to a vertex that does not exist"));
+        return Err(CoreError::invalid(
+            "mesh",
+            "a face refers to a vertex that does not exist",
+        ));
     }
     Ok(())
 }
@@ -146,7 +179,10 @@ mod tests {
         let bytes = std::fs::read(&ply).unwrap();
         let head = b"end_header\n";
         let pos = bytes.windows(head.len()).position(|w| w == head).unwrap() + head.len();
-        assert_eq!(bytes.len() - pos, m.vertices.len() * 32 + m.faces.len() * (1 + 12 + 4 + 1 + 4 + 4));
+        assert_eq!(
+            bytes.len() - pos,
+            m.vertices.len() * 32 + m.faces.len() * (1 + 12 + 4 + 1 + 4 + 4)
+        );
         // no temporary file is left behind
         assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 2);
         assert!(write_obj(&m, &dir.join("missing/a.obj")).is_err());

@@ -205,7 +205,8 @@ fn tokenize(src: &str, param: &str) -> CoreResult<Vec<Tok>> {
             i += 1;
             continue;
         }
-        if c.is_ascii_digit() || (c == '.' && chars.get(i + 1).is_some_and(|d| d.is_ascii_digit())) {
+        if c.is_ascii_digit() || (c == '.' && chars.get(i + 1).is_some_and(|d| d.is_ascii_digit()))
+        {
             let start = i;
             while i < chars.len() && (chars[i].is_ascii_digit() || chars[i] == '.') {
                 i += 1;
@@ -223,9 +224,9 @@ fn tokenize(src: &str, param: &str) -> CoreResult<Vec<Tok>> {
                 }
             }
             let s: String = chars[start..i].iter().collect();
-            let v: f64 = s
-                .parse()
-                .map_err(|_| CoreError::invalid(param, format!("bad number {s:?} in expression {src:?}")))?;
+            let v: f64 = s.parse().map_err(|_| {
+                CoreError::invalid(param, format!("bad number {s:?} in expression {src:?}"))
+            })?;
             out.push(Tok::Num(v));
             continue;
         }
@@ -256,7 +257,10 @@ fn tokenize(src: &str, param: &str) -> CoreResult<Vec<Tok>> {
             i += 1;
             continue;
         }
-        return Err(CoreError::invalid(param, format!("unexpected character {c:?} in expression {src:?}")));
+        return Err(CoreError::invalid(
+            param,
+            format!("unexpected character {c:?} in expression {src:?}"),
+        ));
     }
     Ok(out)
 }
@@ -299,7 +303,14 @@ impl<'a> Parser<'a> {
         const LEVELS: [&[(&str, BinOp)]; 4] = [
             &[("||", BinOp::Or)],
             &[("&&", BinOp::And)],
-            &[("<", BinOp::Lt), ("<=", BinOp::Le), (">", BinOp::Gt), (">=", BinOp::Ge), ("==", BinOp::Eq), ("!=", BinOp::Ne)],
+            &[
+                ("<", BinOp::Lt),
+                ("<=", BinOp::Le),
+                (">", BinOp::Gt),
+                (">=", BinOp::Ge),
+                ("==", BinOp::Eq),
+                ("!=", BinOp::Ne),
+            ],
             &[("+", BinOp::Add), ("-", BinOp::Sub)],
         ];
         if level == LEVELS.len() {
@@ -307,7 +318,9 @@ impl<'a> Parser<'a> {
         }
         let mut lhs = self.binary(level + 1)?;
         while let Some(op) = self.peek_op() {
-            let Some(&(_, b)) = LEVELS[level].iter().find(|(o, _)| *o == op) else { break };
+            let Some(&(_, b)) = LEVELS[level].iter().find(|(o, _)| *o == op) else {
+                break;
+            };
             self.pos += 1;
             let rhs = self.binary(level + 1)?;
             lhs = Expr::Bin(b, Box::new(lhs), Box::new(rhs));
@@ -387,7 +400,8 @@ impl<'a> Parser<'a> {
             Some(Tok::Name(name)) => {
                 self.pos += 1;
                 if self.peek_op() == Some("(") {
-                    let (f, arity) = Func::from_name(&name).ok_or_else(|| self.err(&format!("unknown function {name:?}")))?;
+                    let (f, arity) = Func::from_name(&name)
+                        .ok_or_else(|| self.err(&format!("unknown function {name:?}")))?;
                     self.pos += 1;
                     let mut args = vec![self.binary(0)?];
                     while self.peek_op() == Some(",") {
@@ -396,7 +410,10 @@ impl<'a> Parser<'a> {
                     }
                     self.expect(")")?;
                     if args.len() != arity {
-                        return Err(self.err(&format!("{name} takes {arity} argument(s), got {}", args.len())));
+                        return Err(self.err(&format!(
+                            "{name} takes {arity} argument(s), got {}",
+                            args.len()
+                        )));
                     }
                     return Ok(Expr::Call(f, args));
                 }
@@ -417,12 +434,26 @@ impl<'a> Parser<'a> {
 
 /// Parse `src` into an [`Expr`]; `lookup` maps a parameter name to its slot.
 /// Errors name `param` (the user-facing argument that holds the text).
-pub fn parse_expr(src: &str, param: &str, lookup: &dyn Fn(&str) -> Option<usize>) -> CoreResult<Expr> {
+pub fn parse_expr(
+    src: &str,
+    param: &str,
+    lookup: &dyn Fn(&str) -> Option<usize>,
+) -> CoreResult<Expr> {
     let toks = tokenize(src, param)?;
     if toks.is_empty() {
-        return Err(CoreError::invalid(param, format!("empty expression in {src:?}")));
+        return Err(CoreError::invalid(
+            param,
+            format!("empty expression in {src:?}"),
+        ));
     }
-    let mut p = Parser { toks, pos: 0, depth: 0, src, param, lookup };
+    let mut p = Parser {
+        toks,
+        pos: 0,
+        depth: 0,
+        src,
+        param,
+        lookup,
+    };
     let e = p.binary(0)?;
     if p.pos != p.toks.len() {
         return Err(p.err("trailing text"));
@@ -460,12 +491,17 @@ mod tests {
     #[test]
     fn errors_name_the_problem() {
         let look = |_: &str| None;
-        for bad in ["", "1+", "(1", "foo", "x+1", "sin(1,2)", "1 2", "3 $ 4", "nope(1)"] {
+        for bad in [
+            "", "1+", "(1", "foo", "x+1", "sin(1,2)", "1 2", "3 $ 4", "nope(1)",
+        ] {
             let e = parse_expr(bad, "rules", &look).unwrap_err();
             assert!(e.to_string().starts_with("rules:"), "{bad}: {e}");
         }
         let deep = format!("{}1{}", "(".repeat(100_000), ")".repeat(100_000));
-        assert!(parse_expr(&deep, "rules", &look).unwrap_err().to_string().contains("nesting"));
+        assert!(parse_expr(&deep, "rules", &look)
+            .unwrap_err()
+            .to_string()
+            .contains("nesting"));
         assert!(parse_expr(&"-".repeat(100_000), "rules", &look).is_err());
         let e = parse_expr("x+1", "rules", &look).unwrap_err();
         assert!(e.to_string().contains("unknown parameter \"x\""), "{e}");

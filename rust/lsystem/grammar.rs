@@ -101,15 +101,21 @@ impl ModString {
             if c == '[' {
                 stack.push(i);
             } else if c == ']' {
-                let j = stack
-                    .pop()
-                    .ok_or_else(|| CoreError::invalid(param, format!("unbalanced brackets: ']' at module {i} closes nothing")))?;
+                let j = stack.pop().ok_or_else(|| {
+                    CoreError::invalid(
+                        param,
+                        format!("unbalanced brackets: ']' at module {i} closes nothing"),
+                    )
+                })?;
                 mates[i] = j as u32;
                 mates[j] = i as u32;
             }
         }
         if let Some(j) = stack.pop() {
-            return Err(CoreError::invalid(param, format!("unbalanced brackets: '[' at module {j} is never closed")));
+            return Err(CoreError::invalid(
+                param,
+                format!("unbalanced brackets: '[' at module {j} is never closed"),
+            ));
         }
         Ok(mates)
     }
@@ -124,12 +130,18 @@ pub fn check_brackets(syms: impl Iterator<Item = char>, param: &str, what: &str)
         } else if c == ']' {
             depth -= 1;
             if depth < 0 {
-                return Err(CoreError::invalid(param, format!("unbalanced brackets in {what}: ']' closes nothing")));
+                return Err(CoreError::invalid(
+                    param,
+                    format!("unbalanced brackets in {what}: ']' closes nothing"),
+                ));
             }
         }
     }
     if depth != 0 {
-        return Err(CoreError::invalid(param, format!("unbalanced brackets in {what}: {depth} '[' never closed")));
+        return Err(CoreError::invalid(
+            param,
+            format!("unbalanced brackets in {what}: {depth} '[' never closed"),
+        ));
     }
     Ok(())
 }
@@ -158,7 +170,10 @@ pub fn split_modules(src: &str, param: &str) -> CoreResult<Vec<RawModule>> {
             continue;
         }
         if !is_symbol(c) {
-            return Err(CoreError::invalid(param, format!("unexpected {c:?} at character {i} of {src:?}")));
+            return Err(CoreError::invalid(
+                param,
+                format!("unexpected {c:?} at character {i} of {src:?}"),
+            ));
         }
         i += 1;
         // optional argument list, possibly after spaces only if directly attached
@@ -189,13 +204,22 @@ pub fn split_modules(src: &str, param: &str) -> CoreResult<Vec<RawModule>> {
                 }
             }
             if !closed {
-                return Err(CoreError::invalid(param, format!("unclosed '(' after {c:?} in {src:?}")));
+                return Err(CoreError::invalid(
+                    param,
+                    format!("unclosed '(' after {c:?} in {src:?}"),
+                ));
             }
             args.push(cur);
             if args.iter().any(|a| a.trim().is_empty()) {
-                return Err(CoreError::invalid(param, format!("empty parameter in module {c:?} of {src:?}")));
+                return Err(CoreError::invalid(
+                    param,
+                    format!("empty parameter in module {c:?} of {src:?}"),
+                ));
             }
-            out.push(RawModule { sym: c, args: Some(args) });
+            out.push(RawModule {
+                sym: c,
+                args: Some(args),
+            });
         } else {
             out.push(RawModule { sym: c, args: None });
         }
@@ -219,7 +243,10 @@ pub fn parse_module_string(src: &str, param: &str) -> CoreResult<ModString> {
             for a in args {
                 let v = parse_expr(a, param, &none)?.eval(&[]);
                 if !v.is_finite() {
-                    return Err(CoreError::invalid(param, format!("parameter {a:?} of {:?} is not finite", m.sym)));
+                    return Err(CoreError::invalid(
+                        param,
+                        format!("parameter {a:?} of {:?} is not finite", m.sym),
+                    ));
                 }
                 ms.params.push(v);
             }
@@ -289,7 +316,10 @@ struct RawRule {
 
 fn split_rule(line: &str) -> CoreResult<RawRule> {
     let Some(arrow) = line.find("->") else {
-        return Err(CoreError::invalid("rules", format!("malformed rule {line:?}: no '->'")));
+        return Err(CoreError::invalid(
+            "rules",
+            format!("malformed rule {line:?}: no '->'"),
+        ));
     };
     let mut lhs = line[..arrow].trim_end().to_string();
     let succ = line[arrow + 2..].trim().to_string();
@@ -317,18 +347,30 @@ fn split_rule(line: &str) -> CoreResult<RawRule> {
                 let inner: String = bytes[k + 1..bytes.len() - 1].iter().collect();
                 let none = |_: &str| None;
                 let w = parse_expr(&inner, "rules", &none)
-                    .map_err(|e| CoreError::invalid("rules", format!("bad weight in rule {line:?}: {e}")))?
+                    .map_err(|e| {
+                        CoreError::invalid("rules", format!("bad weight in rule {line:?}: {e}"))
+                    })?
                     .eval(&[]);
                 if !w.is_finite() || w < 0.0 {
-                    return Err(CoreError::invalid("rules", format!("weight {w} of rule {line:?} must be finite and >= 0")));
+                    return Err(CoreError::invalid(
+                        "rules",
+                        format!("weight {w} of rule {line:?} must be finite and >= 0"),
+                    ));
                 }
                 weight = Some(w);
-                lhs = bytes[..k - 1].iter().collect::<String>().trim_end().to_string();
+                lhs = bytes[..k - 1]
+                    .iter()
+                    .collect::<String>()
+                    .trim_end()
+                    .to_string();
             }
         }
     }
     if lhs.trim().is_empty() {
-        return Err(CoreError::invalid("rules", format!("malformed rule {line:?}: no predecessor")));
+        return Err(CoreError::invalid(
+            "rules",
+            format!("malformed rule {line:?}: no predecessor"),
+        ));
     }
     Ok(RawRule { lhs, weight, succ })
 }
@@ -340,7 +382,9 @@ fn split_top(s: &str, sep: char) -> (String, Option<String>) {
         match c {
             '(' => depth += 1,
             ')' => depth -= 1,
-            _ if c == sep && depth == 0 => return (s[..i].to_string(), Some(s[i + c.len_utf8()..].to_string())),
+            _ if c == sep && depth == 0 => {
+                return (s[..i].to_string(), Some(s[i + c.len_utf8()..].to_string()))
+            }
             _ => {}
         }
     }
@@ -361,7 +405,10 @@ impl Slots {
                 Some(args) => {
                     for a in args {
                         let a = a.trim();
-                        let ok = a.chars().next().is_some_and(|c| c.is_alphabetic() || c == '_')
+                        let ok = a
+                            .chars()
+                            .next()
+                            .is_some_and(|c| c.is_alphabetic() || c == '_')
                             && a.chars().all(|c| c.is_alphanumeric() || c == '_');
                         if !ok {
                             return Err(CoreError::invalid(
@@ -370,14 +417,21 @@ impl Slots {
                             ));
                         }
                         if self.names.iter().any(|n| n == a) {
-                            return Err(CoreError::invalid("rules", format!("parameter {a:?} bound twice in rule {line:?}")));
+                            return Err(CoreError::invalid(
+                                "rules",
+                                format!("parameter {a:?} bound twice in rule {line:?}"),
+                            ));
                         }
                         self.names.push(a.to_string());
                     }
                     Some(args.len())
                 }
             };
-            out.push(Pattern { sym: m.sym, arity, first_slot: first });
+            out.push(Pattern {
+                sym: m.sym,
+                arity,
+                first_slot: first,
+            });
         }
         Ok(out)
     }
@@ -400,7 +454,10 @@ fn compile_group(lhs: &str, items: &[(Option<f64>, String)], line: &str) -> Core
             Some(t) => {
                 let m = split_modules(&t, "rules")?;
                 if m.is_empty() {
-                    return Err(CoreError::invalid("rules", format!("empty context in rule {line:?} (use '*' for none)")));
+                    return Err(CoreError::invalid(
+                        "rules",
+                        format!("empty context in rule {line:?} (use '*' for none)"),
+                    ));
                 }
                 Ok(m)
             }
@@ -412,14 +469,23 @@ fn compile_group(lhs: &str, items: &[(Option<f64>, String)], line: &str) -> Core
     if pred_raw.len() != 1 {
         return Err(CoreError::invalid(
             "rules",
-            format!("malformed rule {line:?}: the predecessor must be exactly one module, got {:?}", pred_txt.trim()),
+            format!(
+                "malformed rule {line:?}: the predecessor must be exactly one module, got {:?}",
+                pred_txt.trim()
+            ),
         ));
     }
     if matches!(pred_raw[0].sym, '[' | ']') {
-        return Err(CoreError::invalid("rules", format!("rule {line:?}: brackets cannot be rewritten")));
+        return Err(CoreError::invalid(
+            "rules",
+            format!("rule {line:?}: brackets cannot be rewritten"),
+        ));
     }
     if left_raw.iter().any(|m| matches!(m.sym, '[' | ']')) {
-        return Err(CoreError::invalid("rules", format!("rule {line:?}: brackets are not allowed in a left context")));
+        return Err(CoreError::invalid(
+            "rules",
+            format!("rule {line:?}: brackets are not allowed in a left context"),
+        ));
     }
     let mut slots = Slots { names: vec![] };
     let left = slots.patterns(&left_raw, line)?;
@@ -436,7 +502,11 @@ fn compile_group(lhs: &str, items: &[(Option<f64>, String)], line: &str) -> Core
     let mut weights = Vec::new();
     for (w, succ_txt) in items {
         let mods = split_modules(succ_txt, "rules")?;
-        check_brackets(mods.iter().map(|m| m.sym), "rules", &format!("the successor of rule {line:?}"))?;
+        check_brackets(
+            mods.iter().map(|m| m.sym),
+            "rules",
+            &format!("the successor of rule {line:?}"),
+        )?;
         let mut modules = Vec::new();
         let mut parametric = false;
         for m in mods {
@@ -444,13 +514,19 @@ fn compile_group(lhs: &str, items: &[(Option<f64>, String)], line: &str) -> Core
                 None => vec![],
                 Some(a) => {
                     parametric = true;
-                    a.iter().map(|t| parse_expr(t, "rules", &lookup)).collect::<CoreResult<Vec<_>>>()?
+                    a.iter()
+                        .map(|t| parse_expr(t, "rules", &lookup))
+                        .collect::<CoreResult<Vec<_>>>()?
                 }
             };
             modules.push(SuccModule { sym: m.sym, args });
         }
         let syms = modules.iter().map(|m| m.sym).collect();
-        successors.push(Successor { modules, syms, parametric });
+        successors.push(Successor {
+            modules,
+            syms,
+            parametric,
+        });
         weights.push(w.unwrap_or(1.0));
     }
     let total: f64 = weights.iter().sum();
@@ -510,11 +586,18 @@ pub fn compile_rules(lines: &[String]) -> CoreResult<Vec<Rule>> {
             }
             (_, None) => {
                 index.insert(key, groups.len());
-                groups.push((raw.lhs.clone(), vec![(raw.weight, raw.succ)], line.to_string()));
+                groups.push((
+                    raw.lhs.clone(),
+                    vec![(raw.weight, raw.succ)],
+                    line.to_string(),
+                ));
             }
         }
     }
-    groups.iter().map(|(lhs, items, line)| compile_group(lhs, items, line)).collect()
+    groups
+        .iter()
+        .map(|(lhs, items, line)| compile_group(lhs, items, line))
+        .collect()
 }
 
 /// The content of a rule file.
@@ -542,13 +625,19 @@ pub fn parse_rule_text(text: &str) -> CoreResult<RuleText> {
         let Some((k, v)) = line.split_once(':') else {
             return Err(CoreError::invalid(
                 "text",
-                format!("line {}: expected 'key: value' or a rule 'A -> B', got {line:?}", no + 1),
+                format!(
+                    "line {}: expected 'key: value' or a rule 'A -> B', got {line:?}",
+                    no + 1
+                ),
             ));
         };
         let k = k.trim().to_ascii_lowercase();
         let v = v.trim().to_string();
         if k.is_empty() || !k.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
-            return Err(CoreError::invalid("text", format!("line {}: bad key {k:?}", no + 1)));
+            return Err(CoreError::invalid(
+                "text",
+                format!("line {}: bad key {k:?}", no + 1),
+            ));
         }
         match k.as_str() {
             "axiom" | "omega" => out.axiom = Some(v),
@@ -576,21 +665,30 @@ mod tests {
         assert_eq!(m.to_text(), "A(1,2.5)B[C(6)]");
         assert!(parse_module_string("A[B", "axiom").is_err());
         assert!(parse_module_string("A]B[", "axiom").is_err());
-        assert!(parse_module_string("A(x)", "axiom").unwrap_err().to_string().contains("unknown parameter"));
+        assert!(parse_module_string("A(x)", "axiom")
+            .unwrap_err()
+            .to_string()
+            .contains("unknown parameter"));
         assert!(parse_module_string("A(1", "axiom").is_err());
         assert!(parse_module_string("A(1,)", "axiom").is_err());
     }
 
     #[test]
     fn rules_compile() {
-        let r = compile_rules(&["B(a) < A(x, y) > C(z) : x > a && z < y -> A(x+1, y*2)B".into()]).unwrap();
+        let r = compile_rules(&["B(a) < A(x, y) > C(z) : x > a && z < y -> A(x+1, y*2)B".into()])
+            .unwrap();
         assert_eq!(r.len(), 1);
         assert_eq!(r[0].left[0].sym, 'B');
         assert_eq!(r[0].pred.arity, Some(2));
         assert_eq!(r[0].pred.first_slot, 1);
         assert_eq!(r[0].right[0].first_slot, 3);
         assert_eq!(r[0].n_slots, 4);
-        let s = compile_rules(&["F -(1)-> F[+F]F".into(), "F -(3)-> F[-F]F".into(), "X -> F".into()]).unwrap();
+        let s = compile_rules(&[
+            "F -(1)-> F[+F]F".into(),
+            "F -(3)-> F[-F]F".into(),
+            "X -> F".into(),
+        ])
+        .unwrap();
         assert_eq!(s.len(), 2);
         assert_eq!(s[0].cum_weights, vec![0.25, 1.0]);
         for bad in [
@@ -617,11 +715,20 @@ mod tests {
 
     #[test]
     fn rule_text_parses() {
-        let t = parse_rule_text("# plant\naxiom: X\nignore: +-\nn: 5\nangle: 22.5\nX -> F[+X]F  # comment\nF -> FF\n").unwrap();
+        let t = parse_rule_text(
+            "# plant\naxiom: X\nignore: +-\nn: 5\nangle: 22.5\nX -> F[+X]F  # comment\nF -> FF\n",
+        )
+        .unwrap();
         assert_eq!(t.axiom.as_deref(), Some("X"));
         assert_eq!(t.ignore.as_deref(), Some("+-"));
-        assert_eq!(t.rules, vec!["X -> F[+X]F".to_string(), "F -> FF".to_string()]);
-        assert_eq!(t.directives, vec![("n".into(), "5".into()), ("angle".into(), "22.5".into())]);
+        assert_eq!(
+            t.rules,
+            vec!["X -> F[+X]F".to_string(), "F -> FF".to_string()]
+        );
+        assert_eq!(
+            t.directives,
+            vec![("n".into(), "5".into()), ("angle".into(), "22.5".into())]
+        );
         assert!(parse_rule_text("F -> FF").is_err());
         assert!(parse_rule_text("axiom: F\nrubbish").is_err());
     }

@@ -28,12 +28,22 @@ pub struct Affine {
 impl Affine {
     /// From `[a, b, c, d, e, f]`.
     pub fn from_row(r: [f64; 6]) -> Self {
-        Affine { a: r[0], b: r[1], c: r[2], d: r[3], e: r[4], f: r[5] }
+        Affine {
+            a: r[0],
+            b: r[1],
+            c: r[2],
+            d: r[3],
+            e: r[4],
+            f: r[5],
+        }
     }
     /// Apply to a point.
     #[inline]
     pub fn apply(&self, p: [f64; 2]) -> [f64; 2] {
-        [self.a * p[0] + self.b * p[1] + self.e, self.c * p[0] + self.d * p[1] + self.f]
+        [
+            self.a * p[0] + self.b * p[1] + self.e,
+            self.c * p[0] + self.d * p[1] + self.f,
+        ]
     }
     /// Largest singular value of the linear part.
     pub fn norm(&self) -> f64 {
@@ -53,13 +63,17 @@ impl Affine {
         let r1 = a * a + c * c;
         let r2 = b * b + d * d;
         let scale = r1.max(r2).max(1e-300);
-        ((r1 - r2).abs() <= 1e-9 * scale && (a * b + c * d).abs() <= 1e-9 * scale).then(|| r1.sqrt())
+        ((r1 - r2).abs() <= 1e-9 * scale && (a * b + c * d).abs() <= 1e-9 * scale)
+            .then(|| r1.sqrt())
     }
     /// The fixed point (the map is a contraction, so `I - M` is invertible).
     pub fn fixed_point(&self) -> [f64; 2] {
         let (a, b, c, d) = (1.0 - self.a, -self.b, -self.c, 1.0 - self.d);
         let det = a * d - b * c;
-        [(d * self.e - b * self.f) / det, (a * self.f - c * self.e) / det]
+        [
+            (d * self.e - b * self.f) / det,
+            (a * self.f - c * self.e) / det,
+        ]
     }
 }
 
@@ -87,20 +101,32 @@ impl Ifs {
         for (k, m) in maps.iter().enumerate() {
             let r = [m.a, m.b, m.c, m.d, m.e, m.f];
             if r.iter().any(|v| !v.is_finite()) {
-                return Err(CoreError::invalid("maps", format!("map {k} has a non-finite coefficient")));
+                return Err(CoreError::invalid(
+                    "maps",
+                    format!("map {k} has a non-finite coefficient"),
+                ));
             }
             let n = m.norm();
             if n >= 1.0 {
-                return Err(CoreError::invalid("maps", format!("map {k} is not a contraction (largest singular value {n:.6} >= 1)")));
+                return Err(CoreError::invalid(
+                    "maps",
+                    format!("map {k} is not a contraction (largest singular value {n:.6} >= 1)"),
+                ));
             }
         }
         let w: Vec<f64> = match weights {
             Some(w) => {
                 if w.len() != maps.len() {
-                    return Err(CoreError::invalid("probabilities", format!("expected {} values, got {}", maps.len(), w.len())));
+                    return Err(CoreError::invalid(
+                        "probabilities",
+                        format!("expected {} values, got {}", maps.len(), w.len()),
+                    ));
                 }
                 if w.iter().any(|v| !v.is_finite() || *v < 0.0) {
-                    return Err(CoreError::invalid("probabilities", "values must be finite and >= 0"));
+                    return Err(CoreError::invalid(
+                        "probabilities",
+                        "values must be finite and >= 0",
+                    ));
                 }
                 w.to_vec()
             }
@@ -116,7 +142,10 @@ impl Ifs {
         };
         let total: f64 = w.iter().sum();
         if !(total > 0.0) || !total.is_finite() {
-            return Err(CoreError::invalid("probabilities", format!("must sum to a positive number, got {total}")));
+            return Err(CoreError::invalid(
+                "probabilities",
+                format!("must sum to a positive number, got {total}"),
+            ));
         }
         let probs: Vec<f64> = w.iter().map(|v| v / total).collect();
         let mut acc = 0.0;
@@ -133,7 +162,10 @@ impl Ifs {
 
     /// The rows `[a, b, c, d, e, f]`.
     pub fn rows(&self) -> Vec<[f64; 6]> {
-        self.maps.iter().map(|m| [m.a, m.b, m.c, m.d, m.e, m.f]).collect()
+        self.maps
+            .iter()
+            .map(|m| [m.a, m.b, m.c, m.d, m.e, m.f])
+            .collect()
     }
 
     /// Chaos game: `n` points of the attractor. The orbit is cut into
@@ -144,7 +176,10 @@ impl Ifs {
     pub fn chaos_game(&self, n: usize, seed: u64) -> CoreResult<Vec<[f64; 2]>> {
         const CHAIN: usize = 1 << 16;
         if n > MAX_POINTS {
-            return Err(CoreError::invalid("n_points", format!("at most {MAX_POINTS} points, got {n}")));
+            return Err(CoreError::invalid(
+                "n_points",
+                format!("at most {MAX_POINTS} points, got {n}"),
+            ));
         }
         let start = self.maps[0].fixed_point();
         let n_chains = n.div_ceil(CHAIN);
@@ -157,7 +192,11 @@ impl Ifs {
                 let mut out = Vec::with_capacity(len);
                 for k in 0..len {
                     let u = unit3(cseed, k as u64, 0);
-                    let i = self.cum.iter().position(|&w| u < w).unwrap_or(self.maps.len() - 1);
+                    let i = self
+                        .cum
+                        .iter()
+                        .position(|&w| u < w)
+                        .unwrap_or(self.maps.len() - 1);
                     p = self.maps[i].apply(p);
                     out.push(p);
                 }
@@ -182,7 +221,11 @@ impl Ifs {
         let mut pts = vec![self.maps[0].fixed_point()];
         for _ in 0..depth {
             let prev = pts;
-            let parts: Vec<Vec<[f64; 2]>> = self.maps.par_iter().map(|m| prev.iter().map(|&p| m.apply(p)).collect()).collect();
+            let parts: Vec<Vec<[f64; 2]>> = self
+                .maps
+                .par_iter()
+                .map(|m| prev.iter().map(|&p| m.apply(p)).collect())
+                .collect();
             pts = parts.concat();
         }
         Ok(pts)
@@ -203,14 +246,20 @@ pub fn moran_dimension(ratios: &[f64]) -> CoreResult<f64> {
         return Err(CoreError::invalid("ratios", "need at least one ratio"));
     }
     if ratios.iter().any(|&r| !(r > 0.0 && r < 1.0)) {
-        return Err(CoreError::invalid("ratios", "every ratio must lie in (0, 1)"));
+        return Err(CoreError::invalid(
+            "ratios",
+            "every ratio must lie in (0, 1)",
+        ));
     }
     let f = |s: f64| ratios.iter().map(|r| r.powf(s)).sum::<f64>() - 1.0;
     let (mut lo, mut hi) = (0.0f64, 1.0f64);
     while f(hi) > 0.0 {
         hi *= 2.0;
         if hi > 1e6 {
-            return Err(CoreError::invalid("ratios", "Moran's equation has no root below 1e6"));
+            return Err(CoreError::invalid(
+                "ratios",
+                "Moran's equation has no root below 1e6",
+            ));
         }
     }
     for _ in 0..200 {
@@ -254,15 +303,26 @@ pub fn bounds(points: &[[f64; 2]]) -> [f64; 4] {
 /// `y in [ymin + (rows-1-i) h, ymin + (rows-i) h)` with `w = (xmax - xmin) / cols`,
 /// `h = (ymax - ymin) / rows`; points on the far edges go to the last pixel;
 /// points outside the bounds are dropped.
-pub fn rasterize(points: &[[f64; 2]], rows: usize, cols: usize, b: [f64; 4]) -> CoreResult<Vec<u8>> {
+pub fn rasterize(
+    points: &[[f64; 2]],
+    rows: usize,
+    cols: usize,
+    b: [f64; 4],
+) -> CoreResult<Vec<u8>> {
     if rows == 0 || cols == 0 {
-        return Err(CoreError::invalid("shape", "rows and cols must be positive"));
+        return Err(CoreError::invalid(
+            "shape",
+            "rows and cols must be positive",
+        ));
     }
     if rows.checked_mul(cols).is_none_or(|n| n > 1 << 30) {
         return Err(CoreError::invalid("shape", "the raster is too large"));
     }
     if !b.iter().all(|v| v.is_finite()) || !(b[1] > b[0]) || !(b[3] > b[2]) {
-        return Err(CoreError::invalid("bounds", "expected finite [xmin, xmax, ymin, ymax] with xmax > xmin and ymax > ymin"));
+        return Err(CoreError::invalid(
+            "bounds",
+            "expected finite [xmin, xmax, ymin, ymax] with xmax > xmin and ymax > ymin",
+        ));
     }
     let mut img = vec![0u8; rows * cols];
     let sx = cols as f64 / (b[1] - b[0]);
@@ -280,7 +340,14 @@ pub fn rasterize(points: &[[f64; 2]], rows: usize, cols: usize, b: [f64; 4]) -> 
 }
 
 /// Names of the presets.
-pub const PRESETS: [&str; 6] = ["sierpinski_triangle", "sierpinski_carpet", "barnsley_fern", "koch_curve", "dragon", "vicsek"];
+pub const PRESETS: [&str; 6] = [
+    "sierpinski_triangle",
+    "sierpinski_carpet",
+    "barnsley_fern",
+    "koch_curve",
+    "dragon",
+    "vicsek",
+];
 
 /// A classic IFS by name, with its exact similarity dimension (`None` for the
 /// fern, whose maps are not similarities).
@@ -293,7 +360,11 @@ pub fn preset(name: &str) -> CoreResult<(Ifs, Option<f64>)> {
     };
     let (rows, probs, dim): (Vec<[f64; 6]>, Option<Vec<f64>>, Option<f64>) = match name {
         "sierpinski_triangle" => (
-            vec![[0.5, 0.0, 0.0, 0.5, 0.0, 0.0], [0.5, 0.0, 0.0, 0.5, 0.5, 0.0], [0.5, 0.0, 0.0, 0.5, 0.25, h / 4.0]],
+            vec![
+                [0.5, 0.0, 0.0, 0.5, 0.0, 0.0],
+                [0.5, 0.0, 0.0, 0.5, 0.5, 0.0],
+                [0.5, 0.0, 0.0, 0.5, 0.25, h / 4.0],
+            ],
             None,
             Some(3f64.ln() / 2f64.ln()),
         ),
@@ -319,11 +390,23 @@ pub fn preset(name: &str) -> CoreResult<(Ifs, Option<f64>)> {
             None,
         ),
         "koch_curve" => (
-            vec![rot(0.0, third, 0.0, 0.0), rot(60.0, third, third, 0.0), rot(-60.0, third, 0.5, h / 6.0), rot(0.0, third, 2.0 * third, 0.0)],
+            vec![
+                rot(0.0, third, 0.0, 0.0),
+                rot(60.0, third, third, 0.0),
+                rot(-60.0, third, 0.5, h / 6.0),
+                rot(0.0, third, 2.0 * third, 0.0),
+            ],
             None,
             Some(4f64.ln() / 3f64.ln()),
         ),
-        "dragon" => (vec![[0.5, -0.5, 0.5, 0.5, 0.0, 0.0], [-0.5, -0.5, 0.5, -0.5, 1.0, 0.0]], Some(vec![1.0, 1.0]), Some(2.0)),
+        "dragon" => (
+            vec![
+                [0.5, -0.5, 0.5, 0.5, 0.0, 0.0],
+                [-0.5, -0.5, 0.5, -0.5, 1.0, 0.0],
+            ],
+            Some(vec![1.0, 1.0]),
+            Some(2.0),
+        ),
         "vicsek" => (
             [(1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (2.0, 1.0), (1.0, 2.0)]
                 .iter()
@@ -333,7 +416,13 @@ pub fn preset(name: &str) -> CoreResult<(Ifs, Option<f64>)> {
             Some(5f64.ln() / 3f64.ln()),
         ),
         _ => {
-            return Err(CoreError::invalid("name", format!("unknown preset {name:?}; expected one of {}", PRESETS.join(", "))));
+            return Err(CoreError::invalid(
+                "name",
+                format!(
+                    "unknown preset {name:?}; expected one of {}",
+                    PRESETS.join(", ")
+                ),
+            ));
         }
     };
     Ok((Ifs::new(&rows, probs.as_deref())?, dim))
@@ -347,7 +436,14 @@ mod tests {
 
     /// Least-squares slope of ln N(s) against ln(1/s).
     fn box_dimension(img: &[u8], rows: usize, cols: usize, sizes: &[usize]) -> f64 {
-        let r = box_count(&ByteVolume::new(img, &[rows, cols]).unwrap(), 2, sizes, 1, Anchor::BoundingBox).unwrap();
+        let r = box_count(
+            &ByteVolume::new(img, &[rows, cols]).unwrap(),
+            2,
+            sizes,
+            1,
+            Anchor::BoundingBox,
+        )
+        .unwrap();
         let xs: Vec<f64> = r.box_sizes.iter().map(|&s| -(s as f64).ln()).collect();
         let ys: Vec<f64> = r.counts.iter().map(|c| (c[0] as f64).ln()).collect();
         let n = xs.len() as f64;
@@ -372,9 +468,15 @@ mod tests {
     fn presets_have_their_similarity_dimension() {
         for name in PRESETS {
             let (ifs, d) = preset(name).unwrap();
-            assert_eq!(ifs.similarity_dimension(), d.map(|_| ifs.similarity_dimension().unwrap()));
+            assert_eq!(
+                ifs.similarity_dimension(),
+                d.map(|_| ifs.similarity_dimension().unwrap())
+            );
             if let Some(d) = d {
-                assert!((ifs.similarity_dimension().unwrap() - d).abs() < 1e-12, "{name}");
+                assert!(
+                    (ifs.similarity_dimension().unwrap() - d).abs() < 1e-12,
+                    "{name}"
+                );
             }
         }
         assert!(preset("nope").is_err());
@@ -393,11 +495,46 @@ mod tests {
     #[allow(clippy::type_complexity)]
     fn box_counting_matches_similarity_dimension() {
         let cases: [(&str, usize, usize, [f64; 4], &[usize], f64); 5] = [
-            ("sierpinski_triangle", 11, 1024, [0.0, 1.0, 0.0, 1.0], &[4, 8, 16, 32, 64, 128], 0.03),
-            ("sierpinski_carpet", 7, 729, [-1e-9, 1.0 - 1e-9, -1e-9, 1.0 - 1e-9], &[3, 9, 27, 81], 1e-3),
-            ("vicsek", 7, 729, [-1e-9, 1.0 - 1e-9, -1e-9, 1.0 - 1e-9], &[3, 9, 27, 81], 1e-3),
-            ("koch_curve", 10, 2187, [-1e-9, 1.0 - 1e-9, -0.5, 0.5], &[3, 9, 27, 81, 243], 0.04),
-            ("dragon", 22, 2048, [-0.4, 1.3, -0.5, 1.2], &[2, 4, 8, 16, 32], 0.15),
+            (
+                "sierpinski_triangle",
+                11,
+                1024,
+                [0.0, 1.0, 0.0, 1.0],
+                &[4, 8, 16, 32, 64, 128],
+                0.03,
+            ),
+            (
+                "sierpinski_carpet",
+                7,
+                729,
+                [-1e-9, 1.0 - 1e-9, -1e-9, 1.0 - 1e-9],
+                &[3, 9, 27, 81],
+                1e-3,
+            ),
+            (
+                "vicsek",
+                7,
+                729,
+                [-1e-9, 1.0 - 1e-9, -1e-9, 1.0 - 1e-9],
+                &[3, 9, 27, 81],
+                1e-3,
+            ),
+            (
+                "koch_curve",
+                10,
+                2187,
+                [-1e-9, 1.0 - 1e-9, -0.5, 0.5],
+                &[3, 9, 27, 81, 243],
+                0.04,
+            ),
+            (
+                "dragon",
+                22,
+                2048,
+                [-0.4, 1.3, -0.5, 1.2],
+                &[2, 4, 8, 16, 32],
+                0.15,
+            ),
         ];
         for (name, depth, n, b, sizes, tol) in cases {
             let (ifs, d) = preset(name).unwrap();
@@ -405,7 +542,10 @@ mod tests {
             let img = rasterize(&pts, n, n, b).unwrap();
             let est = box_dimension(&img, n, n, sizes);
             let d = d.unwrap();
-            eprintln!("{name}: box-counting {est:.4}, similarity {d:.4}, error {:.4}", (est - d).abs());
+            eprintln!(
+                "{name}: box-counting {est:.4}, similarity {d:.4}, error {:.4}",
+                (est - d).abs()
+            );
             assert!((est - d).abs() < tol, "{name}: {est} vs {d}");
         }
     }
@@ -417,26 +557,42 @@ mod tests {
         let b = run_in_pool(Some(3), || ifs.chaos_game(300_000, 7)).unwrap();
         assert_eq!(a, b);
         assert_ne!(a, ifs.chaos_game(300_000, 8).unwrap());
-        assert!(ifs.chaos_game(MAX_POINTS + 1, 8).unwrap_err().to_string().starts_with("n_points:"));
+        assert!(ifs
+            .chaos_game(MAX_POINTS + 1, 8)
+            .unwrap_err()
+            .to_string()
+            .starts_with("n_points:"));
         let img = rasterize(&a, 512, 512, [0.0, 1.0, 0.0, 1.0]).unwrap();
         let est = box_dimension(&img, 512, 512, &[4, 8, 16, 32, 64]);
         assert!((est - d.unwrap()).abs() < 0.05, "{est}");
         // the fern: every point stays in its known box
         let (fern, _) = preset("barnsley_fern").unwrap();
         let pts = fern.chaos_game(100_000, 1).unwrap();
-        assert!(pts.iter().all(|p| p[0] > -2.2 && p[0] < 2.7 && p[1] >= 0.0 && p[1] < 10.0));
+        assert!(pts
+            .iter()
+            .all(|p| p[0] > -2.2 && p[0] < 2.7 && p[1] >= 0.0 && p[1] < 10.0));
         assert!(fern.similarity_dimension().is_none());
     }
 
     #[test]
     fn bad_ifs_input() {
         assert!(Ifs::new(&[], None).is_err());
-        assert!(Ifs::new(&[[1.0, 0.0, 0.0, 1.0, 0.0, 0.0]], None).unwrap_err().to_string().starts_with("maps:"));
-        assert!(Ifs::new(&[[0.5, 0.0, 0.0, 0.5, 0.0, 0.0]], Some(&[0.0])).unwrap_err().to_string().starts_with("probabilities:"));
+        assert!(Ifs::new(&[[1.0, 0.0, 0.0, 1.0, 0.0, 0.0]], None)
+            .unwrap_err()
+            .to_string()
+            .starts_with("maps:"));
+        assert!(Ifs::new(&[[0.5, 0.0, 0.0, 0.5, 0.0, 0.0]], Some(&[0.0]))
+            .unwrap_err()
+            .to_string()
+            .starts_with("probabilities:"));
         assert!(Ifs::new(&[[0.5, 0.0, 0.0, 0.5, 0.0, 0.0]], Some(&[-1.0])).is_err());
         assert!(Ifs::new(&[[0.5, 0.0, 0.0, 0.5, 0.0, 0.0]], Some(&[1.0, 1.0])).is_err());
         let (ifs, _) = preset("sierpinski_carpet").unwrap();
-        assert!(ifs.iterate(20, 1 << 20).unwrap_err().to_string().starts_with("depth:"));
+        assert!(ifs
+            .iterate(20, 1 << 20)
+            .unwrap_err()
+            .to_string()
+            .starts_with("depth:"));
         assert!(rasterize(&[[0.0, 0.0]], 0, 4, [0.0, 1.0, 0.0, 1.0]).is_err());
         assert!(rasterize(&[[0.0, 0.0]], 4, 4, [0.0, 0.0, 0.0, 1.0]).is_err());
     }

@@ -45,20 +45,39 @@ pub struct Mesh {
 
 impl Mesh {
     /// Append `other` moved by `f` (applied to points) and `g` (to normals).
-    pub fn append_transformed(&mut self, other: &Mesh, instance: u32, f: impl Fn(DVec3) -> DVec3, g: impl Fn(DVec3) -> DVec3) -> CoreResult<()> {
+    pub fn append_transformed(
+        &mut self,
+        other: &Mesh,
+        instance: u32,
+        f: impl Fn(DVec3) -> DVec3,
+        g: impl Fn(DVec3) -> DVec3,
+    ) -> CoreResult<()> {
         let base = self.vertices.len();
         if base + other.vertices.len() > u32::MAX as usize {
-            return Err(CoreError::invalid("n_plants", "the scene has more than 2^32 vertices"));
+            return Err(CoreError::invalid(
+                "n_plants",
+                "the scene has more than 2^32 vertices",
+            ));
         }
         let b = base as u32;
-        self.vertices.extend(other.vertices.iter().map(|v| f(DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64)).as_vec3().to_array()));
-        self.normals.extend(other.normals.iter().map(|v| g(DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64)).as_vec3().to_array()));
+        self.vertices.extend(other.vertices.iter().map(|v| {
+            f(DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64))
+                .as_vec3()
+                .to_array()
+        }));
+        self.normals.extend(other.normals.iter().map(|v| {
+            g(DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64))
+                .as_vec3()
+                .to_array()
+        }));
         self.uvs.extend_from_slice(&other.uvs);
-        self.faces.extend(other.faces.iter().map(|t| [t[0] + b, t[1] + b, t[2] + b]));
+        self.faces
+            .extend(other.faces.iter().map(|t| [t[0] + b, t[1] + b, t[2] + b]));
         self.part_ids.extend_from_slice(&other.part_ids);
         self.kinds.extend_from_slice(&other.kinds);
         self.colors.extend_from_slice(&other.colors);
-        self.instances.extend(std::iter::repeat_n(instance, other.faces.len()));
+        self.instances
+            .extend(std::iter::repeat_n(instance, other.faces.len()));
         Ok(())
     }
 }
@@ -90,7 +109,10 @@ impl MeshBuilder {
     /// A builder for tubes of `sides` (3 to 64) sides.
     pub fn new(sides: usize) -> CoreResult<Self> {
         if !(3..=64).contains(&sides) {
-            return Err(CoreError::invalid("sides", format!("must be between 3 and 64, got {sides}")));
+            return Err(CoreError::invalid(
+                "sides",
+                format!("must be between 3 and 64, got {sides}"),
+            ));
         }
         let cos_sin = (0..=sides)
             .map(|j| {
@@ -98,7 +120,14 @@ impl MeshBuilder {
                 (t.cos(), t.sin())
             })
             .collect();
-        Ok(MeshBuilder { sides, cos_sin, rings: Vec::new(), tubes: Vec::new(), leaves: Mesh::default(), n_leaves: 0 })
+        Ok(MeshBuilder {
+            sides,
+            cos_sin,
+            rings: Vec::new(),
+            tubes: Vec::new(),
+            leaves: Mesh::default(),
+            n_leaves: 0,
+        })
     }
 
     /// Reserve room for `n` segments and `starts` tube starts.
@@ -108,7 +137,13 @@ impl MeshBuilder {
     }
 
     fn ring(&mut self, center: DVec3, axis: DVec3, reference: DVec3, radius: f64, v: f64) -> u32 {
-        self.rings.push(Ring { center, axis, reference, radius, v });
+        self.rings.push(Ring {
+            center,
+            axis,
+            reference,
+            radius,
+            v,
+        });
         (self.rings.len() - 1) as u32
     }
 
@@ -118,7 +153,10 @@ impl MeshBuilder {
         let k1 = self.sides + 1;
         let n_tube_v = self.rings.len() * k1;
         if n_tube_v + self.leaves.vertices.len() > u32::MAX as usize {
-            return Err(CoreError::invalid("lstring", "the mesh has more than 2^32 vertices"));
+            return Err(CoreError::invalid(
+                "lstring",
+                "the mesh has more than 2^32 vertices",
+            ));
         }
         let mut m = Mesh {
             vertices: vec![[0.0; 3]; n_tube_v],
@@ -213,7 +251,11 @@ impl Sink for MeshBuilder {
         let mut nrm = DVec3::ZERO;
         for k in 0..pts.len() {
             let (a, b) = (pts[k], pts[(k + 1) % pts.len()]);
-            nrm += DVec3::new((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y));
+            nrm += DVec3::new(
+                (a.y - b.y) * (a.z + b.z),
+                (a.z - b.z) * (a.x + b.x),
+                (a.x - b.x) * (a.y + b.y),
+            );
         }
         let m = nrm.length();
         if !(m > 1e-12) {
@@ -239,7 +281,13 @@ impl Sink for MeshBuilder {
         for (p, c) in pts.iter().zip(&uv) {
             self.leaves.vertices.push(p.as_vec3().to_array());
             self.leaves.normals.push(nrm.as_vec3().to_array());
-            let u = |k: usize| if hi[k] > lo[k] { ((c[k] - lo[k]) / (hi[k] - lo[k])) as f32 } else { 0.0 };
+            let u = |k: usize| {
+                if hi[k] > lo[k] {
+                    ((c[k] - lo[k]) / (hi[k] - lo[k])) as f32
+                } else {
+                    0.0
+                }
+            };
             self.leaves.uvs.push([u(0), u(1)]);
         }
         let part = self.n_leaves;
@@ -296,13 +344,23 @@ mod tests {
             // radius 0.5 around the z axis, normal = radial direction
             let r = (v[0] * v[0] + v[1] * v[1]).sqrt();
             assert!((r - 0.5).abs() < 1e-6);
-            assert!((n[0] - v[0] / r).abs() < 1e-6 && (n[1] - v[1] / r).abs() < 1e-6 && n[2].abs() < 1e-6);
+            assert!(
+                (n[0] - v[0] / r).abs() < 1e-6
+                    && (n[1] - v[1] / r).abs() < 1e-6
+                    && n[2].abs() < 1e-6
+            );
         }
         for f in &m.faces {
-            let p: Vec<DVec3> = f.iter().map(|&i| DVec3::from_array(m.vertices[i as usize].map(|x| x as f64))).collect();
+            let p: Vec<DVec3> = f
+                .iter()
+                .map(|&i| DVec3::from_array(m.vertices[i as usize].map(|x| x as f64)))
+                .collect();
             let n = (p[1] - p[0]).cross(p[2] - p[0]);
             let c = (p[0] + p[1] + p[2]) / 3.0;
-            assert!(n.dot(DVec3::new(c.x, c.y, 0.0)) > 0.0, "triangle faces inwards");
+            assert!(
+                n.dot(DVec3::new(c.x, c.y, 0.0)) > 0.0,
+                "triangle faces inwards"
+            );
         }
         let vs: Vec<f32> = m.uvs.iter().map(|t| t[1]).collect();
         assert_eq!(vs[0], 0.0);
@@ -330,7 +388,9 @@ mod tests {
         assert_eq!(m.kinds, vec![KIND_LEAF, KIND_LEAF]);
         // the square lies in the x-z plane: normal along +-y
         assert!((m.normals[0][1].abs() - 1.0).abs() < 1e-6);
-        assert!(m.uvs.iter().all(|t| (0.0..=1.0).contains(&t[0]) && (0.0..=1.0).contains(&t[1])));
+        assert!(m
+            .uvs
+            .iter()
+            .all(|t| (0.0..=1.0).contains(&t[0]) && (0.0..=1.0).contains(&t[1])));
     }
 }
-

@@ -35,37 +35,68 @@ fn bilinear(dem: &[f64], rows: usize, cols: usize, r: f64, c: f64) -> f64 {
     let c0 = (c.floor() as usize).min(cols.saturating_sub(2));
     let r1 = (r0 + 1).min(rows - 1);
     let c1 = (c0 + 1).min(cols - 1);
-    let (tr, tc) = ((r - r0 as f64).clamp(0.0, 1.0), (c - c0 as f64).clamp(0.0, 1.0));
+    let (tr, tc) = (
+        (r - r0 as f64).clamp(0.0, 1.0),
+        (c - c0 as f64).clamp(0.0, 1.0),
+    );
     let z = |i: usize, j: usize| dem[i * cols + j];
-    (1.0 - tr) * ((1.0 - tc) * z(r0, c0) + tc * z(r0, c1)) + tr * ((1.0 - tc) * z(r1, c0) + tc * z(r1, c1))
+    (1.0 - tr) * ((1.0 - tc) * z(r0, c0) + tc * z(r0, c1))
+        + tr * ((1.0 - tc) * z(r1, c0) + tc * z(r1, c1))
 }
 
 /// Place plants of `lsystem` on the DEM (C order, `rows x cols`); returns
 /// the scene mesh (instance ids per triangle) and the base point of every
 /// plant placed.
-pub fn plants_on_terrain(lsystem: &LSystem, dem: &[f64], rows: usize, cols: usize, p: &SceneParams) -> CoreResult<(Mesh, Vec<[f64; 3]>)> {
+pub fn plants_on_terrain(
+    lsystem: &LSystem,
+    dem: &[f64],
+    rows: usize,
+    cols: usize,
+    p: &SceneParams,
+) -> CoreResult<(Mesh, Vec<[f64; 3]>)> {
     if rows < 2 || cols < 2 || dem.len() != rows * cols {
-        return Err(CoreError::invalid("dem", "expected a 2D array of at least 2 x 2 cells"));
+        return Err(CoreError::invalid(
+            "dem",
+            "expected a 2D array of at least 2 x 2 cells",
+        ));
     }
     if !(p.cell_size > 0.0 && p.cell_size.is_finite()) {
-        return Err(CoreError::invalid("cell_size", format!("must be positive and finite, got {}", p.cell_size)));
+        return Err(CoreError::invalid(
+            "cell_size",
+            format!("must be positive and finite, got {}", p.cell_size),
+        ));
     }
     if !(p.density >= 0.0 && p.density.is_finite()) {
-        return Err(CoreError::invalid("density", format!("must be >= 0 and finite, got {}", p.density)));
+        return Err(CoreError::invalid(
+            "density",
+            format!("must be >= 0 and finite, got {}", p.density),
+        ));
     }
     if !(p.scale > 0.0 && p.scale.is_finite()) {
-        return Err(CoreError::invalid("scale", format!("must be positive and finite, got {}", p.scale)));
+        return Err(CoreError::invalid(
+            "scale",
+            format!("must be positive and finite, got {}", p.scale),
+        ));
     }
     if dem.iter().any(|v| v.is_infinite()) {
-        return Err(CoreError::invalid("dem", "heights must be finite or NaN (nodata)"));
+        return Err(CoreError::invalid(
+            "dem",
+            "heights must be finite or NaN (nodata)",
+        ));
     }
     p.turtle.validate()?;
-    let (w, h) = ((cols - 1) as f64 * p.cell_size, (rows - 1) as f64 * p.cell_size);
+    let (w, h) = (
+        (cols - 1) as f64 * p.cell_size,
+        (rows - 1) as f64 * p.cell_size,
+    );
     let n_plants = (p.density * w * h).round();
     if n_plants > p.max_plants as f64 {
         return Err(CoreError::invalid(
             "density",
-            format!("{n_plants} plants is more than max_plants={}; lower the density", p.max_plants),
+            format!(
+                "{n_plants} plants is more than max_plants={}; lower the density",
+                p.max_plants
+            ),
         ));
     }
     let n_plants = n_plants as usize;
@@ -79,7 +110,11 @@ pub fn plants_on_terrain(lsystem: &LSystem, dem: &[f64], rows: usize, cols: usiz
             if z.is_nan() {
                 return Ok(None);
             }
-            let base = DVec3::new((c + 0.5) * p.cell_size, (rows as f64 - r - 0.5) * p.cell_size, z);
+            let base = DVec3::new(
+                (c + 0.5) * p.cell_size,
+                (rows as f64 - r - 0.5) * p.cell_size,
+                z,
+            );
             let s = lsystem.derive_with_seed(p.n, hash3(p.seed, i64_, 3))?;
             let m = build_mesh(&s, &p.turtle, p.sides)?;
             let q = DQuat::from_rotation_z(std::f64::consts::TAU * unit3(p.seed, i64_, 4));
@@ -106,7 +141,11 @@ mod tests {
 
     #[test]
     fn scene_is_seeded_and_sits_on_the_dem() {
-        let rules = vec!["F -(1)-> F[+F]F".to_string(), "F -(1)-> F[-F]F".to_string(), "F -(1)-> FF".to_string()];
+        let rules = vec![
+            "F -(1)-> F[+F]F".to_string(),
+            "F -(1)-> F[-F]F".to_string(),
+            "F -(1)-> FF".to_string(),
+        ];
         let l = LSystem::new("F", &rules, "", 0, DEFAULT_MAX_LENGTH).unwrap();
         let (rows, cols) = (11, 21);
         // a plane z = 2 x + 3 y + 5 (bilinear interpolation is exact on it)
@@ -140,7 +179,13 @@ mod tests {
         assert_eq!(*a.instances.iter().max().unwrap(), 39);
         // plants differ (stochastic rules, own seeds)
         let tri_of = |k: u32| a.instances.iter().filter(|&&i| i == k).count();
-        assert!((0..40).map(tri_of).collect::<std::collections::HashSet<_>>().len() > 1);
+        assert!(
+            (0..40)
+                .map(tri_of)
+                .collect::<std::collections::HashSet<_>>()
+                .len()
+                > 1
+        );
         // nodata holes drop plants; errors name the parameter
         let mut holes = dem.clone();
         for v in holes.iter_mut().take(cols * 6) {
@@ -148,9 +193,21 @@ mod tests {
         }
         let (_, bh) = plants_on_terrain(&l, &holes, rows, cols, &p).unwrap();
         assert!(bh.len() < 40 && !bh.is_empty());
-        let bad = SceneParams { density: -1.0, ..p.clone() };
-        assert!(plants_on_terrain(&l, &dem, rows, cols, &bad).unwrap_err().to_string().starts_with("density:"));
-        let bad = SceneParams { density: 100.0, ..p };
-        assert!(plants_on_terrain(&l, &dem, rows, cols, &bad).unwrap_err().to_string().starts_with("density:"));
+        let bad = SceneParams {
+            density: -1.0,
+            ..p.clone()
+        };
+        assert!(plants_on_terrain(&l, &dem, rows, cols, &bad)
+            .unwrap_err()
+            .to_string()
+            .starts_with("density:"));
+        let bad = SceneParams {
+            density: 100.0,
+            ..p
+        };
+        assert!(plants_on_terrain(&l, &dem, rows, cols, &bad)
+            .unwrap_err()
+            .to_string()
+            .starts_with("density:"));
     }
 }

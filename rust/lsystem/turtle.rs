@@ -66,27 +66,51 @@ impl TurtleParams {
     /// Defaults in space: heading +z (up), left -x, up -y; turns with `+`
     /// and `-` alone draw in the x-z plane as [`TurtleParams::planar`] does in x-y.
     pub fn spatial(angle: f64, step: f64) -> Self {
-        TurtleParams { heading: DVec3::Z, left: DVec3::NEG_X, ..Self::planar(angle, step) }
+        TurtleParams {
+            heading: DVec3::Z,
+            left: DVec3::NEG_X,
+            ..Self::planar(angle, step)
+        }
     }
     /// Check the values; errors name the parameter.
     pub fn validate(&self) -> CoreResult<()> {
-        for (name, v) in [("angle", self.angle), ("step", self.step), ("width", self.width), ("width_factor", self.width_factor), ("elasticity", self.elasticity)] {
+        for (name, v) in [
+            ("angle", self.angle),
+            ("step", self.step),
+            ("width", self.width),
+            ("width_factor", self.width_factor),
+            ("elasticity", self.elasticity),
+        ] {
             if !v.is_finite() {
                 return Err(CoreError::invalid(name, format!("must be finite, got {v}")));
             }
         }
         if self.step <= 0.0 {
-            return Err(CoreError::invalid("step", format!("must be positive, got {}", self.step)));
+            return Err(CoreError::invalid(
+                "step",
+                format!("must be positive, got {}", self.step),
+            ));
         }
         if self.width < 0.0 {
-            return Err(CoreError::invalid("width", format!("must be >= 0, got {}", self.width)));
+            return Err(CoreError::invalid(
+                "width",
+                format!("must be >= 0, got {}", self.width),
+            ));
         }
         if !self.tropism.is_finite() {
             return Err(CoreError::invalid("tropism", "must be finite"));
         }
         let (h, l) = (self.heading, self.left);
-        if !h.is_finite() || !l.is_finite() || h.length() < 1e-12 || l.length() < 1e-12 || h.normalize().dot(l.normalize()).abs() > 1e-9 {
-            return Err(CoreError::invalid("heading", "heading and left must be finite, nonzero and perpendicular"));
+        if !h.is_finite()
+            || !l.is_finite()
+            || h.length() < 1e-12
+            || l.length() < 1e-12
+            || h.normalize().dot(l.normalize()).abs() > 1e-9
+        {
+            return Err(CoreError::invalid(
+                "heading",
+                "heading and left must be finite, nonzero and perpendicular",
+            ));
         }
         Ok(())
     }
@@ -132,7 +156,15 @@ pub fn interpret<S: Sink>(s: &ModString, p: &TurtleParams, sink: &mut S) -> Core
     p.validate()?;
     let h = p.heading.normalize();
     let l = p.left.normalize();
-    let mut st = State { pos: DVec3::ZERO, h, l, u: h.cross(l), width: p.width, color: 0, tag: NO_TAG };
+    let mut st = State {
+        pos: DVec3::ZERO,
+        h,
+        l,
+        u: h.cross(l),
+        width: p.width,
+        color: 0,
+        tag: NO_TAG,
+    };
     let mut stack: Vec<State> = Vec::new();
     let mut polys: Vec<Poly> = Vec::new();
     let (ds, dc) = p.angle.to_radians().sin_cos();
@@ -148,7 +180,11 @@ pub fn interpret<S: Sink>(s: &ModString, p: &TurtleParams, sink: &mut S) -> Core
     for i in 0..s.len() {
         let c = s.syms[i];
         let prm = s.params(i);
-        let (dr, mv) = if (c as u32) < 128 { (draw_ascii[c as usize], move_ascii[c as usize]) } else { (is_draw(c), is_move(c)) };
+        let (dr, mv) = if (c as u32) < 128 {
+            (draw_ascii[c as usize], move_ascii[c as usize])
+        } else {
+            (is_draw(c), is_move(c))
+        };
         if dr || mv {
             let len = prm.first().copied().unwrap_or(p.step);
             let mut to = st;
@@ -223,7 +259,9 @@ pub fn interpret<S: Sink>(s: &ModString, p: &TurtleParams, sink: &mut S) -> Core
                 st.tag = NO_TAG; // a branch starts its own tube
             }
             ']' => {
-                st = stack.pop().ok_or_else(|| CoreError::invalid("lstring", format!("unbalanced ']' at module {i}")))?;
+                st = stack.pop().ok_or_else(|| {
+                    CoreError::invalid("lstring", format!("unbalanced ']' at module {i}"))
+                })?;
                 sink.pen_up();
             }
             '!' => {
@@ -239,15 +277,25 @@ pub fn interpret<S: Sink>(s: &ModString, p: &TurtleParams, sink: &mut S) -> Core
                     None => st.color.saturating_add(1),
                 };
             }
-            '{' => polys.push(Poly { dots: Vec::new(), auto: vec![st.pos], color: st.color }),
+            '{' => polys.push(Poly {
+                dots: Vec::new(),
+                auto: vec![st.pos],
+                color: st.color,
+            }),
             '.' => {
                 if let Some(poly) = polys.last_mut() {
                     poly.dots.push(st.pos);
                 }
             }
             '}' => {
-                let poly = polys.pop().ok_or_else(|| CoreError::invalid("lstring", format!("unbalanced '}}' at module {i}")))?;
-                let pts = if poly.dots.is_empty() { poly.auto } else { poly.dots };
+                let poly = polys.pop().ok_or_else(|| {
+                    CoreError::invalid("lstring", format!("unbalanced '}}' at module {i}"))
+                })?;
+                let pts = if poly.dots.is_empty() {
+                    poly.auto
+                } else {
+                    poly.dots
+                };
                 if pts.len() >= 3 {
                     sink.polygon(&pts, poly.color);
                 }
@@ -257,7 +305,10 @@ pub fn interpret<S: Sink>(s: &ModString, p: &TurtleParams, sink: &mut S) -> Core
         }
     }
     if !stack.is_empty() {
-        return Err(CoreError::invalid("lstring", "unbalanced '[': the string ends inside a branch"));
+        return Err(CoreError::invalid(
+            "lstring",
+            "unbalanced '[': the string ends inside a branch",
+        ));
     }
     Ok(())
 }
@@ -332,7 +383,8 @@ impl Sink for Segments {
         0
     }
     fn polygon(&mut self, pts: &[DVec3], _color: u32) {
-        self.polygons.push(pts.iter().map(|p| p.to_array()).collect());
+        self.polygons
+            .push(pts.iter().map(|p| p.to_array()).collect());
     }
 }
 
@@ -358,7 +410,10 @@ mod tests {
 
     fn derive(axiom: &str, rules: &[&str], n: usize) -> ModString {
         let r: Vec<String> = rules.iter().map(|s| s.to_string()).collect();
-        LSystem::new(axiom, &r, "", 0, DEFAULT_MAX_LENGTH).unwrap().derive(n).unwrap()
+        LSystem::new(axiom, &r, "", 0, DEFAULT_MAX_LENGTH)
+            .unwrap()
+            .derive(n)
+            .unwrap()
     }
 
     #[test]
@@ -368,7 +423,10 @@ mod tests {
         assert_eq!(p.offsets, vec![0, 5]);
         let want = [[0.0, 0.0], [0.0, 2.0], [-2.0, 2.0], [-2.0, 0.0], [0.0, 0.0]];
         for (a, b) in p.xy.iter().zip(want) {
-            assert!((a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12, "{a:?} {b:?}");
+            assert!(
+                (a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12,
+                "{a:?} {b:?}"
+            );
         }
         // f lifts the pen, brackets restore the position
         let s = parse_module_string("F[+F]fF(3)", "axiom").unwrap();
@@ -408,10 +466,16 @@ mod tests {
     fn bad_turtle_input() {
         let s = parse_module_string("F", "axiom").unwrap();
         let mut p = TurtleParams::planar(90.0, 0.0);
-        assert!(polylines(&s, &p).unwrap_err().to_string().starts_with("step:"));
+        assert!(polylines(&s, &p)
+            .unwrap_err()
+            .to_string()
+            .starts_with("step:"));
         p.step = 1.0;
         p.angle = f64::NAN;
-        assert!(polylines(&s, &p).unwrap_err().to_string().starts_with("angle:"));
+        assert!(polylines(&s, &p)
+            .unwrap_err()
+            .to_string()
+            .starts_with("angle:"));
     }
 }
 
@@ -434,7 +498,10 @@ mod hilbert_tests {
         .iter()
         .map(|s| s.to_string())
         .collect();
-        let s = LSystem::new("A", &rules, "", 0, DEFAULT_MAX_LENGTH).unwrap().derive(2).unwrap();
+        let s = LSystem::new("A", &rules, "", 0, DEFAULT_MAX_LENGTH)
+            .unwrap()
+            .derive(2)
+            .unwrap();
         let seg = segments(&s, &TurtleParams::spatial(90.0, 1.0)).unwrap();
         assert_eq!(seg.starts.len(), 63);
         let mut seen = HashSet::new();

@@ -65,13 +65,22 @@ fn key(p: &RefineParams, phase: u64) -> StreamKey {
 
 fn check(p: &RefineParams) -> CoreResult<()> {
     if !(p.hurst > 0.0 && p.hurst < 1.0) {
-        return Err(CoreError::invalid("hurst", format!("expected a number in (0, 1), got {}", p.hurst)));
+        return Err(CoreError::invalid(
+            "hurst",
+            format!("expected a number in (0, 1), got {}", p.hurst),
+        ));
     }
     if !(p.sigma.is_finite() && p.sigma >= 0.0) {
-        return Err(CoreError::invalid("sigma", format!("expected a finite number >= 0, got {}", p.sigma)));
+        return Err(CoreError::invalid(
+            "sigma",
+            format!("expected a finite number >= 0, got {}", p.sigma),
+        ));
     }
     if !(p.coarse_spacing.is_finite() && p.coarse_spacing > 0.0) {
-        return Err(CoreError::invalid("coarse_spacing", format!("expected a positive number, got {}", p.coarse_spacing)));
+        return Err(CoreError::invalid(
+            "coarse_spacing",
+            format!("expected a positive number, got {}", p.coarse_spacing),
+        ));
     }
     Ok(())
 }
@@ -93,7 +102,10 @@ pub fn refine_1d(coarse: &[f64], p: &RefineParams) -> CoreResult<Vec<f64>> {
     check(p)?;
     let n = coarse.len();
     if n < 1 || (!p.periodic && n < 2) {
-        return Err(CoreError::invalid("coarse", format!("need at least 2 samples, got {n}")));
+        return Err(CoreError::invalid(
+            "coarse",
+            format!("need at least 2 samples, got {n}"),
+        ));
     }
     let m = if p.periodic { 2 * n } else { 2 * n - 1 };
     // delta = sigma * (s/2)^H * k: the new neighbour distance is s/2.
@@ -102,25 +114,31 @@ pub fn refine_1d(coarse: &[f64], p: &RefineParams) -> CoreResult<Vec<f64>> {
     let ka = key(p, PHASE_ADD);
     let o = p.origin.1;
     let mut out = vec![0.0; m];
-    out.par_chunks_mut(1 << 12).enumerate().for_each(|(ci, chunk)| {
-        let base = ci << 12;
-        for (j, v) in chunk.iter_mut().enumerate() {
-            let i = base + j;
-            let g = o + i as u64;
-            let mut x = if i % 2 == 0 {
-                coarse[i / 2]
-            } else {
-                let a = coarse[i / 2];
-                let b = coarse[(i / 2 + 1) % n];
-                let mid = 0.5 * (a + b);
-                if p.additions { mid } else { mid + delta * kd.normal(g) }
-            };
-            if p.additions {
-                x += delta * ka.normal(g);
+    out.par_chunks_mut(1 << 12)
+        .enumerate()
+        .for_each(|(ci, chunk)| {
+            let base = ci << 12;
+            for (j, v) in chunk.iter_mut().enumerate() {
+                let i = base + j;
+                let g = o + i as u64;
+                let mut x = if i % 2 == 0 {
+                    coarse[i / 2]
+                } else {
+                    let a = coarse[i / 2];
+                    let b = coarse[(i / 2 + 1) % n];
+                    let mid = 0.5 * (a + b);
+                    if p.additions {
+                        mid
+                    } else {
+                        mid + delta * kd.normal(g)
+                    }
+                };
+                if p.additions {
+                    x += delta * ka.normal(g);
+                }
+                *v = x;
             }
-            *v = x;
-        }
-    });
+        });
     Ok(out)
 }
 
@@ -134,21 +152,39 @@ pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2
     check(p)?;
     let (r, c) = coarse.dim();
     if !p.periodic && (r < 2 || c < 2) {
-        return Err(CoreError::invalid("coarse", format!("need at least 2 x 2 samples, got {r} x {c}")));
+        return Err(CoreError::invalid(
+            "coarse",
+            format!("need at least 2 x 2 samples, got {r} x {c}"),
+        ));
     }
     if p.periodic && (r < 1 || c < 1) {
         return Err(CoreError::invalid("coarse", "empty grid"));
     }
     let coarse = coarse.as_standard_layout();
-    let cs: &[f64] = coarse.as_slice().ok_or_else(|| CoreError::Internal("coarse grid not contiguous".into()))?;
-    let (fr, fc) = if p.periodic { (2 * r, 2 * c) } else { (2 * r - 1, 2 * c - 1) };
+    let cs: &[f64] = coarse
+        .as_slice()
+        .ok_or_else(|| CoreError::Internal("coarse grid not contiguous".into()))?;
+    let (fr, fc) = if p.periodic {
+        (2 * r, 2 * c)
+    } else {
+        (2 * r - 1, 2 * c - 1)
+    };
     let s = p.coarse_spacing;
     let kk = k2(p.hurst, p.additions);
     // Diamond step: the coarse side is s; square step: the lattice side is s / sqrt 2.
     let delta_d = p.sigma * s.powf(p.hurst) * kk;
     let delta_s = p.sigma * s.powf(p.hurst) * 2f64.powf(-p.hurst / 2.0) * kk;
-    let (kd, ka, ks, kas) = (key(p, PHASE_DISPLACE), key(p, PHASE_ADD), key(p, PHASE_DISPLACE_SQ), key(p, PHASE_ADD_SQ));
-    let (o0, o1, gc) = (p.origin.0, p.origin.1, p.global_cols.max((p.origin.1) + fc as u64));
+    let (kd, ka, ks, kas) = (
+        key(p, PHASE_DISPLACE),
+        key(p, PHASE_ADD),
+        key(p, PHASE_DISPLACE_SQ),
+        key(p, PHASE_ADD_SQ),
+    );
+    let (o0, o1, gc) = (
+        p.origin.0,
+        p.origin.1,
+        p.global_cols.max((p.origin.1) + fc as u64),
+    );
     let add = p.additions;
 
     // Pass A (diamond step): old samples and cell centres, row by row.
@@ -160,7 +196,11 @@ pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2
             let crow = &cs[a * c..(a + 1) * c];
             for (b, v) in crow.iter().enumerate() {
                 let j = 2 * b;
-                row[j] = if add { v + delta_d * ka.normal(gbase + j as u64) } else { *v };
+                row[j] = if add {
+                    v + delta_d * ka.normal(gbase + j as u64)
+                } else {
+                    *v
+                };
             }
         } else {
             let a1 = if a + 1 == r { 0 } else { a + 1 };
@@ -171,7 +211,11 @@ pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2
                 let b1 = if b + 1 == c { 0 } else { b + 1 };
                 let mean = 0.25 * (r0[b] + r0[b1] + r1[b] + r1[b1]);
                 let g = gbase + j as u64;
-                row[j] = if add { mean + delta_d * ka.normal(g) } else { mean + delta_d * kd.normal(g) };
+                row[j] = if add {
+                    mean + delta_d * ka.normal(g)
+                } else {
+                    mean + delta_d * kd.normal(g)
+                };
                 j += 2;
             }
         }
@@ -196,12 +240,36 @@ pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2
         // row i only; both are inside the fr * fc buffer.
         let get = |ii: usize, jj: usize| unsafe { *base.add(ii * fc + jj) };
         let gbase = (o0 + i as u64) * gc + o1;
-        let up = if i > 0 { Some(i - 1) } else if periodic { Some(fr - 1) } else { None };
-        let down = if i + 1 < fr { Some(i + 1) } else if periodic { Some(0) } else { None };
+        let up = if i > 0 {
+            Some(i - 1)
+        } else if periodic {
+            Some(fr - 1)
+        } else {
+            None
+        };
+        let down = if i + 1 < fr {
+            Some(i + 1)
+        } else if periodic {
+            Some(0)
+        } else {
+            None
+        };
         let mut j = if i % 2 == 0 { 1 } else { 0 };
         while j < fc {
-            let left = if j > 0 { Some(j - 1) } else if periodic { Some(fc - 1) } else { None };
-            let right = if j + 1 < fc { Some(j + 1) } else if periodic { Some(0) } else { None };
+            let left = if j > 0 {
+                Some(j - 1)
+            } else if periodic {
+                Some(fc - 1)
+            } else {
+                None
+            };
+            let right = if j + 1 < fc {
+                Some(j + 1)
+            } else if periodic {
+                Some(0)
+            } else {
+                None
+            };
             let mut sum = 0.0;
             let mut cnt = 0.0;
             if let Some(u) = up {
@@ -221,7 +289,11 @@ pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2
                 cnt += 1.0;
             }
             let mean = sum / cnt;
-            let v = if add { mean } else { mean + delta_s * ks.normal(gbase + j as u64) };
+            let v = if add {
+                mean
+            } else {
+                mean + delta_s * ks.normal(gbase + j as u64)
+            };
             unsafe { *base.add(i * fc + j) = v };
             j += 2;
         }
@@ -251,7 +323,11 @@ pub fn refine_2d_levels(
     let mut p = *base;
     for l in 0..levels {
         let (r, c) = grid.dim();
-        let (fr, fc) = if p.periodic { (2 * r, 2 * c) } else { (2 * r - 1, 2 * c - 1) };
+        let (fr, fc) = if p.periodic {
+            (2 * r, 2 * c)
+        } else {
+            (2 * r - 1, 2 * c - 1)
+        };
         let _ = fr;
         p.level = base.level + l;
         p.global_cols = fc as u64;
@@ -322,8 +398,14 @@ mod tests {
     #[test]
     fn thread_count_does_not_matter() {
         let coarse = Array2::<f64>::zeros((3, 3));
-        let a = run_in_pool(Some(1), || refine_2d_levels(coarse.view(), 6, &params(true, false))).unwrap();
-        let b = run_in_pool(Some(2), || refine_2d_levels(coarse.view(), 6, &params(true, false))).unwrap();
+        let a = run_in_pool(Some(1), || {
+            refine_2d_levels(coarse.view(), 6, &params(true, false))
+        })
+        .unwrap();
+        let b = run_in_pool(Some(2), || {
+            refine_2d_levels(coarse.view(), 6, &params(true, false))
+        })
+        .unwrap();
         assert_eq!(a, b);
         assert_eq!(a.dim(), (129, 129));
     }
@@ -365,6 +447,9 @@ mod tests {
         let coarse = Array2::<f64>::zeros((2, 2));
         let mut p = params(false, false);
         p.hurst = 1.0;
-        assert!(matches!(refine_2d(coarse.view(), &p), Err(CoreError::InvalidArgument { .. })));
+        assert!(matches!(
+            refine_2d(coarse.view(), &p),
+            Err(CoreError::InvalidArgument { .. })
+        ));
     }
 }

@@ -40,7 +40,11 @@ impl StreamKey {
     /// Fix `(seed, stream)`; samples are then drawn by index.
     pub fn new(seed: u64, stream: u64) -> Self {
         let a = mix64(seed.wrapping_add(GOLDEN));
-        StreamKey(mix64(a ^ stream.wrapping_mul(0xd6e8_feb8_6659_fd93).wrapping_add(GOLDEN)))
+        StreamKey(mix64(
+            a ^ stream
+                .wrapping_mul(0xd6e8_feb8_6659_fd93)
+                .wrapping_add(GOLDEN),
+        ))
     }
     /// 64 random bits at `index`; equals `hash3(seed, stream, index)`.
     ///
@@ -48,7 +52,10 @@ impl StreamKey {
     /// its starting state, evaluated at position `index`.
     #[inline(always)]
     pub fn bits(self, index: u64) -> u64 {
-        mix64(self.0.wrapping_add(index.wrapping_add(1).wrapping_mul(GOLDEN)))
+        mix64(
+            self.0
+                .wrapping_add(index.wrapping_add(1).wrapping_mul(GOLDEN)),
+        )
     }
     /// Uniform in the open interval (0, 1) at `index`.
     #[inline(always)]
@@ -168,7 +175,12 @@ pub fn inverse_normal_cdf(p: f64) -> f64 {
         4.374_664_141_464_968,
         2.938_163_982_698_783,
     ];
-    const D: [f64; 4] = [7.784_695_709_041_462e-3, 3.224_671_290_700_398e-1, 2.445_134_137_142_996, 3.754_408_661_907_416];
+    const D: [f64; 4] = [
+        7.784_695_709_041_462e-3,
+        3.224_671_290_700_398e-1,
+        2.445_134_137_142_996,
+        3.754_408_661_907_416,
+    ];
     const P_LOW: f64 = 0.02425;
     if p < P_LOW {
         let q = (-2.0 * p.ln()).sqrt();
@@ -192,12 +204,14 @@ pub fn inverse_normal_cdf(p: f64) -> f64 {
 pub fn fill_normal(out: &mut [f64], seed: u64, stream: u64, start: u64) {
     use rayon::prelude::*;
     let key = StreamKey::new(seed, stream);
-    out.par_chunks_mut(1 << 14).enumerate().for_each(|(ci, chunk)| {
-        let base = start + (ci as u64) * (1 << 14);
-        for (i, v) in chunk.iter_mut().enumerate() {
-            *v = key.normal(base + i as u64);
-        }
-    });
+    out.par_chunks_mut(1 << 14)
+        .enumerate()
+        .for_each(|(ci, chunk)| {
+            let base = start + (ci as u64) * (1 << 14);
+            for (i, v) in chunk.iter_mut().enumerate() {
+                *v = key.normal(base + i as u64);
+            }
+        });
 }
 
 #[cfg(test)]
@@ -225,7 +239,12 @@ mod tests {
     #[test]
     fn inverse_cdf_known_quantiles() {
         // Quantiles of N(0, 1) from tables (Abramowitz & Stegun 26.2).
-        let cases = [(0.5, 0.0), (0.975, 1.959_963_984_540_054), (0.841_344_746_068_543, 1.0), (0.001, -3.090_232_306_167_813)];
+        let cases = [
+            (0.5, 0.0),
+            (0.975, 1.959_963_984_540_054),
+            (0.841_344_746_068_543, 1.0),
+            (0.001, -3.090_232_306_167_813),
+        ];
         for (p, x) in cases {
             assert!((inverse_normal_cdf(p) - x).abs() < 1e-8, "p={p}");
         }
@@ -276,9 +295,16 @@ mod zig_tests {
     fn ziggurat_tables_close() {
         // The layers must close at the top: x[127] small, area v each.
         let t = zig_tables();
-        assert!(t.x[ZIG_N - 1] > 0.0 && t.x[ZIG_N - 1] < 0.3, "{}", t.x[ZIG_N - 1]);
+        assert!(
+            t.x[ZIG_N - 1] > 0.0 && t.x[ZIG_N - 1] < 0.3,
+            "{}",
+            t.x[ZIG_N - 1]
+        );
         let last_area = t.x[ZIG_N - 1] * (1.0 - t.f[ZIG_N - 1]);
-        assert!((last_area - ZIG_V).abs() < 1e-6 * ZIG_V * 1000.0, "{last_area}");
+        assert!(
+            (last_area - ZIG_V).abs() < 1e-6 * ZIG_V * 1000.0,
+            "{last_area}"
+        );
     }
 
     #[test]
@@ -286,7 +312,14 @@ mod zig_tests {
         // Empirical CDF at fixed points against Phi (A&S 26.2 values); 10^6
         // samples: standard error of a proportion <= 0.0005.
         let k = StreamKey::new(3, 1);
-        let pts = [(-3.0, 0.001_349_898), (-1.0, 0.158_655_254), (0.0, 0.5), (0.5, 0.691_462_461), (2.0, 0.977_249_868), (3.5, 0.999_767_371)];
+        let pts = [
+            (-3.0, 0.001_349_898),
+            (-1.0, 0.158_655_254),
+            (0.0, 0.5),
+            (0.5, 0.691_462_461),
+            (2.0, 0.977_249_868),
+            (3.5, 0.999_767_371),
+        ];
         let n = 1_000_000u64;
         let mut counts = [0u64; 6];
         for i in 0..n {

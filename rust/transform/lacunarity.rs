@@ -6,11 +6,9 @@
 //! `Lambda(r) = E[M^2] / E[M]^2`. Box masses, their squares and their
 //! validity are summed over windows with summed-area tables per band, so the
 //! cost per pixel does not grow with the window.
-use crate::error::{CoreError, CoreResult};
 use super::sat::{band_rows, check_window, rect, sat};
+use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
-
-
 
 /// Lacunarity maps, layout `[size][row][col]` (NaN where the window holds no
 /// complete valid box or fewer valid pixels than `min_valid * w * w`).
@@ -25,7 +23,10 @@ pub fn lacunarity_transform(
     let w = window;
     let min_pixels = check_window(z.len(), rows, cols, w, min_valid)?;
     if box_sizes.is_empty() || box_sizes.iter().any(|&r| r == 0 || r > w) {
-        return Err(CoreError::invalid("box_sizes", format!("box sides must be in [1, {w}], got {box_sizes:?}")));
+        return Err(CoreError::invalid(
+            "box_sizes",
+            format!("box sides must be in [1, {w}], got {box_sizes:?}"),
+        ));
     }
     let h = w / 2;
     let band_rows = band_rows(w);
@@ -41,8 +42,14 @@ pub fn lacunarity_transform(
             let i1 = (o1 + h).min(rows);
             let nr = i1 - i0;
             let sw = cols + 1;
-            let zz: Vec<f64> = z[i0 * cols..i1 * cols].iter().map(|&v| if v.is_nan() { 0.0 } else { v }).collect();
-            let nan: Vec<f64> = z[i0 * cols..i1 * cols].iter().map(|&v| v.is_nan() as u8 as f64).collect();
+            let zz: Vec<f64> = z[i0 * cols..i1 * cols]
+                .iter()
+                .map(|&v| if v.is_nan() { 0.0 } else { v })
+                .collect();
+            let nan: Vec<f64> = z[i0 * cols..i1 * cols]
+                .iter()
+                .map(|&v| v.is_nan() as u8 as f64)
+                .collect();
             let (zs, ns) = (sat(&zz, nr, cols), sat(&nan, nr, cols));
             let mut planes = Vec::with_capacity(box_sizes.len());
             for &r in box_sizes {
@@ -77,7 +84,9 @@ pub fn lacunarity_transform(
                             if c1 < c0 + r {
                                 continue;
                             }
-                            if rect(&ns, sw, r0, r1, c0, c1) > (r1 - r0) as f64 * (c1 - c0) as f64 - min_pixels {
+                            if rect(&ns, sw, r0, r1, c0, c1)
+                                > (r1 - r0) as f64 * (c1 - c0) as f64 - min_pixels
+                            {
                                 continue; // too few valid pixels
                             }
                             let (ar1, bc1) = (r1 - r + 1, c1 - r + 1);

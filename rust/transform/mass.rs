@@ -15,8 +15,8 @@
 //! point's mass does not depend on where the analysis window sits and the
 //! window sums come from summed-area tables: the cost per pixel is the box
 //! neighbourhood (`L_max^2`), independent of the window.
-use crate::error::{CoreError, CoreResult};
 use super::sat::{band_rows, check_window, rect, sat};
+use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 
 /// Options of [`mass_transform`].
@@ -36,14 +36,23 @@ pub struct MassOptions {
 /// inside, so the comparisons vectorise; a pair counts for box `k` when its
 /// spatial offset is within `k` and `|z_q - z_p| <= (k + 1/2) z_scale`
 /// (NaN on either side never counts).
-pub fn box_masses(z: &[f64], rows: usize, cols: usize, r0: usize, r1: usize, ks: &[usize], z_scale: f64) -> Vec<Vec<f64>> {
+pub fn box_masses(
+    z: &[f64],
+    rows: usize,
+    cols: usize,
+    r0: usize,
+    r1: usize,
+    ks: &[usize],
+    z_scale: f64,
+) -> Vec<Vec<f64>> {
     let kmax = *ks.last().unwrap_or(&0) as isize;
     let nr = r1 - r0;
     let thr: Vec<f64> = ks.iter().map(|&k| (k as f64 + 0.5) * z_scale).collect();
     let mut out = vec![vec![0.0f64; nr * cols]; ks.len()];
     let mut acc = vec![vec![0u32; cols]; ks.len()];
     for r in r0..r1 {
-        acc.iter_mut().for_each(|a| a.iter_mut().for_each(|v| *v = 0));
+        acc.iter_mut()
+            .for_each(|a| a.iter_mut().for_each(|v| *v = 0));
         let zp = &z[r * cols..(r + 1) * cols];
         for di in -kmax..=kmax {
             let q = r as isize + di;
@@ -54,7 +63,11 @@ pub fn box_masses(z: &[f64], rows: usize, cols: usize, r0: usize, r1: usize, ks:
             for dj in -kmax..=kmax {
                 let ds = di.unsigned_abs().max(dj.unsigned_abs());
                 // pixels c with 0 <= c + dj < cols
-                let (c0, c1) = if dj >= 0 { (0usize, cols.saturating_sub(dj as usize)) } else { ((-dj) as usize, cols) };
+                let (c0, c1) = if dj >= 0 {
+                    (0usize, cols.saturating_sub(dj as usize))
+                } else {
+                    ((-dj) as usize, cols)
+                };
                 if c1 <= c0 {
                     continue;
                 }
@@ -83,11 +96,14 @@ pub fn box_masses(z: &[f64], rows: usize, cols: usize, r0: usize, r1: usize, ks:
     out
 }
 
-
-
 /// Local P(m, L) dimension and r² maps (row-major; NaN where the window has
 /// fewer valid pixels than `min_valid * w * w`).
-pub fn mass_transform(z: &[f64], rows: usize, cols: usize, opt: &MassOptions) -> CoreResult<(Vec<f32>, Vec<f32>)> {
+pub fn mass_transform(
+    z: &[f64],
+    rows: usize,
+    cols: usize,
+    opt: &MassOptions,
+) -> CoreResult<(Vec<f32>, Vec<f32>)> {
     let w = opt.window;
     let min_pixels = check_window(z.len(), rows, cols, w, opt.min_valid)?;
     let mut sizes = opt.box_sizes.clone();
@@ -96,11 +112,17 @@ pub fn mass_transform(z: &[f64], rows: usize, cols: usize, opt: &MassOptions) ->
     if sizes.len() < 2 || sizes.iter().any(|&l| l < 3 || l % 2 == 0 || l > w) {
         return Err(CoreError::invalid(
             "box_sizes",
-            format!("need at least 2 distinct odd box sides in [3, {w}], got {:?}", opt.box_sizes),
+            format!(
+                "need at least 2 distinct odd box sides in [3, {w}], got {:?}",
+                opt.box_sizes
+            ),
         ));
     }
     if !(opt.z_scale.is_finite() && opt.z_scale > 0.0) {
-        return Err(CoreError::invalid("z_scale", format!("expected a positive number, got {}", opt.z_scale)));
+        return Err(CoreError::invalid(
+            "z_scale",
+            format!("expected a positive number, got {}", opt.z_scale),
+        ));
     }
     let ks: Vec<usize> = sizes.iter().map(|l| l / 2).collect();
     let xs: Vec<f64> = sizes.iter().map(|&l| (l as f64).ln()).collect();
@@ -110,8 +132,10 @@ pub fn mass_transform(z: &[f64], rows: usize, cols: usize, opt: &MassOptions) ->
     let band_rows = band_rows(w);
     let mut dim = vec![f32::NAN; rows * cols];
     let mut r2 = vec![f32::NAN; rows * cols];
-    dim.par_chunks_mut(band_rows * cols).zip(r2.par_chunks_mut(band_rows * cols)).enumerate().for_each(
-        |(band, (dout, rout))| {
+    dim.par_chunks_mut(band_rows * cols)
+        .zip(r2.par_chunks_mut(band_rows * cols))
+        .enumerate()
+        .for_each(|(band, (dout, rout))| {
             let o0 = band * band_rows;
             let o1 = (o0 + band_rows).min(rows);
             let i0 = o0.saturating_sub(h);
@@ -119,12 +143,17 @@ pub fn mass_transform(z: &[f64], rows: usize, cols: usize, opt: &MassOptions) ->
             let nr = i1 - i0;
             let sw = cols + 1;
             let masses = box_masses(z, rows, cols, i0, i1, &ks, opt.z_scale);
-            let valid: Vec<f64> = (0..nr * cols).map(|k| (!z[i0 * cols + k].is_nan()) as u8 as f64).collect();
+            let valid: Vec<f64> = (0..nr * cols)
+                .map(|k| (!z[i0 * cols + k].is_nan()) as u8 as f64)
+                .collect();
             let vsat = sat(&valid, nr, cols);
             let isats: Vec<Vec<f64>> = masses
                 .iter()
                 .map(|m| {
-                    let inv: Vec<f64> = m.iter().map(|&v| if v > 0.0 { 1.0 / v } else { 0.0 }).collect();
+                    let inv: Vec<f64> = m
+                        .iter()
+                        .map(|&v| if v > 0.0 { 1.0 / v } else { 0.0 })
+                        .collect();
                     sat(&inv, nr, cols)
                 })
                 .collect();
@@ -147,11 +176,14 @@ pub fn mass_transform(z: &[f64], rows: usize, cols: usize, opt: &MassOptions) ->
                     let syy: f64 = ys.iter().map(|y| (y - ym) * (y - ym)).sum();
                     let k = (i - o0) * cols + j;
                     dout[k] = (-sxy / sxx) as f32;
-                    rout[k] = if syy > 0.0 { (sxy * sxy / (sxx * syy)) as f32 } else { 1.0 };
+                    rout[k] = if syy > 0.0 {
+                        (sxy * sxy / (sxx * syy)) as f32
+                    } else {
+                        1.0
+                    };
                 }
             }
-        },
-    );
+        });
     Ok((dim, r2))
 }
 
@@ -164,7 +196,12 @@ mod tests {
         // all heights equal: m_p(L) = L^2 inside, N(L) = 1/L^2, D = 2
         let (rows, cols) = (60usize, 50usize);
         let z = vec![3.0f64; rows * cols];
-        let opt = MassOptions { window: 15, box_sizes: vec![3, 5, 7], z_scale: 1.0, min_valid: 0.5 };
+        let opt = MassOptions {
+            window: 15,
+            box_sizes: vec![3, 5, 7],
+            z_scale: 1.0,
+            min_valid: 0.5,
+        };
         let (d, _) = mass_transform(&z, rows, cols, &opt).unwrap();
         // windows whose boxes stay inside the image
         for i in 10..rows - 10 {
@@ -181,7 +218,11 @@ mod tests {
         let z: Vec<f64> = (0..rows * cols)
             .map(|k| {
                 seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
-                if k % 17 == 3 { f64::NAN } else { ((seed >> 40) % 13) as f64 }
+                if k % 17 == 3 {
+                    f64::NAN
+                } else {
+                    ((seed >> 40) % 13) as f64
+                }
             })
             .collect();
         let ks = [1usize, 2, 4];

@@ -28,18 +28,33 @@ pub(crate) fn rect(s: &[f64], w: usize, r0: usize, r1: usize, c0: usize, c1: usi
 
 /// Check the image buffer, the window (odd, >= 3, not larger than the image)
 /// and `min_valid` (a fraction); returns the fewest valid pixels a window needs.
-pub(crate) fn check_window(z_len: usize, rows: usize, cols: usize, w: usize, min_valid: f64) -> CoreResult<f64> {
+pub(crate) fn check_window(
+    z_len: usize,
+    rows: usize,
+    cols: usize,
+    w: usize,
+    min_valid: f64,
+) -> CoreResult<f64> {
     if rows * cols == 0 || z_len != rows * cols {
         return Err(CoreError::invalid("image", "image is empty"));
     }
     if w < 3 || w % 2 == 0 {
-        return Err(CoreError::invalid("window_size", format!("expected an odd integer >= 3, got {w}")));
+        return Err(CoreError::invalid(
+            "window_size",
+            format!("expected an odd integer >= 3, got {w}"),
+        ));
     }
     if w > rows.max(cols) {
-        return Err(CoreError::invalid("window_size", format!("window {w} is larger than the image ({rows} x {cols})")));
+        return Err(CoreError::invalid(
+            "window_size",
+            format!("window {w} is larger than the image ({rows} x {cols})"),
+        ));
     }
     if !(0.0..=1.0).contains(&min_valid) {
-        return Err(CoreError::invalid("min_valid", format!("expected a fraction in [0, 1], got {min_valid}")));
+        return Err(CoreError::invalid(
+            "min_valid",
+            format!("expected a fraction in [0, 1], got {min_valid}"),
+        ));
     }
     Ok((min_valid * (w * w) as f64).ceil().max(1.0))
 }

@@ -14,8 +14,8 @@
 //! increment powers and counts, built per band of rows at fixed positions,
 //! so the cost per pixel is independent of `w` and the result does not
 //! depend on the thread count.
-use crate::error::{CoreError, CoreResult};
 use super::sat::{band_rows, check_window, rect, sat};
+use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 
 /// Which increments.
@@ -36,21 +36,33 @@ pub struct VariationOptions {
     pub min_valid: f64,
 }
 
-
-
 /// Local dimension and r² maps (row-major, `rows x cols`, NaN where the
 /// window has too few valid pixels or a lag has no valid increment).
-pub fn variation_transform(z: &[f64], rows: usize, cols: usize, opt: &VariationOptions) -> CoreResult<(Vec<f32>, Vec<f32>)> {
+pub fn variation_transform(
+    z: &[f64],
+    rows: usize,
+    cols: usize,
+    opt: &VariationOptions,
+) -> CoreResult<(Vec<f32>, Vec<f32>)> {
     let w = opt.window;
     let min_pixels = check_window(z.len(), rows, cols, w, opt.min_valid)?;
     let mut lags = opt.lags.clone();
     lags.sort_unstable();
     lags.dedup();
     if lags.len() < 2 || lags[0] == 0 || *lags.last().unwrap() >= w {
-        return Err(CoreError::invalid("lags", format!("need at least 2 distinct lags in [1, {}), got {:?}", w, opt.lags)));
+        return Err(CoreError::invalid(
+            "lags",
+            format!(
+                "need at least 2 distinct lags in [1, {}), got {:?}",
+                w, opt.lags
+            ),
+        ));
     }
     if !(opt.p.is_finite() && opt.p > 0.0) {
-        return Err(CoreError::invalid("p", format!("expected a positive number, got {}", opt.p)));
+        return Err(CoreError::invalid(
+            "p",
+            format!("expected a positive number, got {}", opt.p),
+        ));
     }
     let h = w / 2;
     let xs: Vec<f64> = lags.iter().map(|&u| (u as f64).ln()).collect();
@@ -83,10 +95,13 @@ pub fn variation_transform(z: &[f64], rows: usize, cols: usize, opt: &VariationO
             let nr = i1 - i0;
             let sw = cols + 1;
             let get = |r: usize, c: usize| z[(i0 + r) * cols + c];
-            let valid: Vec<f64> = (0..nr * cols).map(|k| (!get(k / cols, k % cols).is_nan()) as u8 as f64).collect();
+            let valid: Vec<f64> = (0..nr * cols)
+                .map(|k| (!get(k / cols, k % cols).is_nan()) as u8 as f64)
+                .collect();
             let vsat = sat(&valid, nr, cols);
             // per lag: (power SAT, count SAT) for each component
-            let mut tables: Vec<Vec<(Vec<f64>, Vec<f64>, usize, usize)>> = Vec::with_capacity(lags.len());
+            let mut tables: Vec<Vec<(Vec<f64>, Vec<f64>, usize, usize)>> =
+                Vec::with_capacity(lags.len());
             for &u in &lags {
                 let comps: Vec<(usize, usize)> = match opt.increments {
                     Increments::First => vec![(0, u), (u, 0)],
@@ -101,7 +116,10 @@ pub fn variation_transform(z: &[f64], rows: usize, cols: usize, opt: &VariationO
                             for c in 0..cols.saturating_sub(du_c) {
                                 let d = match opt.increments {
                                     Increments::First => get(r + du_r, c + du_c) - get(r, c),
-                                    Increments::Square => get(r + u, c + u) - get(r + u, c) - get(r, c + u) + get(r, c),
+                                    Increments::Square => {
+                                        get(r + u, c + u) - get(r + u, c) - get(r, c + u)
+                                            + get(r, c)
+                                    }
                                 };
                                 if !d.is_nan() {
                                     pw[r * cols + c] = power(d);
@@ -150,7 +168,11 @@ pub fn variation_transform(z: &[f64], rows: usize, cols: usize, opt: &VariationO
                     let syy: f64 = ys.iter().map(|y| (y - ym) * (y - ym)).sum();
                     let slope = sxy / sxx;
                     dout[k] = (3.0 - slope / opt.p) as f32;
-                    rout[k] = if syy > 0.0 { (sxy * sxy / (sxx * syy)) as f32 } else { 1.0 };
+                    rout[k] = if syy > 0.0 {
+                        (sxy * sxy / (sxx * syy)) as f32
+                    } else {
+                        1.0
+                    };
                 }
             }
         });
@@ -162,10 +184,18 @@ mod tests {
     use super::*;
 
     /// Per-window estimator from the definition (NaN padding at the edges).
-    fn direct(z: &[f64], rows: usize, cols: usize, i: usize, j: usize, opt: &VariationOptions) -> f64 {
+    fn direct(
+        z: &[f64],
+        rows: usize,
+        cols: usize,
+        i: usize,
+        j: usize,
+        opt: &VariationOptions,
+    ) -> f64 {
         let h = opt.window as isize / 2;
         let at = |r: isize, c: isize| -> f64 {
-            if r < i as isize - h || r > i as isize + h || c < j as isize - h || c > j as isize + h {
+            if r < i as isize - h || r > i as isize + h || c < j as isize - h || c > j as isize + h
+            {
                 return f64::NAN;
             }
             if r < 0 || c < 0 || r >= rows as isize || c >= cols as isize {
@@ -181,7 +211,9 @@ mod tests {
                 for c in (j as isize - h)..=(j as isize + h) {
                     let ds: Vec<f64> = match opt.increments {
                         Increments::First => vec![at(r, c + u) - at(r, c), at(r + u, c) - at(r, c)],
-                        Increments::Square => vec![at(r + u, c + u) - at(r + u, c) - at(r, c + u) + at(r, c)],
+                        Increments::Square => {
+                            vec![at(r + u, c + u) - at(r + u, c) - at(r, c + u) + at(r, c)]
+                        }
                     };
                     for d in ds {
                         if !d.is_nan() {
@@ -206,7 +238,9 @@ mod tests {
         let mut seed = 5u64;
         let mut z: Vec<f64> = (0..rows * cols)
             .map(|_| {
-                seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                seed = seed
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
                 (seed >> 11) as f64 / (1u64 << 53) as f64
             })
             .collect();
@@ -214,11 +248,28 @@ mod tests {
             z[k] = f64::NAN;
         }
         for inc in [Increments::First, Increments::Square] {
-            let opt = VariationOptions { window: 9, lags: vec![1, 2, 3], p: 2.0, increments: inc, min_valid: 0.0 };
+            let opt = VariationOptions {
+                window: 9,
+                lags: vec![1, 2, 3],
+                p: 2.0,
+                increments: inc,
+                min_valid: 0.0,
+            };
             let (d, _) = variation_transform(&z, rows, cols, &opt).unwrap();
-            for &(i, j) in &[(0usize, 0usize), (3, 40), (35, 22), (69, 44), (64, 1), (63, 20)] {
+            for &(i, j) in &[
+                (0usize, 0usize),
+                (3, 40),
+                (35, 22),
+                (69, 44),
+                (64, 1),
+                (63, 20),
+            ] {
                 let e = direct(&z, rows, cols, i, j, &opt);
-                assert!((d[i * cols + j] as f64 - e).abs() < 1e-5, "{inc:?} ({i},{j}) {} vs {e}", d[i * cols + j]);
+                assert!(
+                    (d[i * cols + j] as f64 - e).abs() < 1e-5,
+                    "{inc:?} ({i},{j}) {} vs {e}",
+                    d[i * cols + j]
+                );
             }
         }
     }
@@ -226,22 +277,63 @@ mod tests {
     #[test]
     fn plane_is_two_and_threads_agree() {
         let (rows, cols) = (130usize, 90usize);
-        let z: Vec<f64> = (0..rows * cols).map(|k| 0.3 * (k / cols) as f64 + 0.7 * (k % cols) as f64).collect();
-        let opt = VariationOptions { window: 11, lags: vec![1, 2], p: 2.0, increments: Increments::First, min_valid: 0.5 };
-        let run = |t| crate::parallel::run_in_pool(Some(t), || variation_transform(&z, rows, cols, &opt)).unwrap();
+        let z: Vec<f64> = (0..rows * cols)
+            .map(|k| 0.3 * (k / cols) as f64 + 0.7 * (k % cols) as f64)
+            .collect();
+        let opt = VariationOptions {
+            window: 11,
+            lags: vec![1, 2],
+            p: 2.0,
+            increments: Increments::First,
+            min_valid: 0.5,
+        };
+        let run = |t| {
+            crate::parallel::run_in_pool(Some(t), || variation_transform(&z, rows, cols, &opt))
+                .unwrap()
+        };
         let (a, _) = run(1);
         // interior (full windows): exactly a plane's D = 2; at the edges the
         // clipped window pools unequal numbers of row and column increments
         for i in 5..rows - 5 {
             for j in 5..cols - 5 {
-                assert!((a[i * cols + j] - 2.0).abs() < 1e-5, "({i},{j}) {}", a[i * cols + j]);
+                assert!(
+                    (a[i * cols + j] - 2.0).abs() < 1e-5,
+                    "({i},{j}) {}",
+                    a[i * cols + j]
+                );
             }
         }
         // a corner window holds 6 x 6 = 36 pixels, fewer than half of 11 x 11
         assert!(a[0].is_nan() && a[cols + 5].is_finite());
-        let bits = |(d, r): (Vec<f32>, Vec<f32>)| -> Vec<(u32, u32)> { d.iter().zip(&r).map(|(a, b)| (a.to_bits(), b.to_bits())).collect() };
-        assert!(bits(run(1)) == bits(run(3)), "results differ between 1 and 3 threads");
-        assert!(variation_transform(&z, rows, cols, &VariationOptions { window: 10, ..opt.clone() }).is_err());
-        assert!(variation_transform(&z, rows, cols, &VariationOptions { lags: vec![1], ..opt.clone() }).is_err());
+        let bits = |(d, r): (Vec<f32>, Vec<f32>)| -> Vec<(u32, u32)> {
+            d.iter()
+                .zip(&r)
+                .map(|(a, b)| (a.to_bits(), b.to_bits()))
+                .collect()
+        };
+        assert!(
+            bits(run(1)) == bits(run(3)),
+            "results differ between 1 and 3 threads"
+        );
+        assert!(variation_transform(
+            &z,
+            rows,
+            cols,
+            &VariationOptions {
+                window: 10,
+                ..opt.clone()
+            }
+        )
+        .is_err());
+        assert!(variation_transform(
+            &z,
+            rows,
+            cols,
+            &VariationOptions {
+                lags: vec![1],
+                ..opt.clone()
+            }
+        )
+        .is_err());
     }
 }
