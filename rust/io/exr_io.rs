@@ -4,7 +4,7 @@
 //! luminance name other tools show as grey), losslessly compressed. Reading
 //! accepts the first layer's "Y" channel, or its only channel.
 use crate::error::{CoreError, CoreResult};
-use crate::io::image_io::temp_path;
+use crate::io::image_io::{finish_atomic, temp_path};
 use exr::prelude::*;
 use std::path::Path;
 
@@ -25,17 +25,7 @@ pub fn write_exr_gray(path: &Path, data: Vec<f32>, rows: usize, cols: usize) -> 
     );
     let image = Image::from_layer(layer);
     let tmp = temp_path(path);
-    if let Err(e) = image.write().to_file(&tmp) {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(CoreError::Io(format!(
-            "cannot write {}: {e}",
-            path.display()
-        )));
-    }
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        CoreError::Io(format!("cannot write {}: {e}", path.display()))
-    })
+    finish_atomic(image.write().to_file(&tmp), &tmp, path)
 }
 
 /// Read the "Y" (or only) channel of the first layer: `(pixels, rows, cols)`.

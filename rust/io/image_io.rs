@@ -89,15 +89,25 @@ pub fn write_png_gray(path: &Path, pixels: &Pixels, rows: usize, cols: usize) ->
             ))
         }
     };
+    finish_atomic(result, &tmp, path)
+}
+
+/// Complete an atomic write: on success rename `tmp` over `path`; on any
+/// error remove `tmp` and report it for `path`.
+pub fn finish_atomic<E: std::fmt::Display>(
+    result: Result<(), E>,
+    tmp: &Path,
+    path: &Path,
+) -> CoreResult<()> {
     if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
+        let _ = std::fs::remove_file(tmp);
         return Err(CoreError::Io(format!(
             "cannot write {}: {e}",
             path.display()
         )));
     }
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
+    std::fs::rename(tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(tmp);
         CoreError::Io(format!("cannot write {}: {e}", path.display()))
     })
 }

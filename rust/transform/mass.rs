@@ -15,7 +15,7 @@
 //! point's mass does not depend on where the analysis window sits and the
 //! window sums come from summed-area tables: the cost per pixel is the box
 //! neighbourhood (`L_max^2`), independent of the window.
-use super::sat::{band_rows, check_window, rect, sat};
+use super::sat::{band_rows, check_window, line_fit, rect, sat};
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 
@@ -171,16 +171,10 @@ pub fn mass_transform(
                     for (l, s) in isats.iter().enumerate() {
                         ys[l] = (rect(s, sw, r0, r1, c0, c1) / n).ln();
                     }
-                    let ym = ys.iter().sum::<f64>() / ys.len() as f64;
-                    let sxy: f64 = xs.iter().zip(&ys).map(|(x, y)| (x - xm) * (y - ym)).sum();
-                    let syy: f64 = ys.iter().map(|y| (y - ym) * (y - ym)).sum();
+                    let (slope, fit_r2) = line_fit(&xs, xm, sxx, &ys);
                     let k = (i - o0) * cols + j;
-                    dout[k] = (-sxy / sxx) as f32;
-                    rout[k] = if syy > 0.0 {
-                        (sxy * sxy / (sxx * syy)) as f32
-                    } else {
-                        1.0
-                    };
+                    dout[k] = (-slope) as f32;
+                    rout[k] = fit_r2 as f32;
                 }
             }
         });

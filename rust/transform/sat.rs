@@ -64,3 +64,18 @@ pub(crate) fn check_window(
 pub(crate) fn band_rows(w: usize) -> usize {
     64usize.max(4 * w)
 }
+
+/// Least-squares slope and r² of `ys` against `xs` (with `xm` the mean of
+/// `xs` and `sxx` the sum of its squared deviations); r² is 1 when `ys` is flat.
+#[inline]
+pub(crate) fn line_fit(xs: &[f64], xm: f64, sxx: f64, ys: &[f64]) -> (f64, f64) {
+    let ym = ys.iter().sum::<f64>() / ys.len() as f64;
+    let sxy: f64 = xs.iter().zip(ys).map(|(x, y)| (x - xm) * (y - ym)).sum();
+    let syy: f64 = ys.iter().map(|y| (y - ym) * (y - ym)).sum();
+    let r2 = if syy > 0.0 {
+        sxy * sxy / (sxx * syy)
+    } else {
+        1.0
+    };
+    (sxy / sxx, r2)
+}

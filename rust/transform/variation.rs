@@ -14,7 +14,7 @@
 //! increment powers and counts, built per band of rows at fixed positions,
 //! so the cost per pixel is independent of `w` and the result does not
 //! depend on the thread count.
-use super::sat::{band_rows, check_window, rect, sat};
+use super::sat::{band_rows, check_window, line_fit, rect, sat};
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 
@@ -163,16 +163,9 @@ pub fn variation_transform(
                     if !ok {
                         continue;
                     }
-                    let ym = ys.iter().sum::<f64>() / ys.len() as f64;
-                    let sxy: f64 = xs.iter().zip(&ys).map(|(x, y)| (x - xm) * (y - ym)).sum();
-                    let syy: f64 = ys.iter().map(|y| (y - ym) * (y - ym)).sum();
-                    let slope = sxy / sxx;
+                    let (slope, fit_r2) = line_fit(&xs, xm, sxx, &ys);
                     dout[k] = (3.0 - slope / opt.p) as f32;
-                    rout[k] = if syy > 0.0 {
-                        (sxy * sxy / (sxx * syy)) as f32
-                    } else {
-                        1.0
-                    };
+                    rout[k] = fit_r2 as f32;
                 }
             }
         });
