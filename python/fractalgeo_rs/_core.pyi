@@ -24,6 +24,7 @@ __all__ = [
     "ifs_rasterize",
     "lacunarity_transform_map",
     "lsystem_parse_text",
+    "mass_curve_image",
     "mass_transform_map",
     "midpoint_refine_1d",
     "midpoint_refine_2d",
@@ -231,3 +232,9 @@ def lacunarity_transform_map(
     min_valid: float,
     n_threads: Optional[int] = None,
 ) -> npt.NDArray[np.float32]: ...
+def mass_curve_image(
+    image: npt.NDArray[np.float64],
+    box_sizes: Sequence[int],
+    z_scale: float,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...

@@ -1,12 +1,12 @@
 //! Bindings of `crate::transform`.
 use crate::parallel::run_in_pool;
 use crate::transform::lacunarity::lacunarity_transform;
-use crate::transform::mass::{mass_transform, MassOptions};
+use crate::transform::mass::{mass_curve, mass_transform, MassOptions};
 use crate::transform::variation::{variation_transform, Increments, VariationOptions};
 use numpy::ndarray::Array2;
 use numpy::ndarray::Array3;
 use numpy::PyArray3;
-use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -114,7 +114,27 @@ fn lacunarity_transform_map<'py>(
         .into_pyarray(py))
 }
 
+/// Image-wide P(m, L) curve N(L) of a grayscale image (NaN = no point).
+#[pyfunction]
+#[pyo3(signature = (image, box_sizes, z_scale, n_threads=None))]
+fn mass_curve_image<'py>(
+    py: Python<'py>,
+    image: PyReadonlyArray2<'py, f64>,
+    box_sizes: Vec<usize>,
+    z_scale: f64,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let (rows, cols) = (image.shape()[0], image.shape()[1]);
+    let z = image
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("data: internal: must be C-contiguous"))?;
+    let n =
+        py.detach(|| run_in_pool(n_threads, || mass_curve(z, rows, cols, &box_sizes, z_scale)))?;
+    Ok(n.into_pyarray(py))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(mass_curve_image, m)?)?;
     m.add_function(wrap_pyfunction!(lacunarity_transform_map, m)?)?;
     m.add_function(wrap_pyfunction!(variation_transform_map, m)?)?;
     m.add_function(wrap_pyfunction!(mass_transform_map, m)?)?;

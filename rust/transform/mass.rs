@@ -96,6 +96,66 @@ pub fn box_masses(
     out
 }
 
+/// Image-wide `N(L) = mean over valid pixels of 1 / m_p(L)` for every box
+/// side (the global P(m, L) estimator of a grayscale image). Bands of rows
+/// are summed in a fixed order, so the result does not depend on threads.
+pub fn mass_curve(
+    z: &[f64],
+    rows: usize,
+    cols: usize,
+    box_sizes: &[usize],
+    z_scale: f64,
+) -> CoreResult<Vec<f64>> {
+    if rows * cols == 0 || z.len() != rows * cols {
+        return Err(CoreError::invalid("data", "image is empty"));
+    }
+    if box_sizes.is_empty() || box_sizes.iter().any(|&l| l < 1 || l % 2 == 0) {
+        return Err(CoreError::invalid(
+            "box_sizes",
+            format!("box sides must be odd and positive, got {box_sizes:?}"),
+        ));
+    }
+    if !(z_scale.is_finite() && z_scale > 0.0) {
+        return Err(CoreError::invalid(
+            "z_scale",
+            format!("expected a positive number, got {z_scale}"),
+        ));
+    }
+    let mut order: Vec<usize> = (0..box_sizes.len()).collect();
+    order.sort_by_key(|&i| box_sizes[i]);
+    let ks: Vec<usize> = order.iter().map(|&i| box_sizes[i] / 2).collect();
+    let band = 64usize;
+    let partial: Vec<(Vec<f64>, f64)> = (0..rows.div_ceil(band))
+        .into_par_iter()
+        .map(|b| {
+            let (r0, r1) = (b * band, ((b + 1) * band).min(rows));
+            let m = box_masses(z, rows, cols, r0, r1, &ks, z_scale);
+            let n = m[0].iter().filter(|&&v| v > 0.0).count() as f64;
+            let sums = m
+                .iter()
+                .map(|plane| plane.iter().filter(|&&v| v > 0.0).map(|v| 1.0 / v).sum())
+                .collect();
+            (sums, n)
+        })
+        .collect();
+    let mut sums = vec![0.0f64; ks.len()];
+    let mut n = 0.0;
+    for (s, c) in partial {
+        for (a, b) in sums.iter_mut().zip(s) {
+            *a += b;
+        }
+        n += c;
+    }
+    if n == 0.0 {
+        return Err(CoreError::invalid("data", "no valid value (all NaN)"));
+    }
+    let mut out = vec![0.0f64; box_sizes.len()];
+    for (slot, &i) in order.iter().enumerate() {
+        out[i] = sums[slot] / n;
+    }
+    Ok(out)
+}
+
 /// Local P(m, L) dimension and r² maps (row-major; NaN where the window has
 /// fewer valid pixels than `min_valid * w * w`).
 pub fn mass_transform(

@@ -124,7 +124,9 @@ def mass_dimension(
         ``"auto"`` picks binary for bool arrays and grayscale for other 2D arrays.
     box_sizes : sequence of int, optional
         Odd box sides (in samples, or coordinate units for points); default
-        ``3, 5, 9, 17, ...`` up to an eighth of the extent.
+        ``3, 5, 9, 17, ...`` up to an eighth of the extent (for grayscale
+        images at most 33: each box costs L^2 comparisons per pixel, done in
+        Rust).
     z_scale : float, optional
         Grayscale only: intensity units per pixel; default ``(max - min) /
         max(rows, cols)`` as in DBC. NaN pixels are not points.
@@ -161,16 +163,16 @@ def mass_dimension(
         if z_scale is None:
             z_scale = (zmax - zmin) / max(z.shape) if zmax > zmin else 1.0
         z_scale = check_positive_float(z_scale, "z_scale")
-        ij = np.argwhere(ok)
-        pts = np.column_stack([ij.astype(float), (z[ok] - zmin) / z_scale])
         extent = float(max(z.shape))
     if box_sizes is None:
-        sizes = [2**k + 1 for k in range(1, 30) if 2**k + 1 <= extent / 8]
+        # grayscale boxes cost L^2 per pixel: up to 33 pixels by default
+        limit = extent / 8 if kind != "grayscale" else min(33.0, extent / 8)
+        sizes = [2**k + 1 for k in range(1, 30) if 2**k + 1 <= limit]
     else:
         sizes = sorted(set(check_positive_int(v, "box_sizes") for v in box_sizes))
     if len(sizes) < 3:
         raise ValueError(f"box_sizes: need at least 3 distinct sizes, got {sizes} (data extent {extent:g})")
-    if any(s % 2 == 0 for s in sizes) and kind == "binary":
+    if any(s % 2 == 0 for s in sizes) and kind in ("binary", "grayscale"):
         raise ValueError(f"box_sizes: boxes centred on pixels need odd sides, got {sizes}")
     N = []
     if kind == "binary":
@@ -178,6 +180,11 @@ def mass_dimension(
         for L in sizes:
             m = _box_sums_centred(sat, ij, L // 2, mask.shape)
             N.append(float(np.mean(1.0 / m)))
+    elif kind == "grayscale":
+        # Rust kernel (shared with the fractal transform): box masses per pixel
+        from fractalgeo_rs import _core
+
+        N = _core.mass_curve_image(np.ascontiguousarray(z - zmin), sizes, z_scale, None).tolist()
     else:
         from scipy.spatial import cKDTree
 
