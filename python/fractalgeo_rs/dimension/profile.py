@@ -91,7 +91,8 @@ def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, sample_spacin
         Gap-free profile (NaN raises ValueError).
     sigmas : sequence of float, optional
         Gaussian widths in samples; default ``1, 1.5, 2, 3, ...`` (ratio
-        sqrt 2) up to ``n / 16``.
+        sqrt 2) up to ``n / 16`` or 256, whichever is smaller (the filter's
+        cost grows with sigma).
     sample_spacing : float, default 0
         Distance between samples in the units of the values (e.g. metres for
         a height profile in metres). The length of a self-affine graph mixes
@@ -113,7 +114,7 @@ def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, sample_spacin
         raise ValueError(f"sample_spacing: expected a number >= 0, got {sample_spacing!r}")
     dx = float(sample_spacing)
     if sigmas is None:
-        sigmas = [2 ** (k / 2) for k in range(0, 40) if 2 ** (k / 2) <= z.size / 16]
+        sigmas = [2 ** (k / 2) for k in range(0, 40) if 2 ** (k / 2) <= min(z.size / 16, 256)]
     sig = np.asarray(sorted(set(float(s) for s in sigmas)))
     if sig.size < 3 or sig[0] <= 0 or not np.isfinite(sig).all():
         raise ValueError(f"sigmas: need at least 3 distinct positive widths, got {sig.tolist()}")
