@@ -15,7 +15,7 @@
 //! point's mass does not depend on where the analysis window sits and the
 //! window sums come from summed-area tables: the cost per pixel is the box
 //! neighbourhood (`L_max^2`), independent of the window.
-use super::sat::{band_rows, check_window, line_fit, rect, sat};
+use super::sat::{band_rows, check_window, line_fit, log_axis, rect, sat};
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 
@@ -185,9 +185,7 @@ pub fn mass_transform(
         ));
     }
     let ks: Vec<usize> = sizes.iter().map(|l| l / 2).collect();
-    let xs: Vec<f64> = sizes.iter().map(|&l| (l as f64).ln()).collect();
-    let xm = xs.iter().sum::<f64>() / xs.len() as f64;
-    let sxx: f64 = xs.iter().map(|x| (x - xm) * (x - xm)).sum();
+    let (xs, xm, sxx) = log_axis(&sizes);
     let h = w / 2;
     let band_rows = band_rows(w);
     let mut dim = vec![f32::NAN; rows * cols];

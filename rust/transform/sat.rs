@@ -79,3 +79,12 @@ pub(crate) fn line_fit(xs: &[f64], xm: f64, sxx: f64, ys: &[f64]) -> (f64, f64) 
     };
     (sxy / sxx, r2)
 }
+
+/// `ln` of the scales, their mean and the sum of squared deviations: the x
+/// axis of a log-log fit, for [`line_fit`].
+pub(crate) fn log_axis(scales: &[usize]) -> (Vec<f64>, f64, f64) {
+    let xs: Vec<f64> = scales.iter().map(|&v| (v as f64).ln()).collect();
+    let xm = xs.iter().sum::<f64>() / xs.len() as f64;
+    let sxx = xs.iter().map(|x| (x - xm) * (x - xm)).sum();
+    (xs, xm, sxx)
+}

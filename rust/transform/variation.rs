@@ -14,7 +14,7 @@
 //! increment powers and counts, built per band of rows at fixed positions,
 //! so the cost per pixel is independent of `w` and the result does not
 //! depend on the thread count.
-use super::sat::{band_rows, check_window, line_fit, rect, sat};
+use super::sat::{band_rows, check_window, line_fit, log_axis, rect, sat};
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 
@@ -65,9 +65,7 @@ pub fn variation_transform(
         ));
     }
     let h = w / 2;
-    let xs: Vec<f64> = lags.iter().map(|&u| (u as f64).ln()).collect();
-    let xm = xs.iter().sum::<f64>() / xs.len() as f64;
-    let sxx: f64 = xs.iter().map(|x| (x - xm) * (x - xm)).sum();
+    let (xs, xm, sxx) = log_axis(&lags);
     let band_rows = band_rows(w);
     let n_bands = rows.div_ceil(band_rows);
     let p = opt.p;
