@@ -19,6 +19,7 @@ Computer Graphics*, Springer, 805-835. (Self-affine scaling of graphs.)
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -241,6 +242,16 @@ def box_counting_points(
     )
 
 
+def _nan_range(z: np.ndarray) -> Tuple[float, float]:
+    """Lowest and highest valid value (no copy of the data)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN slice
+        lo = float(np.nanmin(z))
+    if math.isnan(lo):
+        raise ValueError("image: no valid value (all NaN or nodata)")
+    return lo, float(np.nanmax(z))
+
+
 def _surface_float(data, nodata, name: str = "data", ndims=(2,)) -> np.ndarray:
     """A C-contiguous float32/float64 copy or view with nodata as NaN."""
     arr = as_array(data, name)
@@ -326,10 +337,7 @@ def differential_box_counting(
     offsets = check_positive_int(offsets, "offsets")
     check_choice(offset_reduce, "offset_reduce", ("mean", "min"))
     n_threads = check_n_threads(n_threads)
-    valid = z[~np.isnan(z)]
-    if valid.size == 0:
-        raise ValueError("image: no valid value (all NaN or nodata)")
-    z0, z1 = float(valid.min()), float(valid.max())
+    z0, z1 = _nan_range(z)
     rows, cols = z.shape
     if z_scale is None:
         z_unit = (z1 - z0) / max(rows, cols) if z1 > z0 else 1.0
