@@ -289,3 +289,18 @@ def test_dragon_curve_boundary():
     assert fg.minkowski(bd).dimension == pytest.approx(d, abs=0.02)
     assert fg.mass_dimension(bd).dimension == pytest.approx(d, abs=0.02)
     assert fg.box_counting(bd, scale_range=(4, 128)).dimension == pytest.approx(d, abs=0.05)
+
+
+def test_scale_space_filter_bank_equals_scipy_gaussian_filter():
+    # the wide kernels go through one shared FFT; each smoothed profile must
+    # equal scipy's direct filter (same sampled, normalised, reflected kernel)
+    from scipy.ndimage import gaussian_filter1d
+
+    from fractalgeo_rs.dimension.profile import _gaussian_bank
+
+    for n in (257, 5000):
+        z = fg.fbm(n, 0.4, method="exact", seed=n)
+        sig = np.array([1.0, 3.0, 6.0, 7.5, 16.0, n / 12])
+        for s, g in zip(sig, _gaussian_bank(z, sig)):
+            ref = gaussian_filter1d(z, s, mode="reflect")
+            np.testing.assert_allclose(g, ref, rtol=0, atol=1e-10 * np.abs(ref).max())

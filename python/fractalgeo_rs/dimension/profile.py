@@ -77,6 +77,49 @@ def higuchi(data, *, k_max: Optional[int] = None, nodata: Optional[float] = None
                       x_label="interval k (samples)", y_label="curve length L(k)")
 
 
+_FFT_SIGMA = 6.0  # above this width the filter bank runs through one shared FFT
+
+
+def _gaussian_bank(z: np.ndarray, sigmas: np.ndarray):
+    """Yield ``scipy.ndimage.gaussian_filter1d(z, s, mode="reflect")`` for
+    each width (same sampled kernel, radius ``int(4 s + 0.5)``, normalised).
+
+    Narrow kernels are applied directly; wide ones (whose direct cost grows
+    with ``s``) as products with the FFT of the signal, reflected once by the
+    largest radius and transformed once for all widths. A circular
+    convolution of that padded signal equals the linear one on the central
+    ``n`` samples because no kernel reaches past the padding; results agree
+    with the direct filter to rounding (about 1e-12 relative).
+    """
+    from scipy import fft as sfft
+    from scipy.ndimage import gaussian_filter1d
+
+    z = np.asarray(z, dtype=np.float64)
+    n = z.size
+    wide = [s for s in sigmas if s > _FFT_SIGMA]
+    if wide:
+        big = int(4.0 * max(wide) + 0.5)
+        if big >= n:
+            wide = []  # reflection by more than the profile: use the direct filter
+    spec = None
+    for s in sigmas:
+        if s not in wide:
+            yield gaussian_filter1d(z, s, mode="reflect")
+            continue
+        if spec is None:
+            y = np.pad(z, big, mode="symmetric")  # scipy's "reflect": d c b a | a b c d
+            size = sfft.next_fast_len(y.size, real=True)
+            spec = sfft.rfft(y, size)
+        r = int(4.0 * s + 0.5)
+        k = np.arange(-r, r + 1, dtype=np.float64)
+        w = np.exp(-0.5 * (k / s) ** 2)
+        w /= w.sum()
+        kern = np.zeros(size)
+        kern[: r + 1] = w[r:]
+        kern[size - r:] = w[:r]
+        yield sfft.irfft(spec * sfft.rfft(kern), size)[big:big + n]
+
+
 def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, sample_spacing: float = 0.0,
                 nodata: Optional[float] = None, scale_range: ScaleRange = None) -> DimensionFit:
     """Gaussian scale-space dimension of a profile (the paper's eq. 14).
@@ -106,8 +149,6 @@ def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, sample_spacin
         ``D = 1 - slope``. Edges are handled by reflection
         (``scipy.ndimage.gaussian_filter1d``, mode "reflect").
     """
-    from scipy.ndimage import gaussian_filter1d
-
     z = _with_nodata(_real_array(data, (1,)), data, nodata)
     _gap_free(z, "scale space")
     if isinstance(sample_spacing, bool) or not np.isscalar(sample_spacing) or not sample_spacing >= 0:
@@ -118,7 +159,7 @@ def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, sample_spacin
     sig = np.asarray(sorted(set(float(s) for s in sigmas)))
     if sig.size < 3 or sig[0] <= 0 or not np.isfinite(sig).all():
         raise ValueError(f"sigmas: need at least 3 distinct positive widths, got {sig.tolist()}")
-    lengths = np.array([np.sum(np.hypot(dx, np.diff(gaussian_filter1d(z, s, mode="reflect")))) for s in sig])
+    lengths = np.array([np.sum(np.hypot(dx, np.diff(g))) for g in _gaussian_bank(z, sig)])
     return fit_loglog(sig, lengths, method="scale_space", dim_offset=1.0, dim_factor=-1.0,
                       scale_range=scale_range, x_label="sigma (samples)", y_label="length L(sigma)",
                       extra={"sample_spacing": dx})
