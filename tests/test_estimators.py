@@ -304,3 +304,24 @@ def test_scale_space_filter_bank_equals_scipy_gaussian_filter():
         for s, g in zip(sig, _gaussian_bank(z, sig)):
             ref = gaussian_filter1d(z, s, mode="reflect")
             np.testing.assert_allclose(g, ref, rtol=0, atol=1e-10 * np.abs(ref).max())
+
+
+def test_higuchi_lengths_equal_the_definition_and_any_thread_count():
+    # L(k) from a direct loop over offsets m (Higuchi 1988, with the final 1/k)
+    def lengths(z, k_max):
+        n, out = z.size, []
+        for k in range(1, k_max + 1):
+            lm = []
+            for m in range(k):
+                x = z[m::k]
+                if x.size >= 2:
+                    lm.append(np.abs(np.diff(x)).sum() * (n - 1) / ((x.size - 1) * k) / k)
+            out.append(np.mean(lm))
+        return np.array(out)
+
+    for n, k_max in ((21, 10), (101, 17), (1000, 64)):
+        z = fg.fbm(n, 0.3, method="exact", seed=n)
+        fit = fg.higuchi(z, k_max=k_max)
+        np.testing.assert_allclose(fit.measures, lengths(z, k_max), rtol=1e-12)
+        assert np.array_equal(fit.measures, fg.higuchi(z, k_max=k_max, n_threads=1).measures)
+        assert np.array_equal(fit.measures, fg.higuchi(z, k_max=k_max, n_threads=3).measures)

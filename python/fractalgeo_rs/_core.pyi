@@ -16,6 +16,7 @@ __all__ = [
     "box_count_points",
     "column_ranges",
     "dbc_count",
+    "higuchi_lengths",
     "hillshade_f64",
     "ifs_chaos_game",
     "ifs_check",
@@ -65,6 +66,11 @@ def dbc_count(
     z_unit: float,
     n_threads: Optional[int] = None,
 ) -> Tuple[npt.NDArray[np.uint64], npt.NDArray[np.float64]]: ...
+def higuchi_lengths(
+    data: npt.NDArray[np.float64],
+    k_max: int,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...
 def column_ranges(
     data: npt.NDArray[np.float64],
     box_sizes: Sequence[int],
