@@ -325,3 +325,26 @@ def test_higuchi_lengths_equal_the_definition_and_any_thread_count():
         np.testing.assert_allclose(fit.measures, lengths(z, k_max), rtol=1e-12)
         assert np.array_equal(fit.measures, fg.higuchi(z, k_max=k_max, n_threads=1).measures)
         assert np.array_equal(fit.measures, fg.higuchi(z, k_max=k_max, n_threads=3).measures)
+
+
+def test_transect_dimensions_equal_a_per_line_fit_with_nan_holes():
+    # independent: np.polyfit per row and column on the NaN-free increments
+    z = fg.fbm_surface((64, 80), 0.4, method="exact", seed=3).astype(float)
+    z[5, 7] = np.nan
+    z[20:23, :] = np.nan
+    z[:, 40] = np.nan
+    lags = (1, 2, 3)
+    for p in (1.0, 2.0, 1.5):
+        fit = fg.surface_variation(z, estimator="transect", p=p, lags=lags)
+        dims = []
+        for line in list(z) + list(z.T):
+            m = []
+            for u in lags:
+                d = line[u:] - line[:-u]
+                d = d[~np.isnan(d)]
+                m.append(np.mean(np.abs(d) ** p) / 2 if d.size else np.nan)
+            m = np.array(m)
+            if np.all(m > 0) and np.isfinite(m).all():
+                dims.append(2 - np.polyfit(np.log(lags), np.log(m), 1)[0] / p)
+        np.testing.assert_allclose(fit.extra["transect_dimensions"], np.array(dims) + 1, rtol=1e-12)
+        assert fit.dimension == pytest.approx(np.median(dims) + 1, rel=1e-12)
