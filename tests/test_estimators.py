@@ -348,3 +348,15 @@ def test_transect_dimensions_equal_a_per_line_fit_with_nan_holes():
                 dims.append(2 - np.polyfit(np.log(lags), np.log(m), 1)[0] / p)
         np.testing.assert_allclose(fit.extra["transect_dimensions"], np.array(dims) + 1, rtol=1e-12)
         assert fit.dimension == pytest.approx(np.median(dims) + 1, rel=1e-12)
+
+
+def test_spectral_detrend_removes_the_least_squares_plane():
+    from fractalgeo_rs.dimension.spectral import _detrend
+
+    rng = np.random.default_rng(1)
+    for shape in [(7, 9), (1, 5), (50, 1), (33, 64)]:
+        z = rng.normal(size=shape) + np.add.outer(np.arange(shape[0]) * 0.3, np.arange(shape[1]) * -0.7)
+        i, j = np.indices(shape, dtype=float)
+        a = np.column_stack([np.ones(z.size), i.ravel(), j.ravel()])
+        coef, *_ = np.linalg.lstsq(a, z.ravel(), rcond=None)
+        np.testing.assert_allclose(_detrend(z), z - (a @ coef).reshape(shape), atol=1e-10)
