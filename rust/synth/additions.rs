@@ -105,33 +105,64 @@ fn check(p: &AdditionsParams) -> CoreResult<()> {
 fn pad2(g: &[f64], r: usize, c: usize, periodic: bool) -> Vec<f64> {
     let (pr, pc) = (r + 4, c + 4);
     let mut out = vec![0.0; pr * pc];
-    // Rows of the original, columns padded.
-    let ext = |v: &dyn Fn(usize) -> f64, n: usize, k: isize| -> f64 {
-        if periodic {
-            v(k.rem_euclid(n as isize) as usize)
-        } else if n == 1 {
-            v(0)
-        } else if k < 0 {
-            let d = v(0) - v(1);
-            v(0) + (-k) as f64 * d
-        } else if k as usize >= n {
-            let d = v(n - 1) - v(n - 2);
-            v(n - 1) + (k as usize - n + 1) as f64 * d
+    // Values at -2, -1 and n, n+1 of a line `v` of length n.
+    let ends = |v0: f64, v1: f64, w1: f64, w0: f64, n: usize| -> [f64; 4] {
+        // v0 = v[0], v1 = v[1], w1 = v[n-2], w0 = v[n-1]
+        if n == 1 {
+            [v0; 4]
         } else {
-            v(k as usize)
+            let (d0, d1) = (v0 - v1, w0 - w1);
+            [v0 + 2.0 * d0, v0 + d0, w0 + d1, w0 + 2.0 * d1]
         }
     };
-    for i in 0..r {
-        let row = &g[i * c..(i + 1) * c];
-        for jj in 0..pc {
-            out[(i + 2) * pc + jj] = ext(&|j| row[j], c, jj as isize - 2);
+    out[2 * pc..(r + 2) * pc]
+        .par_chunks_mut(pc)
+        .enumerate()
+        .for_each(|(i, dst)| {
+            let row = &g[i * c..(i + 1) * c];
+            dst[2..c + 2].copy_from_slice(row);
+            let e = if periodic {
+                [row[(2 * c - 2) % c], row[c - 1], row[0], row[1 % c]]
+            } else {
+                ends(
+                    row[0],
+                    row[c.min(2) - 1],
+                    row[c.saturating_sub(2)],
+                    row[c - 1],
+                    c,
+                )
+            };
+            dst[0] = e[0];
+            dst[1] = e[1];
+            dst[c + 2] = e[2];
+            dst[c + 3] = e[3];
+        });
+    // Padded rows -2, -1, r, r+1 from whole padded rows.
+    let src = |k: usize| (k + 2) * pc; // start of padded row of original row k
+    let mut extra = vec![0.0; 4 * pc];
+    for jj in 0..pc {
+        let e = if periodic {
+            [
+                out[src((2 * r - 2) % r) + jj],
+                out[src(r - 1) + jj],
+                out[src(0) + jj],
+                out[src(1 % r) + jj],
+            ]
+        } else {
+            ends(
+                out[src(0) + jj],
+                out[src(r.min(2) - 1) + jj],
+                out[src(r.saturating_sub(2)) + jj],
+                out[src(r - 1) + jj],
+                r,
+            )
+        };
+        for (t, v) in e.iter().enumerate() {
+            extra[t * pc + jj] = *v;
         }
     }
-    for jj in 0..pc {
-        let col: Vec<f64> = (0..r).map(|i| out[(i + 2) * pc + jj]).collect();
-        for ii in [0usize, 1, r + 2, r + 3] {
-            out[ii * pc + jj] = ext(&|i| col[i], r, ii as isize - 2);
-        }
+    for (t, ii) in [0usize, 1, r + 2, r + 3].iter().enumerate() {
+        out[ii * pc..(ii + 1) * pc].copy_from_slice(&extra[t * pc..(t + 1) * pc]);
     }
     out
 }

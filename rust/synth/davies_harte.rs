@@ -19,7 +19,25 @@ use super::rng::StreamKey;
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 use realfft::num_complex::Complex;
-use realfft::RealFftPlanner;
+use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// One planner for the process: plans (twiddle tables) are built once per
+/// length and shared; the lock is held only while looking a plan up.
+fn planner() -> &'static Mutex<RealFftPlanner<f64>> {
+    static P: OnceLock<Mutex<RealFftPlanner<f64>>> = OnceLock::new();
+    P.get_or_init(|| Mutex::new(RealFftPlanner::new()))
+}
+
+fn forward(n: usize) -> Arc<dyn RealToComplex<f64>> {
+    let mut p = planner().lock().unwrap_or_else(|e| e.into_inner());
+    p.plan_fft_forward(n)
+}
+
+fn inverse(n: usize) -> Arc<dyn ComplexToReal<f64>> {
+    let mut p = planner().lock().unwrap_or_else(|e| e.into_inner());
+    p.plan_fft_inverse(n)
+}
 
 fn check(m: usize, hurst: f64) -> CoreResult<()> {
     if !(hurst > 0.0 && hurst < 1.0) {
@@ -51,8 +69,7 @@ pub fn fgn_sqrt_eigenvalues(m: usize, hurst: f64) -> CoreResult<Vec<f64>> {
         .with_min_len(1 << 14)
         .map(|t| g(if t <= m { t } else { n - t }))
         .collect();
-    let mut planner = RealFftPlanner::<f64>::new();
-    let r2c = planner.plan_fft_forward(n);
+    let r2c = forward(n);
     let mut spec = r2c.make_output_vec();
     r2c.process(&mut row, &mut spec)
         .map_err(|e| CoreError::Internal(format!("fft: {e}")))?;
@@ -113,8 +130,7 @@ pub fn fbm_from_eigenvalues(
             };
         });
     let len = 2 * m;
-    let mut planner = RealFftPlanner::<f64>::new();
-    let c2r = planner.plan_fft_inverse(len);
+    let c2r = inverse(len);
     let mut inc = c2r.make_output_vec();
     c2r.process(&mut spec, &mut inc)
         .map_err(|e| CoreError::Internal(format!("fft: {e}")))?;
