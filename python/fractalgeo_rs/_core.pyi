@@ -12,10 +12,13 @@ __all__ = [
     "LSystemCore",
     "ModuleString",
     "__version__",
+    "additions_refine_2d",
     "box_count_binary",
     "box_count_points",
     "column_ranges",
+    "davies_harte_fbm",
     "dbc_count",
+    "fgn_sqrt_eigenvalues",
     "higuchi_lengths",
     "hillshade_f64",
     "ifs_chaos_game",
@@ -107,6 +110,23 @@ def midpoint_refine_2d(
     seed: int,
     first_level: int = 0,
     n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...
+def additions_refine_2d(
+    coarse: npt.NDArray[np.float64],
+    levels: int,
+    hurst: float,
+    sigma: float,
+    coarse_spacing: float,
+    tension: float,
+    variances: Sequence[float],
+    periodic: bool,
+    seed: int,
+    first_level: int = 0,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...
+def fgn_sqrt_eigenvalues(m: int, hurst: float, n_threads: Optional[int] = None) -> npt.NDArray[np.float64]: ...
+def davies_harte_fbm(
+    sqrt_eig: npt.NDArray[np.float64], n: int, seed: int, stream: int, n_threads: Optional[int] = None
 ) -> npt.NDArray[np.float64]: ...
 def hillshade_f64(
     dem: npt.NDArray[np.float64],
