@@ -38,6 +38,7 @@ __all__ = [
     "read_exr",
     "read_image",
     "shade_to_byte",
+    "spectral_filter_2d",
     "turtle_mesh",
     "turtle_polylines",
     "turtle_segments",
@@ -128,6 +129,7 @@ def fgn_sqrt_eigenvalues(m: int, hurst: float, n_threads: Optional[int] = None) 
 def davies_harte_fbm(
     sqrt_eig: npt.NDArray[np.float64], n: int, seed: int, stream: int, n_threads: Optional[int] = None
 ) -> npt.NDArray[np.float64]: ...
+def spectral_filter_2d(n0: int, n1: int, hurst: float, n_threads: Optional[int] = None) -> npt.NDArray[np.float64]: ...
 def hillshade_f64(
     dem: npt.NDArray[np.float64],
     dx: Sequence[float],

@@ -6,6 +6,7 @@ use crate::synth::additions::{self, AdditionsParams};
 use crate::synth::davies_harte;
 use crate::synth::midpoint::{self, RefineParams};
 use crate::synth::rng;
+use crate::synth::spectral;
 use numpy::ndarray::Array2;
 use numpy::PyUntypedArrayMethods;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
@@ -171,6 +172,22 @@ fn fgn_sqrt_eigenvalues<'py>(
     Ok(v.into_pyarray(py))
 }
 
+/// Amplitude filter of 2D spectral synthesis on the `rfft2` grid of an
+/// `(n0, n1)` field: aliased fBm density with the low-frequency
+/// compensation, unit lag-one variance (`crate::synth::spectral`).
+#[pyfunction]
+#[pyo3(signature = (n0, n1, hurst, n_threads=None))]
+fn spectral_filter_2d<'py>(
+    py: Python<'py>,
+    n0: usize,
+    n1: usize,
+    hurst: f64,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let v = py.detach(|| run_in_pool(n_threads, || spectral::filter_2d(n0, n1, hurst)))?;
+    Ok(v.into_pyarray(py))
+}
+
 /// Exact fBm path of `n` samples (Davies-Harte) from `fgn_sqrt_eigenvalues`.
 #[pyfunction]
 #[pyo3(signature = (sqrt_eig, n, seed, stream, n_threads=None))]
@@ -273,6 +290,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(additions_refine_2d, m)?)?;
     m.add_function(wrap_pyfunction!(fgn_sqrt_eigenvalues, m)?)?;
     m.add_function(wrap_pyfunction!(davies_harte_fbm, m)?)?;
+    m.add_function(wrap_pyfunction!(spectral_filter_2d, m)?)?;
     m.add_function(wrap_pyfunction!(hillshade_f64, m)?)?;
     Ok(())
 }

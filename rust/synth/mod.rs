@@ -6,11 +6,14 @@
 //!   factor-2 refinement kernels in 1D and 2D (diamond-square);
 //! * [`additions`]: successive random additions with 4-point interpolation
 //!   and variances balanced against creases (2D `"additions"`);
-//! * [`davies_harte`]: exact 1D fBm by circulant embedding with real FFTs.
+//! * [`davies_harte`]: exact 1D fBm by circulant embedding with real FFTs;
+//! * [`spectral`]: the amplitude filter of 2D spectral synthesis (aliased
+//!   fBm density with a low-frequency compensation).
 //!
-//! Stein's 2D circulant embedding and spectral synthesis run on the Python
-//! side with `scipy.fft` on noise drawn here.
+//! Stein's 2D circulant embedding and the FFTs of spectral synthesis run on
+//! the Python side with `scipy.fft` on noise and filters computed here.
 pub mod additions;
 pub mod davies_harte;
 pub mod midpoint;
 pub mod rng;
+pub mod spectral;

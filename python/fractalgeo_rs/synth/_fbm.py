@@ -339,28 +339,12 @@ def _refine(coarse, levels, h, spacing, additions, periodic, seed, n_threads):
 
 @functools.lru_cache(maxsize=2)
 def _spectral_amplitude(n0, n1, h):
-    """Filter |f|^(-beta/2), beta = 2H + 2, on the rfft2 grid, scaled so the
-    field has unit lag-one increment variance (mean of both axes). Cached
+    """Amplitude filter on the rfft2 grid (``_core.spectral_filter_2d``):
+    ``A^2`` is the aliased fBm density ``sum over m of |f + m|^-(2H+2)``
+    plus the power of the cell ``f = 0`` in the lowest modes, scaled to unit
+    lag-one increment variance along both axes (docs/synthesis.md). Cached
     (read-only) for repeated syntheses of one shape."""
-    f0 = sfft.fftfreq(n0)
-    f1 = sfft.rfftfreq(n1)
-    a2 = np.add.outer(f0 * f0, f1 * f1)
-    a2[0, 0] = 1.0
-    np.power(a2, -(h + 1.0), out=a2)  # amp^2 = |f|^(-beta)
-    a2[0, 0] = 0.0
-    # Lag-1 variance along each axis of the real field irfft2(amp * W):
-    # (1/N) sum over the full spectrum of amp^2 * 2 (1 - cos(2 pi f)); in the
-    # half spectrum the columns 0 < k1 < n1/2 stand for two bins.
-    weight = np.full(f1.size, 2.0)
-    weight[0] = 1.0
-    if n1 % 2 == 0:
-        weight[-1] = 1.0
-    rows = a2 @ weight  # sum over k1 of w * a2
-    cols = weight * a2.sum(axis=0)
-    v0 = rows @ (2 * (1 - np.cos(2 * np.pi * f0))) / (n0 * n1)
-    v1 = cols @ (2 * (1 - np.cos(2 * np.pi * f1))) / (n0 * n1)
-    amp = np.sqrt(a2, out=a2)
-    amp *= 1.0 / math.sqrt(0.5 * (v0 + v1))
+    amp = _core.spectral_filter_2d(int(n0), int(n1), float(h))
     amp.setflags(write=False)
     return amp
 
