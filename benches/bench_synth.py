@@ -6,7 +6,8 @@ Every pair is timed in the same run (best of ``--repeat``), and the table
 prints ``ratio = baseline / ours`` (above 1: ours is faster). Baselines:
 
 * 2D spectral: plain numpy (``np.random`` white noise, ``np.fft.rfft2``,
-  ``|f|^-beta/2`` filter, ``np.fft.irfft2``), the figure-3 algorithm;
+  ``|f|^-beta/2`` filter, ``np.fft.irfft2``), the figure-3 algorithm; ours
+  computes the aliased fBm filter (Rust) on the first call, then caches it;
 * 2D midpoint/additions: a vectorised numpy diamond-square (below); for
   additions it is the classic Peitgen & Saupe form (bilinear means), which
   does less work than our crease-free 4-point scheme;

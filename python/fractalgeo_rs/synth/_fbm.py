@@ -226,7 +226,12 @@ def fbm_surface(shape, hurst, *, method="exact", seed=None, cell_size=1.0, sigma
           ``R = 2`` above), in memory too.
         * ``"spectral"``: figure 3 of the seed paper: a random matrix (white
           noise), its FFT, the filter :math:`|f|^{-\beta/2}` with
-          :math:`\beta = 2H + 2`, the inverse FFT (Voss 1988). The FFT of the
+          :math:`\beta = 2H + 2`, the inverse FFT (Voss 1988). The filter is
+          that of fBm sampled on the grid: the aliased density
+          :math:`\sum_m |f + m|^{-\beta}` plus, in the lowest modes, the
+          power of wavelengths longer than the grid, so the variogram
+          follows :math:`|h|^{2H}` from lag 1 on (0.1 % to lag 16; below it
+          at lags comparable to the grid). The FFT of the
           random matrix is drawn directly with its exact distribution, which
           saves one FFT. Periodic on the
           generated grid; with ``periodic=False`` the grid is padded by a

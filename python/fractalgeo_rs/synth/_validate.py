@@ -209,9 +209,9 @@ def validate_surface(z, hurst=None, *, lags=None, periodic=None, coastline=True)
         :math:`\gamma(h) = \mathrm{mean}(Z(x+h) - Z(x))^2 \propto h^{2H}`.
         Default ``(8, 16, 32, 64)`` without the lags above a quarter of the
         smaller side (at least two kept). Lags 1-4 are left out on purpose:
-        there the discretisation of the midpoint and spectral methods bends
-        the variogram (their local slope converges to ``2H`` from 8 cells
-        on), while exact fBm follows :math:`h^{2H}` at every lag.
+        there the discretisation of the midpoint methods bends the variogram
+        (their local slope converges to ``2H`` from 8 cells on), while exact
+        fBm and the spectral method follow :math:`h^{2H}` at every lag.
     periodic : bool or None
         Treat the surface as periodic for the spectrum (no window). ``None``:
         periodic when ``periodicity_ratio < 1.5``.
