@@ -15,6 +15,7 @@ from fractalgeo_rs.fit import DimensionFit
 from fractalgeo_rs.dimension import (
     Lacunarity,
     blanket,
+    fbm_mle,
     higuchi,
     lacunarity,
     madogram,
@@ -48,6 +49,7 @@ __all__ = [
     "DimensionFit",
     "Lacunarity",
     "blanket",
+    "fbm_mle",
     "higuchi",
     "lacunarity",
     "madogram",

@@ -22,6 +22,7 @@ method         data                                             function
 ``"scale_space"`` profiles (Gaussian scale space, eq. 14)       :func:`scale_space`
 ``"higuchi"``  profiles and time series                         :func:`higuchi`
 ``"whittle"``  fBm profiles and surfaces (debiased Whittle)     :func:`whittle`
+``"mle"``      small fBm profiles and surfaces (exact Gaussian) :func:`fbm_mle`
 =============  ===============================================  =====================================
 
 :func:`lacunarity` (gliding box) returns its own :class:`Lacunarity` result.
@@ -41,13 +42,14 @@ from fractalgeo_rs.dimension.profile import higuchi, scale_space, wavelet_dimens
 from fractalgeo_rs.dimension.spectral import spectral_dimension
 from fractalgeo_rs.dimension.surface import blanket, mass_dimension, minkowski
 from fractalgeo_rs.dimension.variation import madogram, power_variation, surface_variation, variogram
-from fractalgeo_rs.dimension.whittle import whittle
+from fractalgeo_rs.dimension.likelihood import fbm_mle, whittle
 from fractalgeo_rs.fit import DimensionFit
 
 __all__ = [
     "METHODS",
     "Lacunarity",
     "blanket",
+    "fbm_mle",
     "higuchi",
     "lacunarity",
     "madogram",
@@ -84,6 +86,7 @@ METHODS: Dict[str, Callable[..., DimensionFit]] = {
     "scale_space": scale_space,
     "higuchi": higuchi,
     "whittle": whittle,
+    "mle": fbm_mle,
 }
 
 
