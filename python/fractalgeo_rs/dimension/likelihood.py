@@ -1,5 +1,6 @@
-"""Debiased Whittle likelihood estimator of the Hurst exponent of fBm profiles
-and surfaces.
+"""Likelihood estimators of the Hurst exponent of fBm profiles and surfaces:
+the debiased Whittle likelihood (:func:`whittle`, any size) and exact
+Gaussian maximum likelihood (:func:`fbm_mle`, small grids).
 
 fBm is not stationary, but any filter whose weights sum to zero turns it into
 a stationary Gaussian field ``Y(x) = sum_a w_a Z(x + x_a)``. From the fBm
@@ -286,10 +287,19 @@ def whittle(
 
     Notes
     -----
-    The curvature standard error treats periodogram ordinates as
-    independent; for the pooled ``"first"`` filter of surfaces the two
-    contrasts share information and its ``stderr`` is too small (see
-    ``docs/accuracy.md`` for the measured calibration).
+    Measured on exact fBm (``docs/accuracy.md``, 100 replicates): RMSE of
+    ``D`` about 0.004-0.005 at 256², 0.016-0.019 at 64² and 0.037-0.044 at
+    32² for ``0.3 <= H <= 0.7`` with the default filter, |bias| <= 0.004.
+    On small grids the debiased Whittle likelihood is not efficient: at 32²
+    its RMSE is 25-30 % above that of the exact likelihood and 40 % above
+    the Cramér-Rao bound (``benches/crb_fbm_surface.py``); use
+    :func:`fbm_mle` on grids up to about 40 x 40. The curvature standard error treats periodogram
+    ordinates as independent; it is 5-15 % below the measured spread for
+    the Laplacian and square filters, and about 30 % below it for the
+    pooled ``"first"`` filter of surfaces, whose two contrasts share
+    information. A data taper (``"hann"``) is accounted for exactly but
+    costs efficiency on small grids (RMSE 0.056 instead of 0.037 at 32²,
+    ``H = 0.3``).
 
     References
     ----------
@@ -460,9 +470,11 @@ def fbm_mle(
     the ``N x N`` matrix per step, ``O(N^3)``). This is the efficient
     estimator the debiased Whittle likelihood (:func:`whittle`)
     approximates; on grids up to about 40 x 40 its lower variance is worth
-    the cost (``docs/accuracy.md``). ``D = 2 - H`` (profiles) or ``3 - H``
-    (surfaces). Missing samples are simply left out of ``u``: the
-    likelihood of the observed samples is exact for any gap pattern.
+    the cost (``docs/accuracy.md``: RMSE of ``D`` 0.028-0.035 at 32² for
+    ``0.3 <= H <= 0.7``, within 10 % of the Cramér-Rao bound).
+    ``D = 2 - H`` (profiles) or ``3 - H`` (surfaces). Missing samples are
+    simply left out of ``u``: the likelihood of the observed samples is
+    exact for any gap pattern.
 
     Parameters
     ----------
