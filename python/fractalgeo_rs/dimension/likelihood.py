@@ -294,9 +294,9 @@ def whittle(
     its RMSE is 25-30 % above that of the exact likelihood and 40 % above
     the Cramér-Rao bound (``benches/crb_fbm_surface.py``); use
     :func:`fbm_mle` on grids up to about 40 x 40. The curvature standard error treats periodogram
-    ordinates as independent; it is 5-15 % below the measured spread for
-    the Laplacian and square filters, and about 30 % below it for the
-    pooled ``"first"`` filter of surfaces, whose two contrasts share
+    ordinates as independent; it is 0-15 % below the measured spread for
+    the Laplacian and square filters, and 30-70 % below it for the pooled
+    ``"first"`` filter of surfaces, whose two contrasts share
     information. A data taper (``"hann"``) is accounted for exactly but
     costs efficiency on small grids (RMSE 0.056 instead of 0.037 at 32²,
     ``H = 0.3``).
