@@ -61,6 +61,11 @@ class DimensionFit:
     extra : mapping
         Method-specific results (e.g. ``hurst`` for self-affine counting, the
         counts of every lattice offset).
+    model : ndarray or None
+        Model-based estimates only (``range_selection == "model"``, built by
+        :meth:`from_model`, e.g. the Whittle likelihood): the fitted model's
+        value of the measure at each scale, drawn by :meth:`plot` instead of
+        a line. ``None`` for log-log regressions.
     """
 
     dimension: float
@@ -80,6 +85,76 @@ class DimensionFit:
     x_label: str = "scale"
     y_label: str = "measure"
     extra: Mapping[str, Any] = field(default_factory=dict)
+    model: Optional[np.ndarray] = None
+
+    @classmethod
+    def from_model(
+        cls,
+        *,
+        dimension: float,
+        stderr: float,
+        scales: Sequence[float],
+        measures: Sequence[float],
+        model: Sequence[float],
+        method: str,
+        dim_offset: float = 0.0,
+        x_label: str = "scale",
+        y_label: str = "measure",
+        extra: Optional[Mapping[str, Any]] = None,
+    ) -> "DimensionFit":
+        """A dimension estimated by fitting a model rather than a line.
+
+        Likelihood estimators (e.g. :func:`fractalgeo_rs.whittle`) estimate
+        ``D`` directly; there is no regression line. Their fit object keeps
+        the log-log data for :meth:`plot` (``scales``, ``measures`` and the
+        fitted ``model`` at the same scales), ``slope`` and ``intercept``
+        are NaN, ``r_squared`` is the coefficient of determination of
+        ``log measures`` by ``log model``, ``ci95`` is
+        ``dimension +- 1.96 stderr`` (normal approximation) and
+        ``range_selection`` is ``"model"``.
+
+        Parameters
+        ----------
+        dimension, stderr : float
+            The estimate and its standard error.
+        scales, measures, model : sequence of float
+            Log-log data and the fitted model at the same scales (positive).
+        method : str
+            Name recorded in the result.
+        dim_offset : float
+            Recorded as ``dim_offset`` (e.g. 3 for ``D = 3 - H``); the
+            ``dim_factor`` is -1.
+        x_label, y_label : str
+            Axis labels of :meth:`plot`.
+        extra : mapping, optional
+            Method-specific results.
+
+        Returns
+        -------
+        DimensionFit
+        """
+        s = np.asarray(scales, dtype=float)
+        m = np.asarray(measures, dtype=float)
+        mo = np.asarray(model, dtype=float)
+        if s.ndim != 1 or s.shape != m.shape or s.shape != mo.shape or s.size == 0:
+            raise ValueError("scales: scales, measures and model must be non-empty 1D arrays of the same length")
+        order = np.argsort(s, kind="stable")
+        s, m, mo = s[order], m[order], mo[order]
+        used = np.isfinite(s) & np.isfinite(m) & np.isfinite(mo) & (s > 0) & (m > 0) & (mo > 0)
+        r2 = float("nan")
+        if np.count_nonzero(used) > 1:
+            ly, lm = np.log(m[used]), np.log(mo[used])
+            syy = float(np.sum((ly - ly.mean()) ** 2))
+            r2 = 1.0 - float(np.sum((ly - lm) ** 2)) / syy if syy > 0 else 1.0
+        half = 1.959963984540054 * float(stderr)
+        lo, hi = (float(s[used][0]), float(s[used][-1])) if used.any() else (float("nan"), float("nan"))
+        return cls(
+            dimension=float(dimension), slope=float("nan"), intercept=float("nan"), r_squared=r2,
+            stderr=float(stderr), ci95=(float(dimension) - half, float(dimension) + half),
+            scales=s, measures=m, used=used, scale_range=(lo, hi), method=method,
+            range_selection="model", dim_offset=float(dim_offset), dim_factor=-1.0,
+            x_label=x_label, y_label=y_label, extra=dict(extra or {}), model=mo,
+        )
 
     @property
     def n_used(self) -> int:
@@ -131,9 +206,13 @@ class DimensionFit:
         ax.loglog(s[u & ok], m[u & ok], "o", color=color, label=label or self.method)
         if np.any(~u & ok):
             ax.loglog(s[~u & ok], m[~u & ok], "o", mfc="none", color=color, label="not fitted")
-        xs = np.array(self.scale_range, dtype=float)
-        ax.loglog(xs, np.exp(self.intercept + self.slope * np.log(xs)), "-", color=color,
-                  label=f"D = {self.dimension:.3f} ± {1.96 * self.stderr:.3f}")
+        if self.model is not None:
+            ax.loglog(s[u], self.model[u], "-", color=color,
+                      label=f"D = {self.dimension:.3f} ± {1.96 * self.stderr:.3f} (model)")
+        else:
+            xs = np.array(self.scale_range, dtype=float)
+            ax.loglog(xs, np.exp(self.intercept + self.slope * np.log(xs)), "-", color=color,
+                      label=f"D = {self.dimension:.3f} ± {1.96 * self.stderr:.3f}")
         from matplotlib.ticker import NullFormatter
 
         ax.xaxis.set_minor_formatter(NullFormatter())

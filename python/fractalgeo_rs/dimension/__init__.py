@@ -21,6 +21,8 @@ method         data                                             function
 ``"wavelet"``  profiles and surfaces (Haar detail variance)     :func:`wavelet_dimension`
 ``"scale_space"`` profiles (Gaussian scale space, eq. 14)       :func:`scale_space`
 ``"higuchi"``  profiles and time series                         :func:`higuchi`
+``"whittle"``  fBm profiles and surfaces (debiased Whittle)     :func:`whittle`
+``"mle"``      small fBm profiles and surfaces (exact Gaussian) :func:`fbm_mle`
 =============  ===============================================  =====================================
 
 :func:`lacunarity` (gliding box) returns its own :class:`Lacunarity` result.
@@ -40,12 +42,14 @@ from fractalgeo_rs.dimension.profile import higuchi, scale_space, wavelet_dimens
 from fractalgeo_rs.dimension.spectral import spectral_dimension
 from fractalgeo_rs.dimension.surface import blanket, mass_dimension, minkowski
 from fractalgeo_rs.dimension.variation import madogram, power_variation, surface_variation, variogram
+from fractalgeo_rs.dimension.likelihood import fbm_mle, whittle
 from fractalgeo_rs.fit import DimensionFit
 
 __all__ = [
     "METHODS",
     "Lacunarity",
     "blanket",
+    "fbm_mle",
     "higuchi",
     "lacunarity",
     "madogram",
@@ -57,6 +61,7 @@ __all__ = [
     "surface_variation",
     "variogram",
     "wavelet_dimension",
+    "whittle",
     "box_counting",
     "box_counting_points",
     "differential_box_counting",
@@ -80,6 +85,8 @@ METHODS: Dict[str, Callable[..., DimensionFit]] = {
     "wavelet": wavelet_dimension,
     "scale_space": scale_space,
     "higuchi": higuchi,
+    "whittle": whittle,
+    "mle": fbm_mle,
 }
 
 

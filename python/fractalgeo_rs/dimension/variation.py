@@ -24,6 +24,7 @@ dimension for two-dimensional surface data. *Statistica Sinica* 10, 343-376.
 """
 from __future__ import annotations
 
+import numbers
 from typing import Optional, Sequence
 
 import numpy as np
@@ -52,7 +53,7 @@ def _real_array(data, ndims, name="data") -> np.ndarray:
 def _with_nodata(z: np.ndarray, data, nodata) -> np.ndarray:
     if nodata is None:
         return z
-    if isinstance(nodata, bool) or not np.isscalar(nodata):
+    if isinstance(nodata, bool) or not isinstance(nodata, numbers.Real):
         raise TypeError(f"nodata: expected a number, got {nodata!r}")
     if not np.isnan(nodata):
         z = z.copy()
