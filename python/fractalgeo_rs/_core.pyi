@@ -12,10 +12,13 @@ __all__ = [
     "LSystemCore",
     "ModuleString",
     "__version__",
+    "blanket_areas_image",
+    "blanket_transform_map",
     "box_count_binary",
     "box_count_points",
     "column_ranges",
     "dbc_count",
+    "dbc_transform_map",
     "hillshade_f64",
     "ifs_chaos_game",
     "ifs_check",
@@ -225,6 +228,31 @@ def mass_transform_map(
     min_valid: float,
     n_threads: Optional[int] = None,
 ) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
+def dbc_transform_map(
+    image: npt.NDArray[np.float64],
+    window_size: int,
+    box_sizes: Sequence[int],
+    z_scale: float,
+    z0: float,
+    min_valid: float,
+    step: int,
+    n_threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
+def blanket_transform_map(
+    image: npt.NDArray[np.float64],
+    window_size: int,
+    epsilons: Sequence[int],
+    z_scale: float,
+    min_valid: float,
+    step: int,
+    n_threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
+def blanket_areas_image(
+    image: npt.NDArray[np.float64],
+    eps_max: int,
+    z_scale: float,
+    n_threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.float64], int]: ...
 def lacunarity_transform_map(
     image: npt.NDArray[np.float64],
     window_size: int,

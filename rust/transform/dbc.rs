@@ -213,7 +213,8 @@ pub fn dbc_transform(
                     for kc in 0..ocols {
                         let v0 = (kc * step) as isize;
                         let (a, b) = (u0 + last, v0 + last);
-                        let mut n = at(&tss, wss, a, b) - at(&tss, wss, u0 - si_, b)
+                        let mut n = at(&tss, wss, a, b)
+                            - at(&tss, wss, u0 - si_, b)
                             - at(&tss, wss, a, v0 - si_)
                             + at(&tss, wss, u0 - si_, v0 - si_);
                         if let Some((pts, pst, ptt, wst)) = &partial {
@@ -282,7 +283,10 @@ mod tests {
         let mut win = vec![f64::NAN; w * w];
         for a in 0..w {
             for b in 0..w {
-                let (r, c) = (i as isize + a as isize - h as isize, j as isize + b as isize - h as isize);
+                let (r, c) = (
+                    i as isize + a as isize - h as isize,
+                    j as isize + b as isize - h as isize,
+                );
                 if r >= 0 && c >= 0 && (r as usize) < rows && (c as usize) < cols {
                     win[a * w + b] = z[r as usize * cols + c as usize];
                 }

@@ -26,7 +26,10 @@ pub(crate) fn rect_minmax(
     let mut suf2 = vec![0.0f64; cols];
     for r in 0..rows {
         let (xl, xh) = (&lo[r * cols..(r + 1) * cols], &hi[r * cols..(r + 1) * cols]);
-        let (ol, oh) = (&mut hlo[r * oc..(r + 1) * oc], &mut hhi[r * oc..(r + 1) * oc]);
+        let (ol, oh) = (
+            &mut hlo[r * oc..(r + 1) * oc],
+            &mut hhi[r * oc..(r + 1) * oc],
+        );
         if bw == 1 {
             ol.copy_from_slice(xl);
             oh.copy_from_slice(xh);
@@ -136,7 +139,11 @@ mod tests {
                             h = h.max(hi[rr * cols + cc]);
                         }
                     }
-                    assert_eq!((a[r * oc + c], b[r * oc + c]), (l, h), "{bh}x{bw} ({r},{c})");
+                    assert_eq!(
+                        (a[r * oc + c], b[r * oc + c]),
+                        (l, h),
+                        "{bh}x{bw} ({r},{c})"
+                    );
                 }
             }
         }

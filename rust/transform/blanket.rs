@@ -1,0 +1,363 @@
+//! Peleg's covering blanket (Peleg, Naor, Hartley and Avnir 1984): the
+//! image-wide areas of the `blanket` estimator and the moving-window map.
+//!
+//! From `u_0 = b_0 = z / z_scale` the blankets grow one step at a time over
+//! the 4-neighbourhood `N` (clipped at the edge of the data):
+//!
+//! ```text
+//! u_e = max(u_{e-1} + 1, max_N u_{e-1}),   b_e = min(b_{e-1} - 1, min_N b_{e-1})
+//! A(e) = sum over valid pixels of (u_e - b_e) / (2 e)
+//! D    = 2 - slope of log A(e) against log e
+//! ```
+//!
+//! Missing (NaN) pixels are not part of the surface: they hold no blanket and
+//! pass none on (the blankets grow around holes); the edge of the data is
+//! the same thing as a band of missing pixels. Both kernels run the same
+//! growth step on planes framed by one missing pixel, so they give the same
+//! blankets bit for bit.
+//!
+//! The map recomputes the blankets of every window (the window restricts the
+//! growth, so a pixel's blanket near the window border depends on the
+//! window): its cost is `O(w^2 e_max)` per output pixel and grows with the
+//! window.
+use super::dbc::{check_step, LocalMap};
+use super::sat::{check_window, line_fit, log_axis};
+use crate::error::{CoreError, CoreResult};
+use rayon::prelude::*;
+
+/// Planes of `(rows + 2) x (cols + 2)` samples framed by one missing pixel:
+/// upper and lower blankets (missing: `-inf`, `+inf`), their next step, and
+/// the validity mask.
+struct Planes {
+    rows: usize,
+    cols: usize,
+    u: Vec<f64>,
+    b: Vec<f64>,
+    nu: Vec<f64>,
+    nb: Vec<f64>,
+    valid: Vec<bool>,
+}
+
+impl Planes {
+    fn new(rows: usize, cols: usize) -> Self {
+        let n = (rows + 2) * (cols + 2);
+        Planes {
+            rows,
+            cols,
+            u: vec![f64::NEG_INFINITY; n],
+            b: vec![f64::INFINITY; n],
+            nu: vec![f64::NEG_INFINITY; n],
+            nb: vec![f64::INFINITY; n],
+            valid: vec![false; n],
+        }
+    }
+
+    /// Load row-major `rows x cols` values through `get(r, c)` (NaN: missing),
+    /// divided by `z_scale`; returns the number of valid pixels.
+    fn load(&mut self, z_scale: f64, get: impl Fn(usize, usize) -> f64) -> usize {
+        let pw = self.cols + 2;
+        let mut n = 0;
+        for r in 0..self.rows {
+            for c in 0..self.cols {
+                let k = (r + 1) * pw + c + 1;
+                let x = get(r, c);
+                if x.is_nan() {
+                    self.u[k] = f64::NEG_INFINITY;
+                    self.b[k] = f64::INFINITY;
+                    self.valid[k] = false;
+                } else {
+                    let v = x / z_scale;
+                    self.u[k] = v;
+                    self.b[k] = v;
+                    self.valid[k] = true;
+                    n += 1;
+                }
+            }
+        }
+        n
+    }
+
+    /// One growth step; returns `sum over valid pixels of (u - b)` for the
+    /// rows `[s0, s1)` (plane rows without the frame).
+    fn grow(&mut self, s0: usize, s1: usize) -> f64 {
+        let pw = self.cols + 2;
+        let mut total = 0.0;
+        for r in 1..=self.rows {
+            let k0 = r * pw + 1;
+            let k1 = k0 + self.cols;
+            let (u, b) = (&self.u, &self.b);
+            let mut acc = 0.0;
+            for k in k0..k1 {
+                let mu = (u[k] + 1.0)
+                    .max(u[k - pw])
+                    .max(u[k + pw])
+                    .max(u[k - 1])
+                    .max(u[k + 1]);
+                let mb = (b[k] - 1.0)
+                    .min(b[k - pw])
+                    .min(b[k + pw])
+                    .min(b[k - 1])
+                    .min(b[k + 1]);
+                let ok = self.valid[k];
+                self.nu[k] = if ok { mu } else { f64::NEG_INFINITY };
+                self.nb[k] = if ok { mb } else { f64::INFINITY };
+                if ok {
+                    acc += mu - mb;
+                }
+            }
+            if (s0 + 1..=s1).contains(&r) {
+                total += acc;
+            }
+        }
+        std::mem::swap(&mut self.u, &mut self.nu);
+        std::mem::swap(&mut self.b, &mut self.nb);
+        total
+    }
+}
+
+fn check_z_scale(z_scale: f64) -> CoreResult<()> {
+    if z_scale.is_finite() && z_scale > 0.0 {
+        Ok(())
+    } else {
+        Err(CoreError::invalid(
+            "z_scale",
+            format!("expected a positive number, got {z_scale}"),
+        ))
+    }
+}
+
+/// Image-wide blanket areas `A(e)` for `e = 1 ..= eps_max` and the number of
+/// valid pixels. Bands of 128 rows grow their own blankets with a halo of
+/// `eps_max` rows (a wrong value at a band's cut spreads one row per step,
+/// so it never reaches the band's own rows) and are summed in a fixed order:
+/// the result does not depend on the thread count.
+pub fn blanket_areas(
+    z: &[f64],
+    rows: usize,
+    cols: usize,
+    eps_max: usize,
+    z_scale: f64,
+) -> CoreResult<(Vec<f64>, usize)> {
+    if rows * cols == 0 || z.len() != rows * cols {
+        return Err(CoreError::invalid("data", "image is empty"));
+    }
+    if eps_max == 0 {
+        return Err(CoreError::invalid("epsilons", "expected positive integers"));
+    }
+    check_z_scale(z_scale)?;
+    let band = 128usize;
+    let parts: Vec<(Vec<f64>, usize)> = (0..rows.div_ceil(band))
+        .into_par_iter()
+        .map(|bi| {
+            let (o0, o1) = (bi * band, ((bi + 1) * band).min(rows));
+            let (i0, i1) = (o0.saturating_sub(eps_max), (o1 + eps_max).min(rows));
+            let mut p = Planes::new(i1 - i0, cols);
+            p.load(z_scale, |r, c| z[(i0 + r) * cols + c]);
+            let n = z[o0 * cols..o1 * cols]
+                .iter()
+                .filter(|v| !v.is_nan())
+                .count();
+            let sums = (1..=eps_max)
+                .map(|_| p.grow(o0 - i0, o1 - i0))
+                .collect::<Vec<f64>>();
+            (sums, n)
+        })
+        .collect();
+    let mut sums = vec![0.0f64; eps_max];
+    let mut n = 0;
+    for (s, c) in parts {
+        for (a, b) in sums.iter_mut().zip(s) {
+            *a += b;
+        }
+        n += c;
+    }
+    if n == 0 {
+        return Err(CoreError::invalid("data", "no valid value (all NaN)"));
+    }
+    let areas = sums
+        .iter()
+        .enumerate()
+        .map(|(e, s)| s / (2.0 * (e + 1) as f64))
+        .collect();
+    Ok((areas, n))
+}
+
+/// Options of [`blanket_transform`].
+#[derive(Debug, Clone)]
+pub struct BlanketMapOptions {
+    pub window: usize,
+    /// Blanket thicknesses of the fit, at least three distinct positive values.
+    pub epsilons: Vec<usize>,
+    pub z_scale: f64,
+    pub min_valid: f64,
+    pub step: usize,
+}
+
+/// Local blanket dimension and r² maps on the grid of every `step`-th pixel
+/// (NaN where the window has fewer valid pixels than `min_valid * w * w`).
+/// Each window grows its own blankets (rayon over output rows).
+pub fn blanket_transform(
+    z: &[f64],
+    rows: usize,
+    cols: usize,
+    opt: &BlanketMapOptions,
+) -> CoreResult<LocalMap> {
+    let w = opt.window;
+    let min_pixels = check_window(z.len(), rows, cols, w, opt.min_valid)?;
+    let (orows, ocols) = check_step(opt.step, rows, cols)?;
+    let mut eps = opt.epsilons.clone();
+    eps.sort_unstable();
+    eps.dedup();
+    if eps.len() < 3 || eps[0] == 0 {
+        return Err(CoreError::invalid(
+            "epsilons",
+            format!(
+                "need at least 3 distinct positive thicknesses, got {:?}",
+                opt.epsilons
+            ),
+        ));
+    }
+    check_z_scale(opt.z_scale)?;
+    let emax = *eps.last().unwrap();
+    let (xs, xm, sxx) = log_axis(&eps);
+    let (h, step) = ((w / 2) as isize, opt.step);
+    let mut dim = vec![f32::NAN; orows * ocols];
+    let mut r2 = vec![f32::NAN; orows * ocols];
+    dim.par_chunks_mut(ocols)
+        .zip(r2.par_chunks_mut(ocols))
+        .enumerate()
+        .for_each(|(k, (drow, rrow))| {
+            let i = (k * step) as isize;
+            let mut p = Planes::new(w, w);
+            let mut areas = vec![0.0f64; emax];
+            let mut ys = vec![0.0f64; eps.len()];
+            for (kc, (d, q)) in drow.iter_mut().zip(rrow.iter_mut()).enumerate() {
+                let j = (kc * step) as isize;
+                let n = p.load(opt.z_scale, |a, b| {
+                    let (r, c) = (i - h + a as isize, j - h + b as isize);
+                    if r < 0 || c < 0 || r >= rows as isize || c >= cols as isize {
+                        f64::NAN
+                    } else {
+                        z[r as usize * cols + c as usize]
+                    }
+                });
+                if (n as f64) < min_pixels {
+                    continue;
+                }
+                for (e, a) in areas.iter_mut().enumerate() {
+                    *a = p.grow(0, w) / (2.0 * (e + 1) as f64);
+                }
+                for (y, &e) in ys.iter_mut().zip(&eps) {
+                    *y = areas[e - 1].ln();
+                }
+                let (slope, fit_r2) = line_fit(&xs, xm, sxx, &ys);
+                *d = (2.0 - slope) as f32;
+                *q = fit_r2 as f32;
+            }
+        });
+    Ok(LocalMap {
+        dim,
+        r2,
+        rows: orows,
+        cols: ocols,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Blanket areas from the definition, with explicit bounds checks.
+    fn naive(z: &[f64], rows: usize, cols: usize, emax: usize) -> Vec<f64> {
+        let mut u = z.to_vec();
+        let mut b = z.to_vec();
+        let mut out = vec![];
+        for e in 1..=emax {
+            let (mut nu, mut nb) = (u.clone(), b.clone());
+            let mut s = 0.0;
+            for r in 0..rows {
+                for c in 0..cols {
+                    let k = r * cols + c;
+                    if z[k].is_nan() {
+                        continue;
+                    }
+                    let (mut a, mut m) = (u[k] + 1.0, b[k] - 1.0);
+                    for (dr, dc) in [(-1isize, 0isize), (1, 0), (0, -1), (0, 1)] {
+                        let (rr, cc) = (r as isize + dr, c as isize + dc);
+                        if rr >= 0 && cc >= 0 && (rr as usize) < rows && (cc as usize) < cols {
+                            let q = rr as usize * cols + cc as usize;
+                            if !z[q].is_nan() {
+                                a = a.max(u[q]);
+                                m = m.min(b[q]);
+                            }
+                        }
+                    }
+                    nu[k] = a;
+                    nb[k] = m;
+                    s += a - m;
+                }
+            }
+            u = nu;
+            b = nb;
+            out.push(s / (2.0 * e as f64));
+        }
+        out
+    }
+
+    fn image(rows: usize, cols: usize) -> Vec<f64> {
+        let mut s = 17u64;
+        (0..rows * cols)
+            .map(|k| {
+                s = s.wrapping_mul(6364136223846793005).wrapping_add(3);
+                if k % 19 == 4 {
+                    f64::NAN
+                } else {
+                    ((s >> 40) % 9) as f64 + (k % cols) as f64 * 0.2
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn areas_match_definition_across_bands() {
+        let (rows, cols) = (300usize, 23usize);
+        let z = image(rows, cols);
+        let (a, n) = blanket_areas(&z, rows, cols, 6, 1.0).unwrap();
+        assert_eq!(n, z.iter().filter(|v| !v.is_nan()).count());
+        for (x, y) in a.iter().zip(naive(&z, rows, cols, 6)) {
+            assert!((x - y).abs() <= 1e-12 * y.abs(), "{x} vs {y}");
+        }
+    }
+
+    #[test]
+    fn map_equals_areas_of_each_window() {
+        let (rows, cols) = (20usize, 17usize);
+        let z = image(rows, cols);
+        let o = BlanketMapOptions {
+            window: 7,
+            epsilons: vec![1, 2, 3],
+            z_scale: 1.0,
+            min_valid: 0.0,
+            step: 2,
+        };
+        let m = blanket_transform(&z, rows, cols, &o).unwrap();
+        for k in 0..m.rows {
+            for kc in 0..m.cols {
+                let (i, j) = ((2 * k) as isize, (2 * kc) as isize);
+                let mut win = vec![f64::NAN; 49];
+                for a in 0..7isize {
+                    for b in 0..7isize {
+                        let (r, c) = (i - 3 + a, j - 3 + b);
+                        if r >= 0 && c >= 0 && r < rows as isize && c < cols as isize {
+                            win[(a * 7 + b) as usize] = z[r as usize * cols + c as usize];
+                        }
+                    }
+                }
+                let ys: Vec<f64> = naive(&win, 7, 7, 3).iter().map(|v| v.ln()).collect();
+                let (xs, xm, sxx) = log_axis(&[1, 2, 3]);
+                let e = 2.0 - line_fit(&xs, xm, sxx, &ys).0;
+                assert!((m.dim[k * m.cols + kc] as f64 - e).abs() < 1e-5);
+            }
+        }
+    }
+}
