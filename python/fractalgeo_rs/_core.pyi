@@ -234,6 +234,7 @@ def dbc_transform_map(
     box_sizes: Sequence[int],
     z_scale: float,
     z0: float,
+    partial_blocks: bool,
     min_valid: float,
     step: int,
     n_threads: Optional[int] = None,

@@ -107,7 +107,7 @@ fn local_map_arrays(py: Python<'_>, m: LocalMap) -> PyResult<MapPair<'_>> {
 /// Moving-window differential box counting on the grid of every `step`-th
 /// pixel. Returns (dimension, r_squared) float32 maps.
 #[pyfunction]
-#[pyo3(signature = (image, window_size, box_sizes, z_scale, z0, min_valid, step, n_threads=None))]
+#[pyo3(signature = (image, window_size, box_sizes, z_scale, z0, partial_blocks, min_valid, step, n_threads=None))]
 #[allow(clippy::too_many_arguments)]
 fn dbc_transform_map<'py>(
     py: Python<'py>,
@@ -116,6 +116,7 @@ fn dbc_transform_map<'py>(
     box_sizes: Vec<usize>,
     z_scale: f64,
     z0: f64,
+    partial_blocks: bool,
     min_valid: f64,
     step: usize,
     n_threads: Option<usize>,
@@ -131,6 +132,7 @@ fn dbc_transform_map<'py>(
         z0,
         min_valid,
         step,
+        partial_blocks,
     };
     let m = py.detach(|| run_in_pool(n_threads, || dbc_transform(z, rows, cols, &opt)))?;
     local_map_arrays(py, m)

@@ -11,7 +11,8 @@
 //! n = floor((zmax - z0) / h) - floor((zmin - z0) / h) + 1,   h = s * z_unit
 //! ```
 //!
-//! boxes (0 when it holds no valid value), `N(s)` is the window's sum and
+//! boxes (0 when it holds no valid value; with `partial_blocks = false` the
+//! partial blocks are left out), `N(s)` is the window's sum and
 //! `D = -slope` of `log N(s)` against `log s`. The box stacks start at a fixed
 //! height `z0` and have a fixed unit `z_unit` for every window (not the
 //! window's own range), so a block's count does not depend on the window.
@@ -41,6 +42,9 @@ pub struct DbcMapOptions {
     pub min_valid: f64,
     /// Output every `step`-th row and column (1: every pixel).
     pub step: usize,
+    /// Count the partial blocks of the last row and column (`false`: drop
+    /// them, so box size `s` covers the top-left `floor(w/s) s` square).
+    pub partial_blocks: bool,
 }
 
 /// A local map on the grid of every `step`-th pixel: dimension and r²,
@@ -190,7 +194,7 @@ pub fn dbc_transform(
                     }
                 }
                 // partial blocks: bottom row (t x s), right column (s x t), corner (t x t)
-                let partial = (t > 0).then(|| {
+                let partial = (t > 0 && opt.partial_blocks).then(|| {
                     let mut pts = count_field(&lo, &hi, nr, nc, t, s, opt.z0, hgt);
                     for u in 0..nr - t + 1 {
                         for v in s..wss {
@@ -314,6 +318,7 @@ mod tests {
                 z0: -1.5,
                 min_valid: 0.0,
                 step,
+                partial_blocks: true,
             };
             let m = dbc_transform(&z, rows, cols, &o).unwrap();
             assert_eq!((m.rows, m.cols), (rows.div_ceil(step), cols.div_ceil(step)));
@@ -338,6 +343,7 @@ mod tests {
             z0: 0.0,
             min_valid: 0.5,
             step: 1,
+            partial_blocks: false,
         };
         let run = |t| {
             let m = crate::parallel::run_in_pool(Some(t), || dbc_transform(&z, rows, cols, &o))
