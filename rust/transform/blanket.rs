@@ -25,9 +25,68 @@ use super::sat::{check_window, line_fit, log_axis};
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 
+/// Larger of two non-NaN values (the planes hold finite values and
+/// infinities only); compiles to one vector max.
+#[inline(always)]
+fn fmax(a: f64, b: f64) -> f64 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+#[inline(always)]
+fn fmin(a: f64, b: f64) -> f64 {
+    if a < b {
+        a
+    } else {
+        b
+    }
+}
+
+/// One growth step of one row. The `u*`/`b*` rows (rows above, at and below,
+/// `n + 2` samples with a missing sample at each end) are the blankets of
+/// the previous step; `mu`/`mb` (`n` samples) are 0 on valid pixels and
+/// `-inf`/`+inf` on missing ones. Writes samples `1 ..= n` of `nu`/`nb` and,
+/// with `colsum`, adds `u - b` of the valid pixels to it column by column
+/// (independent lanes, so the loop vectorises and the order is fixed).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn step_row(
+    uu: &[f64],
+    uc: &[f64],
+    ud: &[f64],
+    bu: &[f64],
+    bc: &[f64],
+    bd: &[f64],
+    mu: &[f64],
+    mb: &[f64],
+    nu: &mut [f64],
+    nb: &mut [f64],
+    colsum: Option<&mut [f64]>,
+) {
+    let n = mu.len();
+    let (uu, ud, ul, ur, uc) = (&uu[1..=n], &ud[1..=n], &uc[..n], &uc[2..n + 2], &uc[1..=n]);
+    let (bu, bd, bl, br, bc) = (&bu[1..=n], &bd[1..=n], &bc[..n], &bc[2..n + 2], &bc[1..=n]);
+    let (nu, nb) = (&mut nu[1..=n], &mut nb[1..=n]);
+    let mb = &mb[..n];
+    for c in 0..n {
+        nu[c] = fmax(fmax(fmax(uc[c] + 1.0, uu[c]), fmax(ud[c], ul[c])), ur[c]) + mu[c];
+        nb[c] = fmin(fmin(fmin(bc[c] - 1.0, bu[c]), fmin(bd[c], bl[c])), br[c]) + mb[c];
+    }
+    if let Some(cs) = colsum {
+        // valid: u - b >= 2 e > 0; missing: -inf, counted as 0
+        for (c, s) in cs[..n].iter_mut().enumerate() {
+            *s += fmax(nu[c] - nb[c], 0.0);
+        }
+    }
+}
+
 /// Planes of `(rows + 2) x (cols + 2)` samples framed by one missing pixel:
 /// upper and lower blankets (missing: `-inf`, `+inf`), their next step, and
-/// the validity mask.
+/// the masks added after each step (0 on valid pixels, `-inf` / `+inf` on
+/// missing ones, so that missing pixels stay missing without a branch).
 struct Planes {
     rows: usize,
     cols: usize,
@@ -35,7 +94,9 @@ struct Planes {
     b: Vec<f64>,
     nu: Vec<f64>,
     nb: Vec<f64>,
-    valid: Vec<bool>,
+    mu: Vec<f64>,
+    mb: Vec<f64>,
+    colsum: Vec<f64>,
 }
 
 impl Planes {
@@ -48,71 +109,176 @@ impl Planes {
             b: vec![f64::INFINITY; n],
             nu: vec![f64::NEG_INFINITY; n],
             nb: vec![f64::INFINITY; n],
-            valid: vec![false; n],
+            mu: vec![f64::NEG_INFINITY; n],
+            mb: vec![f64::INFINITY; n],
+            colsum: vec![0.0; cols],
         }
     }
 
-    /// Load row-major `rows x cols` values through `get(r, c)` (NaN: missing),
-    /// divided by `z_scale`; returns the number of valid pixels.
-    fn load(&mut self, z_scale: f64, get: impl Fn(usize, usize) -> f64) -> usize {
-        let pw = self.cols + 2;
+    /// Load row `r` (`cols` values, NaN: missing) divided by `z_scale`;
+    /// returns its number of valid pixels.
+    #[inline]
+    fn load_row(&mut self, r: usize, src: &[f64], z_scale: f64) -> usize {
+        let k0 = (r + 1) * (self.cols + 2) + 1;
         let mut n = 0;
-        for r in 0..self.rows {
-            for c in 0..self.cols {
-                let k = (r + 1) * pw + c + 1;
-                let x = get(r, c);
-                if x.is_nan() {
-                    self.u[k] = f64::NEG_INFINITY;
-                    self.b[k] = f64::INFINITY;
-                    self.valid[k] = false;
-                } else {
-                    let v = x / z_scale;
-                    self.u[k] = v;
-                    self.b[k] = v;
-                    self.valid[k] = true;
-                    n += 1;
-                }
+        for (c, &x) in src.iter().enumerate() {
+            let k = k0 + c;
+            if x.is_nan() {
+                self.u[k] = f64::NEG_INFINITY;
+                self.b[k] = f64::INFINITY;
+                self.mu[k] = f64::NEG_INFINITY;
+                self.mb[k] = f64::INFINITY;
+            } else {
+                let v = x / z_scale;
+                self.u[k] = v;
+                self.b[k] = v;
+                self.mu[k] = 0.0;
+                self.mb[k] = 0.0;
+                n += 1;
             }
         }
         n
+    }
+
+    /// Mark row `r` missing.
+    #[inline]
+    fn clear_row(&mut self, r: usize) {
+        let k0 = (r + 1) * (self.cols + 2) + 1;
+        let k1 = k0 + self.cols;
+        self.u[k0..k1].fill(f64::NEG_INFINITY);
+        self.b[k0..k1].fill(f64::INFINITY);
+        self.mu[k0..k1].fill(f64::NEG_INFINITY);
+        self.mb[k0..k1].fill(f64::INFINITY);
     }
 
     /// One growth step; returns `sum over valid pixels of (u - b)` for the
     /// rows `[s0, s1)` (plane rows without the frame).
     fn grow(&mut self, s0: usize, s1: usize) -> f64 {
         let pw = self.cols + 2;
-        let mut total = 0.0;
+        let n = self.cols;
+        self.colsum.fill(0.0);
         for r in 1..=self.rows {
-            let k0 = r * pw + 1;
-            let k1 = k0 + self.cols;
+            let k = r * pw;
             let (u, b) = (&self.u, &self.b);
-            let mut acc = 0.0;
-            for k in k0..k1 {
-                let mu = (u[k] + 1.0)
-                    .max(u[k - pw])
-                    .max(u[k + pw])
-                    .max(u[k - 1])
-                    .max(u[k + 1]);
-                let mb = (b[k] - 1.0)
-                    .min(b[k - pw])
-                    .min(b[k + pw])
-                    .min(b[k - 1])
-                    .min(b[k + 1]);
-                let ok = self.valid[k];
-                self.nu[k] = if ok { mu } else { f64::NEG_INFINITY };
-                self.nb[k] = if ok { mb } else { f64::INFINITY };
-                if ok {
-                    acc += mu - mb;
-                }
-            }
-            if (s0 + 1..=s1).contains(&r) {
-                total += acc;
-            }
+            let in_sum = (s0 + 1..=s1).contains(&r);
+            step_row(
+                &u[k - pw..k],
+                &u[k..k + pw],
+                &u[k + pw..k + 2 * pw],
+                &b[k - pw..k],
+                &b[k..k + pw],
+                &b[k + pw..k + 2 * pw],
+                &self.mu[k + 1..k + 1 + n],
+                &self.mb[k + 1..k + 1 + n],
+                &mut self.nu[k..k + pw],
+                &mut self.nb[k..k + pw],
+                in_sum.then_some(&mut self.colsum[..]),
+            );
         }
         std::mem::swap(&mut self.u, &mut self.nu);
         std::mem::swap(&mut self.b, &mut self.nb);
-        total
+        self.colsum.iter().sum()
     }
+}
+
+/// Blanket sums `sum over valid pixels of rows [s0, s1) of (u_e - b_e)`,
+/// `e = 1 ..= eps_max`, of the image rows `[r_lo, r_hi)` (rows outside are
+/// missing), streamed row by row: level `e` keeps three rows and row `r` of
+/// level `e` is computed as soon as row `r + 1` of level `e - 1` exists, so
+/// the working set is `3 (eps_max + 1)` rows instead of whole planes.
+#[allow(clippy::too_many_arguments)]
+fn stream_sums(
+    z: &[f64],
+    cols: usize,
+    r_lo: usize,
+    r_hi: usize,
+    s0: usize,
+    s1: usize,
+    eps_max: usize,
+    z_scale: f64,
+) -> Vec<f64> {
+    let pw = cols + 2;
+    let levels = eps_max + 1;
+    let nm = eps_max + 2; // mask ring
+    let mut lu = vec![f64::NEG_INFINITY; levels * 3 * pw];
+    let mut lb = vec![f64::INFINITY; levels * 3 * pw];
+    let mut mu = vec![0.0f64; nm * cols];
+    let mut mb = vec![0.0f64; nm * cols];
+    let mut colsum = vec![0.0f64; eps_max * cols];
+    let slot = |e: usize, r: usize| (e * 3 + r % 3) * pw;
+    for t in r_lo..r_hi + eps_max {
+        // level 0: the input row t (missing past r_hi)
+        let k = slot(0, t);
+        if t < r_hi {
+            let src = &z[t * cols..(t + 1) * cols];
+            let m = (t % nm) * cols;
+            for (c, &x) in src.iter().enumerate() {
+                let ok = !x.is_nan();
+                let v = if ok { x / z_scale } else { 0.0 };
+                lu[k + 1 + c] = if ok { v } else { f64::NEG_INFINITY };
+                lb[k + 1 + c] = if ok { v } else { f64::INFINITY };
+                mu[m + c] = if ok { 0.0 } else { f64::NEG_INFINITY };
+                mb[m + c] = if ok { 0.0 } else { f64::INFINITY };
+            }
+        } else {
+            lu[k..k + pw].fill(f64::NEG_INFINITY);
+            lb[k..k + pw].fill(f64::INFINITY);
+        }
+        for e in 1..=eps_max {
+            if t < r_lo + e {
+                break;
+            }
+            let r = t - e;
+            let k = slot(e, r);
+            if r >= r_hi {
+                lu[k..k + pw].fill(f64::NEG_INFINITY);
+                lb[k..k + pw].fill(f64::INFINITY);
+                continue;
+            }
+            // rows r - 1, r, r + 1 of level e - 1 ((r + 2) % 3 = (r - 1) % 3)
+            let (ku, kc, kd) = (slot(e - 1, r + 2), slot(e - 1, r), slot(e - 1, r + 1));
+            let (prev_u, cur_u) = lu.split_at_mut(e * 3 * pw);
+            let (prev_b, cur_b) = lb.split_at_mut(e * 3 * pw);
+            let up_missing = r == r_lo;
+            let m = (r % nm) * cols;
+            let in_sum = (s0..s1).contains(&r);
+            let cs = &mut colsum[(e - 1) * cols..e * cols];
+            let kk = k - e * 3 * pw;
+            if up_missing {
+                // a missing row above: the upper row is the frame value
+                let fu = vec![f64::NEG_INFINITY; pw];
+                let fb = vec![f64::INFINITY; pw];
+                step_row(
+                    &fu,
+                    &prev_u[kc..kc + pw],
+                    &prev_u[kd..kd + pw],
+                    &fb,
+                    &prev_b[kc..kc + pw],
+                    &prev_b[kd..kd + pw],
+                    &mu[m..m + cols],
+                    &mb[m..m + cols],
+                    &mut cur_u[kk..kk + pw],
+                    &mut cur_b[kk..kk + pw],
+                    in_sum.then_some(cs),
+                );
+            } else {
+                step_row(
+                    &prev_u[ku..ku + pw],
+                    &prev_u[kc..kc + pw],
+                    &prev_u[kd..kd + pw],
+                    &prev_b[ku..ku + pw],
+                    &prev_b[kc..kc + pw],
+                    &prev_b[kd..kd + pw],
+                    &mu[m..m + cols],
+                    &mb[m..m + cols],
+                    &mut cur_u[kk..kk + pw],
+                    &mut cur_b[kk..kk + pw],
+                    in_sum.then_some(cs),
+                );
+            }
+        }
+    }
+    colsum.chunks(cols).map(|c| c.iter().sum::<f64>()).collect()
 }
 
 fn check_z_scale(z_scale: f64) -> CoreResult<()> {
@@ -127,7 +293,7 @@ fn check_z_scale(z_scale: f64) -> CoreResult<()> {
 }
 
 /// Image-wide blanket areas `A(e)` for `e = 1 ..= eps_max` and the number of
-/// valid pixels. Bands of 128 rows grow their own blankets with a halo of
+/// valid pixels. Bands of 256 rows grow their own blankets with a halo of
 /// `eps_max` rows (a wrong value at a band's cut spreads one row per step,
 /// so it never reaches the band's own rows) and are summed in a fixed order:
 /// the result does not depend on the thread count.
@@ -145,21 +311,17 @@ pub fn blanket_areas(
         return Err(CoreError::invalid("epsilons", "expected positive integers"));
     }
     check_z_scale(z_scale)?;
-    let band = 128usize;
+    let band = 256usize;
     let parts: Vec<(Vec<f64>, usize)> = (0..rows.div_ceil(band))
         .into_par_iter()
         .map(|bi| {
             let (o0, o1) = (bi * band, ((bi + 1) * band).min(rows));
             let (i0, i1) = (o0.saturating_sub(eps_max), (o1 + eps_max).min(rows));
-            let mut p = Planes::new(i1 - i0, cols);
-            p.load(z_scale, |r, c| z[(i0 + r) * cols + c]);
             let n = z[o0 * cols..o1 * cols]
                 .iter()
                 .filter(|v| !v.is_nan())
                 .count();
-            let sums = (1..=eps_max)
-                .map(|_| p.grow(o0 - i0, o1 - i0))
-                .collect::<Vec<f64>>();
+            let sums = stream_sums(z, cols, i0, i1, o0, o1, eps_max, z_scale);
             (sums, n)
         })
         .collect();
@@ -229,18 +391,27 @@ pub fn blanket_transform(
         .for_each(|(k, (drow, rrow))| {
             let i = (k * step) as isize;
             let mut p = Planes::new(w, w);
+            let mut buf = vec![f64::NAN; w];
             let mut areas = vec![0.0f64; emax];
             let mut ys = vec![0.0f64; eps.len()];
             for (kc, (d, q)) in drow.iter_mut().zip(rrow.iter_mut()).enumerate() {
                 let j = (kc * step) as isize;
-                let n = p.load(opt.z_scale, |a, b| {
-                    let (r, c) = (i - h + a as isize, j - h + b as isize);
-                    if r < 0 || c < 0 || r >= rows as isize || c >= cols as isize {
-                        f64::NAN
-                    } else {
-                        z[r as usize * cols + c as usize]
+                // the window, clipped to the image (missing outside)
+                let (c0, c1) = ((j - h).max(0) as usize, ((j + h + 1) as usize).min(cols));
+                let off = (c0 as isize - (j - h)) as usize;
+                let mut n = 0;
+                for a in 0..w {
+                    let r = i - h + a as isize;
+                    if r < 0 || r >= rows as isize {
+                        p.clear_row(a);
+                        continue;
                     }
-                });
+                    let row = &z[r as usize * cols..(r as usize + 1) * cols];
+                    buf[..off].fill(f64::NAN);
+                    buf[off..off + c1 - c0].copy_from_slice(&row[c0..c1]);
+                    buf[off + c1 - c0..].fill(f64::NAN);
+                    n += p.load_row(a, &buf, opt.z_scale);
+                }
                 if (n as f64) < min_pixels {
                     continue;
                 }
