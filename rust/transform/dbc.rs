@@ -142,111 +142,121 @@ pub fn dbc_transform(
         .for_each(|(band, (dout, rout))| {
             let k0 = band * ob;
             let k1 = (k0 + ob).min(orows);
-            // band planes: rows ri0 .. ri0 + nr of the NaN-padded image,
-            // columns -h .. cols + h
+            // tiles of output columns, in order (results do not depend on
+            // threads): planes of rows ri0 .. ri0 + nr and columns
+            // ci0 .. ci0 + nc of the NaN-padded image, small enough to stay
+            // in cache
             let ri0 = (k0 * step) as isize - h as isize;
             let nr = (k1 - 1 - k0) * step + 2 * h + 1;
-            let nc = cols + 2 * h;
-            let mut lo = vec![f64::INFINITY; nr * nc];
-            let mut hi = vec![f64::NEG_INFINITY; nr * nc];
-            let mut valid = vec![0.0f64; nr * nc];
-            for u in 0..nr {
-                let r = ri0 + u as isize;
-                if r < 0 || r >= rows as isize {
-                    continue;
-                }
-                let src = &z[r as usize * cols..(r as usize + 1) * cols];
-                for (c, &x) in src.iter().enumerate() {
-                    if !x.is_nan() {
-                        let k = u * nc + h + c;
-                        lo[k] = x;
-                        hi[k] = x;
-                        valid[k] = 1.0;
-                    }
-                }
-            }
-            let vsat = sat(&valid, nr, nc);
-            drop(valid);
-            let npix = (k1 - k0) * ocols;
-            let mut counts = vec![vec![0.0f64; npix]; sizes.len()];
-            for (si, &s) in sizes.iter().enumerate() {
-                let hgt = s as f64 * opt.z_unit;
-                let nf = w / s;
-                let t = w % s;
-                let si_ = s as isize;
-                let last = ((nf - 1) * s) as isize;
-                // full blocks: table strided by s
-                let wss = nc - s + 1;
-                let mut tss = count_field(&lo, &hi, nr, nc, s, s, opt.z0, hgt);
-                for u in 0..nr - s + 1 {
-                    for v in 0..wss {
-                        let mut acc = tss[u * wss + v];
-                        if u >= s {
-                            acc += tss[(u - s) * wss + v];
-                        }
-                        if v >= s {
-                            acc += tss[u * wss + v - s];
-                        }
-                        if u >= s && v >= s {
-                            acc -= tss[(u - s) * wss + v - s];
-                        }
-                        tss[u * wss + v] = acc;
-                    }
-                }
-                // partial blocks: bottom row (t x s), right column (s x t), corner (t x t)
-                let partial = (t > 0 && opt.partial_blocks).then(|| {
-                    let mut pts = count_field(&lo, &hi, nr, nc, t, s, opt.z0, hgt);
-                    for u in 0..nr - t + 1 {
-                        for v in s..wss {
-                            pts[u * wss + v] += pts[u * wss + v - s];
-                        }
-                    }
-                    let wst = nc - t + 1;
-                    let mut pst = count_field(&lo, &hi, nr, nc, s, t, opt.z0, hgt);
-                    for u in s..nr - s + 1 {
-                        for v in 0..wst {
-                            pst[u * wst + v] += pst[(u - s) * wst + v];
-                        }
-                    }
-                    let ptt = count_field(&lo, &hi, nr, nc, t, t, opt.z0, hgt);
-                    (pts, pst, ptt, wst)
-                });
-                let out = &mut counts[si];
-                for k in k0..k1 {
-                    let u0 = ((k - k0) * step) as isize;
-                    for kc in 0..ocols {
-                        let v0 = (kc * step) as isize;
-                        let (a, b) = (u0 + last, v0 + last);
-                        let mut n = at(&tss, wss, a, b)
-                            - at(&tss, wss, u0 - si_, b)
-                            - at(&tss, wss, a, v0 - si_)
-                            + at(&tss, wss, u0 - si_, v0 - si_);
-                        if let Some((pts, pst, ptt, wst)) = &partial {
-                            let (ue, ve) = (u0 + (nf * s) as isize, v0 + (nf * s) as isize);
-                            n += at(pts, wss, ue, b) - at(pts, wss, ue, v0 - si_);
-                            n += at(pst, *wst, a, ve) - at(pst, *wst, u0 - si_, ve);
-                            n += at(ptt, *wst, ue, ve);
-                        }
-                        out[(k - k0) * ocols + kc] = n;
-                    }
-                }
-            }
-            let mut ys = vec![0.0f64; sizes.len()];
-            let sw = nc + 1;
-            for k in k0..k1 {
-                let u0 = (k - k0) * step;
-                for kc in 0..ocols {
-                    let v0 = kc * step;
-                    if rect(&vsat, sw, u0, u0 + w, v0, v0 + w) < min_pixels {
+            let tq = (band_rows(w) / step).max(1); // output columns per tile
+            for q0 in (0..ocols).step_by(tq) {
+                let q1 = (q0 + tq).min(ocols);
+                let nq = q1 - q0;
+                let ci0 = (q0 * step) as isize - h as isize;
+                let nc = (q1 - 1 - q0) * step + 2 * h + 1;
+                let mut lo = vec![f64::INFINITY; nr * nc];
+                let mut hi = vec![f64::NEG_INFINITY; nr * nc];
+                let mut valid = vec![0.0f64; nr * nc];
+                // image columns c0 .. c1 of the tile
+                let c0 = ci0.max(0) as usize;
+                let c1 = ((ci0 + nc as isize) as usize).min(cols);
+                for u in 0..nr {
+                    let r = ri0 + u as isize;
+                    if r < 0 || r >= rows as isize {
                         continue;
                     }
-                    let p = (k - k0) * ocols + kc;
-                    for (y, c) in ys.iter_mut().zip(&counts) {
-                        *y = c[p].ln();
+                    let src = &z[r as usize * cols + c0..r as usize * cols + c1];
+                    let base = u * nc + (c0 as isize - ci0) as usize;
+                    for (c, &x) in src.iter().enumerate() {
+                        if !x.is_nan() {
+                            lo[base + c] = x;
+                            hi[base + c] = x;
+                            valid[base + c] = 1.0;
+                        }
                     }
-                    let (slope, fit_r2) = line_fit(&xs, xm, sxx, &ys);
-                    dout[p] = (-slope) as f32;
-                    rout[p] = fit_r2 as f32;
+                }
+                let vsat = sat(&valid, nr, nc);
+                drop(valid);
+                let npix = (k1 - k0) * nq;
+                let mut counts = vec![vec![0.0f64; npix]; sizes.len()];
+                for (si, &s) in sizes.iter().enumerate() {
+                    let hgt = s as f64 * opt.z_unit;
+                    let nf = w / s;
+                    let t = w % s;
+                    let si_ = s as isize;
+                    let last = ((nf - 1) * s) as isize;
+                    // full blocks: table strided by s
+                    let wss = nc - s + 1;
+                    let mut tss = count_field(&lo, &hi, nr, nc, s, s, opt.z0, hgt);
+                    let nss = nr - s + 1;
+                    for row in tss.chunks_mut(wss) {
+                        for v in s..wss {
+                            row[v] += row[v - s];
+                        }
+                    }
+                    for u in s..nss {
+                        let (done, cur) = tss.split_at_mut(u * wss);
+                        let prev = &done[(u - s) * wss..(u - s + 1) * wss];
+                        for (x, &y) in cur[..wss].iter_mut().zip(prev) {
+                            *x += y;
+                        }
+                    }
+                    // partial blocks: bottom row (t x s), right column (s x t), corner (t x t)
+                    let partial = (t > 0 && opt.partial_blocks).then(|| {
+                        let mut pts = count_field(&lo, &hi, nr, nc, t, s, opt.z0, hgt);
+                        for u in 0..nr - t + 1 {
+                            for v in s..wss {
+                                pts[u * wss + v] += pts[u * wss + v - s];
+                            }
+                        }
+                        let wst = nc - t + 1;
+                        let mut pst = count_field(&lo, &hi, nr, nc, s, t, opt.z0, hgt);
+                        for u in s..nr - s + 1 {
+                            for v in 0..wst {
+                                pst[u * wst + v] += pst[(u - s) * wst + v];
+                            }
+                        }
+                        let ptt = count_field(&lo, &hi, nr, nc, t, t, opt.z0, hgt);
+                        (pts, pst, ptt, wst)
+                    });
+                    let out = &mut counts[si];
+                    for k in k0..k1 {
+                        let u0 = ((k - k0) * step) as isize;
+                        for kc in 0..nq {
+                            let v0 = (kc * step) as isize;
+                            let (a, b) = (u0 + last, v0 + last);
+                            let mut n = at(&tss, wss, a, b)
+                                - at(&tss, wss, u0 - si_, b)
+                                - at(&tss, wss, a, v0 - si_)
+                                + at(&tss, wss, u0 - si_, v0 - si_);
+                            if let Some((pts, pst, ptt, wst)) = &partial {
+                                let (ue, ve) = (u0 + (nf * s) as isize, v0 + (nf * s) as isize);
+                                n += at(pts, wss, ue, b) - at(pts, wss, ue, v0 - si_);
+                                n += at(pst, *wst, a, ve) - at(pst, *wst, u0 - si_, ve);
+                                n += at(ptt, *wst, ue, ve);
+                            }
+                            out[(k - k0) * nq + kc] = n;
+                        }
+                    }
+                }
+                let mut ys = vec![0.0f64; sizes.len()];
+                let sw = nc + 1;
+                for k in k0..k1 {
+                    let u0 = (k - k0) * step;
+                    for kc in 0..nq {
+                        let v0 = kc * step;
+                        if rect(&vsat, sw, u0, u0 + w, v0, v0 + w) < min_pixels {
+                            continue;
+                        }
+                        let p = (k - k0) * nq + kc;
+                        for (y, c) in ys.iter_mut().zip(&counts) {
+                            *y = c[p].ln();
+                        }
+                        let (slope, fit_r2) = line_fit(&xs, xm, sxx, &ys);
+                        let o = (k - k0) * ocols + q0 + kc;
+                        dout[o] = (-slope) as f32;
+                        rout[o] = fit_r2 as f32;
+                    }
                 }
             }
         });
@@ -304,7 +314,8 @@ mod tests {
 
     #[test]
     fn equals_global_counter_on_every_window() {
-        let (rows, cols) = (41usize, 37usize);
+        // several bands and column tiles (64 output columns per tile)
+        let (rows, cols) = (70usize, 150usize);
         let z = image(rows, cols, 4);
         for (w, sizes, step) in [
             (9usize, vec![2usize, 3, 4], 1usize),

@@ -35,20 +35,18 @@ pub(crate) fn rect_minmax(
             oh.copy_from_slice(xh);
             continue;
         }
-        for c in 0..cols {
-            if c % bw == 0 {
-                pre[c] = xl[c];
-                pre2[c] = xh[c];
-            } else {
+        // prefix and suffix extrema within blocks of bw samples
+        for b0 in (0..cols).step_by(bw) {
+            let b1 = (b0 + bw).min(cols);
+            pre[b0] = xl[b0];
+            pre2[b0] = xh[b0];
+            for c in b0 + 1..b1 {
                 pre[c] = pre[c - 1].min(xl[c]);
                 pre2[c] = pre2[c - 1].max(xh[c]);
             }
-        }
-        for c in (0..cols).rev() {
-            if c % bw == bw - 1 || c == cols - 1 {
-                suf[c] = xl[c];
-                suf2[c] = xh[c];
-            } else {
+            suf[b1 - 1] = xl[b1 - 1];
+            suf2[b1 - 1] = xh[b1 - 1];
+            for c in (b0..b1 - 1).rev() {
                 suf[c] = suf[c + 1].min(xl[c]);
                 suf2[c] = suf2[c + 1].max(xh[c]);
             }
