@@ -32,7 +32,8 @@ def main() -> None:
                         kw["z_scale"] = float(np.mean(np.abs(np.diff(z, axis=1))))
                     step = 4 if method == "blanket" else 1
                     d = fg.fractal_transform(z, w, method=method, step=step, **kw)
-                    d = d[-(-w // step):-(-w // step), -(-w // step):-(-w // step)]
+                    k = -(-w // step)  # one window from the edges, in grid steps
+                    d = d[k:-k, k:-k]
                     means.append(np.nanmean(d))
                     sds.append(np.nanstd(d))
                 m, sd = float(np.mean(means)), float(np.mean(sds))
