@@ -5,8 +5,8 @@ Voss's P(m, L) mass dimension (the paper's method, the default), the
 increment estimators (variogram, madogram, square increments) and
 differential box counting are computed with summed-area tables in Rust, so
 that the time per pixel does not grow with the window; the covering-blanket
-map grows the blankets of every window (Rust, its cost grows with the
-window).
+map grows only each window's border frame (Rust; its cost grows linearly
+with the window).
 
 References
 ----------
@@ -161,8 +161,10 @@ def fractal_transform(
         window, 4-neighbourhood, ``z_scale`` data units per step):
         ``A(e) = sum (u_e - b_e) / (2 e)`` and ``D = 2 - slope`` of
         ``log A`` against ``log e`` over ``epsilons``, exactly
-        :func:`fractalgeo_rs.blanket` of the window. Each window grows its
-        own blankets: the cost grows as ``window_size**2 * max(epsilons)``.
+        :func:`fractalgeo_rs.blanket` of the window. The blankets are grown
+        once per tile of the image; per window only the frame of pixels
+        closer than ``e`` to its border is grown again, so the cost grows as
+        ``window_size * max(epsilons)**2``.
 
     Parameters
     ----------
