@@ -134,7 +134,10 @@ def numpy_mass_windows_rows(z: np.ndarray, w: int, rows: int) -> float:
 def numpy_dbc_rows(z: np.ndarray, w: int, rows, sizes=(2, 4, 8, 16), z_unit=1.0) -> np.ndarray:
     """DBC map rows (partial blocks dropped, z0 = 0) vectorised over the
     windows of each row (view_as_windows)."""
-    from skimage.util import view_as_windows
+    try:
+        from skimage.util import view_as_windows
+    except ImportError:  # the same view
+        from numpy.lib.stride_tricks import sliding_window_view as view_as_windows
 
     h = w // 2
     zp = np.pad(z.astype(np.float64), h, constant_values=np.nan)
@@ -160,7 +163,10 @@ def numpy_dbc_rows(z: np.ndarray, w: int, rows, sizes=(2, 4, 8, 16), z_unit=1.0)
 def numpy_blanket_rows(z: np.ndarray, w: int, rows, eps=(1, 2, 3, 4)) -> np.ndarray:
     """Blanket map rows: the blankets of all windows of a row grown together
     (missing samples and the window frame are -inf / +inf)."""
-    from skimage.util import view_as_windows
+    try:
+        from skimage.util import view_as_windows
+    except ImportError:  # the same view
+        from numpy.lib.stride_tricks import sliding_window_view as view_as_windows
 
     h = w // 2
     zp = np.pad(z.astype(np.float64), h, constant_values=np.nan)

@@ -270,8 +270,13 @@ def test_lacunarity_map_equals_per_window_lacunarity():
 
 
 def windows(z, w):
-    """Every w x w window of the NaN-padded image (skimage's view_as_windows)."""
-    from skimage.util import view_as_windows
+    """Every w x w window of the NaN-padded image (skimage's view_as_windows;
+    numpy's sliding_window_view, the same view, where skimage is missing:
+    it is not a test dependency)."""
+    try:
+        from skimage.util import view_as_windows
+    except ImportError:
+        from numpy.lib.stride_tricks import sliding_window_view as view_as_windows
 
     zp = np.pad(np.asarray(z, dtype=float), w // 2, constant_values=np.nan)
     return view_as_windows(zp, (w, w))
