@@ -7,12 +7,16 @@ prints ``ratio = baseline / ours`` (above 1: ours is faster). Baselines:
 
 * 2D spectral: plain numpy (``np.random`` white noise, ``np.fft.rfft2``,
   ``|f|^-beta/2`` filter, ``np.fft.irfft2``), the figure-3 algorithm;
-* 2D midpoint/additions: a vectorised numpy diamond-square (below);
+* 2D midpoint/additions: a vectorised numpy diamond-square (below); for
+  additions it is the classic Peitgen & Saupe form (bilinear means), which
+  does less work than our crease-free 4-point scheme;
 * 2D exact: no common baseline (numpy Cholesky is O(n^6)); timed alone, at
   ``--exact-size`` (default 2048: the embedding torus is about 2.4x the
   side for H <= 0.75, so 4096^2 needs a 10000^2 complex FFT);
-* 1D: the ``stochastic`` package (Davies-Harte) when installed, and numpy
-  spectral synthesis;
+* 1D: the ``stochastic`` package (Davies-Harte, numpy FFTs) when installed,
+  and numpy spectral synthesis; our exact method runs eigenvalues, noise,
+  real FFT and cumulative sum in Rust (``realfft``), the eigenvalues cached
+  per length and H as in repeated use;
 * hillshade: ``gdaldem hillshade`` (subprocess on a float32 GeoTIFF: its
   time includes reading and writing the files) and a numpy Horn hillshade;
 * lake mask: numpy ``z < level`` plus ``scipy.ndimage.label``.
@@ -122,7 +126,8 @@ def main():
         rows.append(f"{name:34s} {ours:8.3f} {bt} {ratio}  {base_name}")
         print(rows[-1], flush=True)
 
-    print(f"threads: {os.cpu_count()} cores, fractalgeo_rs {fg.__version__}")
+    print(f"threads: {os.cpu_count()} cores, fractalgeo_rs {fg.__version__}, "
+          f"load average {os.getloadavg()[0]:.1f}")
     print(f"{'task':34s} {'ours s':>8s} {'base s':>8s} {'ratio':>6s}  baseline")
     # 2D
     from fractalgeo_rs.synth import _fbm

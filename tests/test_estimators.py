@@ -289,3 +289,74 @@ def test_dragon_curve_boundary():
     assert fg.minkowski(bd).dimension == pytest.approx(d, abs=0.02)
     assert fg.mass_dimension(bd).dimension == pytest.approx(d, abs=0.02)
     assert fg.box_counting(bd, scale_range=(4, 128)).dimension == pytest.approx(d, abs=0.05)
+
+
+def test_scale_space_filter_bank_equals_scipy_gaussian_filter():
+    # the wide kernels go through one shared FFT; each smoothed profile must
+    # equal scipy's direct filter (same sampled, normalised, reflected kernel)
+    from scipy.ndimage import gaussian_filter1d
+
+    from fractalgeo_rs.dimension.profile import _gaussian_bank
+
+    for n in (257, 5000):
+        z = fg.fbm(n, 0.4, method="exact", seed=n)
+        sig = np.array([1.0, 3.0, 6.0, 7.5, 16.0, n / 12])
+        for s, g in zip(sig, _gaussian_bank(z, sig)):
+            ref = gaussian_filter1d(z, s, mode="reflect")
+            np.testing.assert_allclose(g, ref, rtol=0, atol=1e-10 * np.abs(ref).max())
+
+
+def test_higuchi_lengths_equal_the_definition_and_any_thread_count():
+    # L(k) from a direct loop over offsets m (Higuchi 1988, with the final 1/k)
+    def lengths(z, k_max):
+        n, out = z.size, []
+        for k in range(1, k_max + 1):
+            lm = []
+            for m in range(k):
+                x = z[m::k]
+                if x.size >= 2:
+                    lm.append(np.abs(np.diff(x)).sum() * (n - 1) / ((x.size - 1) * k) / k)
+            out.append(np.mean(lm))
+        return np.array(out)
+
+    for n, k_max in ((21, 10), (101, 17), (1000, 64)):
+        z = fg.fbm(n, 0.3, method="exact", seed=n)
+        fit = fg.higuchi(z, k_max=k_max)
+        np.testing.assert_allclose(fit.measures, lengths(z, k_max), rtol=1e-12)
+        assert np.array_equal(fit.measures, fg.higuchi(z, k_max=k_max, n_threads=1).measures)
+        assert np.array_equal(fit.measures, fg.higuchi(z, k_max=k_max, n_threads=3).measures)
+
+
+def test_transect_dimensions_equal_a_per_line_fit_with_nan_holes():
+    # independent: np.polyfit per row and column on the NaN-free increments
+    z = fg.fbm_surface((64, 80), 0.4, method="exact", seed=3).astype(float)
+    z[5, 7] = np.nan
+    z[20:23, :] = np.nan
+    z[:, 40] = np.nan
+    lags = (1, 2, 3)
+    for p in (1.0, 2.0, 1.5):
+        fit = fg.surface_variation(z, estimator="transect", p=p, lags=lags)
+        dims = []
+        for line in list(z) + list(z.T):
+            m = []
+            for u in lags:
+                d = line[u:] - line[:-u]
+                d = d[~np.isnan(d)]
+                m.append(np.mean(np.abs(d) ** p) / 2 if d.size else np.nan)
+            m = np.array(m)
+            if np.all(m > 0) and np.isfinite(m).all():
+                dims.append(2 - np.polyfit(np.log(lags), np.log(m), 1)[0] / p)
+        np.testing.assert_allclose(fit.extra["transect_dimensions"], np.array(dims) + 1, rtol=1e-12)
+        assert fit.dimension == pytest.approx(np.median(dims) + 1, rel=1e-12)
+
+
+def test_spectral_detrend_removes_the_least_squares_plane():
+    from fractalgeo_rs.dimension.spectral import _detrend
+
+    rng = np.random.default_rng(1)
+    for shape in [(7, 9), (1, 5), (50, 1), (33, 64)]:
+        z = rng.normal(size=shape) + np.add.outer(np.arange(shape[0]) * 0.3, np.arange(shape[1]) * -0.7)
+        i, j = np.indices(shape, dtype=float)
+        a = np.column_stack([np.ones(z.size), i.ravel(), j.ravel()])
+        coef, *_ = np.linalg.lstsq(a, z.ravel(), rcond=None)
+        np.testing.assert_allclose(_detrend(z), z - (a @ coef).reshape(shape), atol=1e-10)

@@ -324,9 +324,152 @@ def test_crease_ratio_is_one_for_stationary_fields_and_sees_seams():
     assert cr[0] > 1.5 and cr[1] < 1.1, cr
 
 
-@pytest.mark.xfail(strict=True, reason="issue target not met: Voss additions (Peitgen & Saupe form) give "
-                                        "crease ratios 1.30-2.17 (docs/synthesis.md, Known limits)")
-def test_additions_crease_ratio_target():
-    r = [fg.validate_surface(fbm_surface((512, 512), 0.7, method="additions", seed=s), 0.7,
+@pytest.mark.parametrize("h", [0.2, 0.5, 0.7, 0.8])
+def test_additions_crease_ratio_target(h):
+    # The issue's target: crease ratio <= 1.1 (validate_surface, 1024^2).
+    # Measured over 6 seeds: 1.03-1.06 (docs/synthesis.md); a stationary
+    # field gives 1.01-1.02 at this size.
+    r = [fg.validate_surface(fbm_surface((1024, 1024), h, method="additions", seed=s), h,
                              coastline=False).crease_ratio for s in range(3)]
-    assert np.mean(r) <= 1.1, r
+    assert max(r) <= 1.1, r
+
+
+@pytest.mark.parametrize("h", [0.2, 0.5, 0.7, 0.8])
+def test_additions_hurst_target_at_1024(h):
+    # The issue's target: H within 0.05 by validate_surface (variogram and
+    # spectrum) on 1024^2, mean over seeds.
+    reps = [fg.validate_surface(fbm_surface((1024, 1024), h, method="additions", seed=100 + s), h,
+                                coastline=False) for s in range(3)]
+    assert abs(np.mean([r.hurst_variogram for r in reps]) - h) <= 0.05
+    assert abs(np.mean([r.hurst_spectrum for r in reps]) - h) <= 0.05
+
+
+def _ref_additions(coarse, h, sigma, s, w, var, periodic, seed, level=0):
+    """Slow numpy version of one level of _core.additions_refine_2d, written
+    from docs/synthesis.md ("Successive random additions without creases")."""
+    r, c = coarse.shape
+    fr, fc = (2 * r, 2 * c) if periodic else (2 * r - 1, 2 * c - 1)
+    nr, nc = (r, c) if periodic else (r - 1, c - 1)
+    sd = [sigma * s**h * math.sqrt(v) for v in var]  # a2, c1, c2, e
+    base = (1 << 21) + 8 * level
+    rule = [(-1, -w), (0, 0.5 + w), (1, 0.5 + w), (2, -w)]
+
+    def ext(get, n, k):  # periodic wrap, else linear extension
+        if periodic:
+            return get(k % n)
+        if k < 0:
+            return get(0) + (-k) * (get(0) - get(1))
+        if k >= n:
+            return get(n - 1) + (k - n + 1) * (get(n - 1) - get(n - 2))
+        return get(k)
+
+    def old(a, b):
+        return ext(lambda aa: ext(lambda bb: coarse[aa, bb], c, b), r, a)
+
+    cen = np.empty((nr, nc))
+    for a in range(nr):
+        for b in range(nc):
+            v = sum(wa * wb * old(a + ka, b + kb) for ka, wa in rule for kb, wb in rule)
+            cen[a, b] = v + sd[1] * _ref_normals(seed, base + 0, (2 * a + 1) * fc + 2 * b + 1)
+
+    def centre(a, b):
+        return ext(lambda aa: ext(lambda bb: cen[aa, bb], nc, b), nr, a)
+
+    out = np.empty((fr, fc))
+    for i in range(fr):
+        for j in range(fc):
+            g = i * fc + j
+            a, b = i // 2, j // 2
+            if i % 2 == 0 and j % 2 == 0:
+                out[i, j] = coarse[a, b] + sd[0] * _ref_normals(seed, base + 2, g)
+            elif i % 2 == 1 and j % 2 == 1:
+                out[i, j] = cen[a, b] + sd[2] * _ref_normals(seed, base + 1, g)
+            else:
+                if i % 2 == 0:  # old samples along the row, centres along the column
+                    along = sum(wk * old(a, b + k) for k, wk in rule)
+                    across = sum(wk * centre(a - 1 + k, b) for k, wk in rule)
+                else:
+                    along = sum(wk * old(a + k, b) for k, wk in rule)
+                    across = sum(wk * centre(a, b - 1 + k) for k, wk in rule)
+                out[i, j] = 0.5 * (along + across) + sd[3] * _ref_normals(seed, base + 3, g)
+    return out
+
+
+@pytest.mark.parametrize("periodic", [False, True])
+def test_additions_kernel_matches_numpy_reference(periodic):
+    rng = np.random.default_rng(1)
+    coarse = rng.normal(size=(4, 5))
+    before = coarse.copy()
+    var = [0.01, 0.09, 0.02, 0.08]
+    got = _core.additions_refine_2d(coarse, 1, 0.7, 1.3, 8.0, 0.1, var, periodic, 11, 0, 2)
+    want = _ref_additions(coarse, 0.7, 1.3, 8.0, 0.1, var, periodic, 11)
+    np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-9)
+    np.testing.assert_array_equal(coarse, before)
+
+
+def test_additions_schedule_balances_the_second_differences():
+    # The derived variances make the second-difference variance equal at the
+    # four kinds of positions and the lag-one variance (1/2)^(2H) when the
+    # coarse grid is fBm; checked here by Monte Carlo on exact fBm coarse
+    # grids through the Rust kernel (interior only).
+    from fractalgeo_rs.synth import _additions
+
+    h = 0.7
+    w, var = _additions.schedule(h)
+    d2 = {k: [] for k in ((0, 0), (0, 1), (1, 0), (1, 1))}
+    lag = []
+    for s in range(60):
+        coarse = fbm_surface((24, 24), h, method="exact", seed=500 + s)
+        f = _core.additions_refine_2d(coarse, 1, h, 1.0, 1.0, w, list(var), False, s)[8:-8, 8:-8]
+        dd = f[:, 2:] - 2 * f[:, 1:-1] + f[:, :-2]
+        for (r, q) in d2:
+            d2[(r, q)].append(np.mean(dd[r::2, (1 - q)::2] ** 2))  # centre column 1 + index
+        lag.append(np.mean(np.diff(f, axis=1) ** 2))
+    means = {k: np.mean(v) for k, v in d2.items()}
+    ses = {k: np.std(v, ddof=1) / math.sqrt(len(v)) for k, v in d2.items()}
+    ref = means[(0, 0)]
+    for k in d2:
+        assert abs(means[k] - ref) <= 4 * math.hypot(ses[k], ses[(0, 0)]), (k, means, ses)
+    ok, info = within(np.array(lag) / 0.5 ** (2 * h), 1.0)
+    assert ok, info
+
+
+def test_exact_memory_guard_raises_before_allocating():
+    from fractalgeo_rs.synth import _fbm
+
+    with pytest.raises(ValueError, match=r"shape.*GiB.*spectral"):
+        fbm_surface((200_000, 200_000), 0.7, method="exact")  # would need petabytes
+    need = _fbm.exact_memory_bytes(64, 64, 0.5)
+    with pytest.raises(ValueError, match="shape"):
+        fbm_surface((64, 64), 0.5, method="exact", max_memory=need - 1)
+    assert fbm_surface((64, 64), 0.5, method="exact", max_memory=need, seed=1).shape == (64, 64)
+    with pytest.raises(ValueError, match="max_memory"):
+        fbm_surface((64, 64), 0.5, method="exact", max_memory=0)
+    with pytest.raises(TypeError, match="max_memory"):
+        fbm_surface((64, 64), 0.5, method="exact", max_memory="1G")
+
+
+@pytest.mark.parametrize("h", [0.3, 0.8])
+def test_exact_memory_estimate_bounds_the_measured_peak(h):
+    # numpy and scipy.fft outputs are traced by tracemalloc: the estimate must
+    # be at least the real peak and not wildly above it.
+    import tracemalloc
+
+    from fractalgeo_rs.synth import _fbm
+
+    shape = (300, 200)
+    tracemalloc.start()
+    fbm_surface(shape, h, method="exact", seed=1)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    est = _fbm.exact_memory_bytes(*shape, h)
+    assert peak <= est <= 3 * peak, (peak, est)
+
+
+def test_davies_harte_eigenvalues_match_numpy_fft():
+    # The Rust real FFT of the circulant row against numpy's complex FFT.
+    m, h = 1000, 0.65
+    k = np.arange(m + 1, dtype=np.float64)
+    g = 0.5 * (np.abs(k + 1) ** (2 * h) - 2 * k ** (2 * h) + np.abs(k - 1) ** (2 * h))
+    lam = np.fft.fft(np.concatenate([g, g[-2:0:-1]])).real[: m + 1]
+    np.testing.assert_allclose(_core.fgn_sqrt_eigenvalues(m, h) ** 2 * 2 * m, lam, rtol=1e-9, atol=1e-9)

@@ -12,13 +12,17 @@ __all__ = [
     "LSystemCore",
     "ModuleString",
     "__version__",
+    "additions_refine_2d",
     "blanket_areas_image",
     "blanket_transform_map",
     "box_count_binary",
     "box_count_points",
     "column_ranges",
+    "davies_harte_fbm",
     "dbc_count",
     "dbc_transform_map",
+    "fgn_sqrt_eigenvalues",
+    "higuchi_lengths",
     "hillshade_f64",
     "ifs_chaos_game",
     "ifs_check",
@@ -68,6 +72,11 @@ def dbc_count(
     z_unit: float,
     n_threads: Optional[int] = None,
 ) -> Tuple[npt.NDArray[np.uint64], npt.NDArray[np.float64]]: ...
+def higuchi_lengths(
+    data: npt.NDArray[np.float64],
+    k_max: int,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...
 def column_ranges(
     data: npt.NDArray[np.float64],
     box_sizes: Sequence[int],
@@ -104,6 +113,23 @@ def midpoint_refine_2d(
     seed: int,
     first_level: int = 0,
     n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...
+def additions_refine_2d(
+    coarse: npt.NDArray[np.float64],
+    levels: int,
+    hurst: float,
+    sigma: float,
+    coarse_spacing: float,
+    tension: float,
+    variances: Sequence[float],
+    periodic: bool,
+    seed: int,
+    first_level: int = 0,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...
+def fgn_sqrt_eigenvalues(m: int, hurst: float, n_threads: Optional[int] = None) -> npt.NDArray[np.float64]: ...
+def davies_harte_fbm(
+    sqrt_eig: npt.NDArray[np.float64], n: int, seed: int, stream: int, n_threads: Optional[int] = None
 ) -> npt.NDArray[np.float64]: ...
 def hillshade_f64(
     dem: npt.NDArray[np.float64],

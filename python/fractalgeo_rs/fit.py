@@ -258,10 +258,12 @@ def fit_loglog(
     slope, intercept, r2, se = _ols(x, y)
     dim = dim_offset + dim_factor * slope
     dse = abs(dim_factor) * se
-    from scipy.stats import t as student_t
+    # Student t quantile from scipy.special (what scipy.stats.t.ppf calls;
+    # importing scipy.stats would cost about a second on first use)
+    from scipy.special import stdtrit
 
     if len(x) > 2:
-        half = float(student_t.ppf(0.975, len(x) - 2)) * dse
+        half = float(stdtrit(len(x) - 2, 0.975)) * dse
     else:
         dse = half = float("nan")
     return DimensionFit(

@@ -1,5 +1,5 @@
 //! Bindings of `crate::dimension`.
-use crate::dimension::{affine, boxcount, dbc, points};
+use crate::dimension::{affine, boxcount, dbc, higuchi, points};
 use crate::parallel::run_in_pool;
 use numpy::ndarray::Array2;
 use numpy::{
@@ -156,7 +156,22 @@ fn column_ranges<'py>(
     Ok((m.into_pyarray(py), n.into_pyarray(py)))
 }
 
+/// Higuchi curve lengths L(k), k = 1 ..= k_max, of a gap-free profile.
+#[pyfunction]
+#[pyo3(signature = (data, k_max, n_threads=None))]
+fn higuchi_lengths<'py>(
+    py: Python<'py>,
+    data: PyReadonlyArrayDyn<'py, f64>,
+    k_max: usize,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let x = contiguous(&data)?;
+    let l = py.detach(|| run_in_pool(n_threads, || higuchi::higuchi_lengths(x, k_max)))?;
+    Ok(l.into_pyarray(py))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(higuchi_lengths, m)?)?;
     m.add_function(wrap_pyfunction!(box_count_binary, m)?)?;
     m.add_function(wrap_pyfunction!(box_count_points, m)?)?;
     m.add_function(wrap_pyfunction!(dbc_count, m)?)?;

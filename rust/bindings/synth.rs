@@ -2,6 +2,8 @@
 use crate::dem::hillshade::{self, ShadeParams};
 use crate::io::exr_io;
 use crate::parallel::run_in_pool;
+use crate::synth::additions::{self, AdditionsParams};
+use crate::synth::davies_harte;
 use crate::synth::midpoint::{self, RefineParams};
 use crate::synth::rng;
 use numpy::ndarray::Array2;
@@ -118,6 +120,85 @@ fn midpoint_refine_2d<'py>(
     Ok(v.into_pyarray(py))
 }
 
+/// Refine a 2D grid `levels` times by successive random additions with the
+/// 4-point rule of tension `tension` and the variances `[a2, c1, c2, e]` in
+/// units of `sigma^2 s^(2H)` (see `crate::synth::additions`).
+#[pyfunction]
+#[pyo3(signature = (coarse, levels, hurst, sigma, coarse_spacing, tension, variances, periodic, seed, first_level=0, n_threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn additions_refine_2d<'py>(
+    py: Python<'py>,
+    coarse: PyReadonlyArray2<'py, f64>,
+    levels: u32,
+    hurst: f64,
+    sigma: f64,
+    coarse_spacing: f64,
+    tension: f64,
+    variances: [f64; 4],
+    periodic: bool,
+    seed: u64,
+    first_level: u32,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let c = coarse.as_array();
+    let p = AdditionsParams {
+        hurst,
+        sigma,
+        coarse_spacing,
+        tension,
+        variances,
+        periodic,
+        seed,
+        level: first_level,
+        origin: (0, 0),
+        global_cols: 0,
+    };
+    let v = py.detach(|| run_in_pool(n_threads, || additions::refine_2d_levels(c, levels, &p)))?;
+    Ok(v.into_pyarray(py))
+}
+
+/// `sqrt(lambda_k / 2m)`, `k = 0 .. m`, of the circulant embedding of unit fGn.
+#[pyfunction]
+#[pyo3(signature = (m, hurst, n_threads=None))]
+fn fgn_sqrt_eigenvalues<'py>(
+    py: Python<'py>,
+    m: usize,
+    hurst: f64,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let v =
+        py.detach(|| run_in_pool(n_threads, || davies_harte::fgn_sqrt_eigenvalues(m, hurst)))?;
+    Ok(v.into_pyarray(py))
+}
+
+/// Exact fBm path of `n` samples (Davies-Harte) from `fgn_sqrt_eigenvalues`.
+#[pyfunction]
+#[pyo3(signature = (sqrt_eig, n, seed, stream, n_threads=None))]
+fn davies_harte_fbm<'py>(
+    py: Python<'py>,
+    sqrt_eig: PyReadonlyArray1<'py, f64>,
+    n: usize,
+    seed: u64,
+    stream: u64,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let s = sqrt_eig.as_array();
+    let owned;
+    let sl: &[f64] = match s.as_slice() {
+        Some(x) => x,
+        None => {
+            owned = s.to_vec();
+            &owned
+        }
+    };
+    let v = py.detach(|| {
+        run_in_pool(n_threads, || {
+            davies_harte::fbm_from_eigenvalues(sl, n, seed, stream)
+        })
+    })?;
+    Ok(v.into_pyarray(py))
+}
+
 /// Hillshade in [0, 1] (NaN = nodata); `dx` per row, `dy` scalar.
 #[pyfunction]
 #[pyo3(signature = (dem, dx, dy, azimuth, altitude, z_factor, multidirectional, n_threads=None))]
@@ -189,6 +270,9 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(normal_noise, m)?)?;
     m.add_function(wrap_pyfunction!(midpoint_refine_1d, m)?)?;
     m.add_function(wrap_pyfunction!(midpoint_refine_2d, m)?)?;
+    m.add_function(wrap_pyfunction!(additions_refine_2d, m)?)?;
+    m.add_function(wrap_pyfunction!(fgn_sqrt_eigenvalues, m)?)?;
+    m.add_function(wrap_pyfunction!(davies_harte_fbm, m)?)?;
     m.add_function(wrap_pyfunction!(hillshade_f64, m)?)?;
     Ok(())
 }

@@ -37,10 +37,59 @@ pub(crate) struct MinMax {
     pub shape: [usize; 2],
 }
 
-/// Block min/max of a row-major `rows x cols` source by factor `m`, shift `c`.
-fn reduce_minmax<F>(rows: usize, cols: usize, m: usize, c: [usize; 2], read: F) -> MinMax
+/// Fold one source row into the block minima/maxima of its block row.
+///
+/// Block `b` covers source columns `[b m - c, (b + 1) m - c)` (clipped), as
+/// [`box_range`]; `lo_row`/`hi_row` are the row's minima/maxima (the same
+/// slice for raw data). `f64::min`/`max` skip NaN.
+#[inline]
+fn fold_row<T: Sample>(
+    lo_row: &[T],
+    hi_row: &[T],
+    m: usize,
+    c: usize,
+    lrow: &mut [f64],
+    hrow: &mut [f64],
+) {
+    let len = lo_row.len();
+    if c == 0 && m == 2 {
+        // the finest level dominates the cost: a branch-free pairwise loop
+        let full = len / 2;
+        for (b, (l, h)) in lo_row
+            .chunks_exact(2)
+            .zip(hi_row.chunks_exact(2))
+            .enumerate()
+        {
+            lrow[b] = lrow[b].min(l[0].to_f64().min(l[1].to_f64()));
+            hrow[b] = hrow[b].max(h[0].to_f64().max(h[1].to_f64()));
+        }
+        if len % 2 == 1 {
+            lrow[full] = lrow[full].min(lo_row[len - 1].to_f64());
+            hrow[full] = hrow[full].max(hi_row[len - 1].to_f64());
+        }
+        return;
+    }
+    let (mut k, mut b) = (0usize, 0usize);
+    while k < len {
+        let end = ((b + 1) * m - c).min(len);
+        let (mut a, mut z) = (lrow[b], hrow[b]);
+        for i in k..end {
+            a = a.min(lo_row[i].to_f64());
+            z = z.max(hi_row[i].to_f64());
+        }
+        lrow[b] = a;
+        hrow[b] = z;
+        k = end;
+        b += 1;
+    }
+}
+
+/// Block min/max by factor `m`, shift `c` of a row-major `rows x cols`
+/// source given as per-row minima and maxima (`row(r) -> (lo, hi)`).
+fn reduce_minmax<'a, T, F>(rows: usize, cols: usize, m: usize, c: [usize; 2], row: F) -> MinMax
 where
-    F: Fn(usize, usize, usize) -> (f64, f64) + Sync, // (row, col_lo, col_hi) -> (min, max) over the row segment
+    T: Sample + 'a,
+    F: Fn(usize) -> (&'a [T], &'a [T]) + Sync,
 {
     let shape = [n_boxes(rows, m, c[0]), n_boxes(cols, m, c[1])];
     let mut lo = vec![f64::INFINITY; shape[0] * shape[1]];
@@ -50,16 +99,9 @@ where
         .enumerate()
         .for_each(|(b0, (lrow, hrow))| {
             let (r0, r1) = box_range(b0, m, c[0], rows);
-            for b1 in 0..shape[1] {
-                let (c0, c1) = box_range(b1, m, c[1], cols);
-                let (mut a, mut b) = (f64::INFINITY, f64::NEG_INFINITY);
-                for r in r0..r1 {
-                    let (x, y) = read(r, c0, c1);
-                    a = a.min(x);
-                    b = b.max(y);
-                }
-                lrow[b1] = a;
-                hrow[b1] = b;
+            for r in r0..r1 {
+                let (l, h) = row(r);
+                fold_row(&l[..cols], &h[..cols], m, c[1], lrow, hrow);
             }
         });
     MinMax { lo, hi, shape }
@@ -134,21 +176,16 @@ pub fn dbc_count<T: Sample>(
             let m = s / t;
             let c = [((g[1] % s) - (g[1] % t)) / t, ((g[2] % s) - (g[2] % t)) / t];
             let mm = if t == 1 {
-                reduce_minmax(rows, cols, m, c, |r, c0, c1| {
-                    nan_minmax(&data[r * cols + c0..r * cols + c1])
+                reduce_minmax(rows, cols, m, c, |r| {
+                    let row = &data[r * cols..(r + 1) * cols];
+                    (row, row)
                 })
             } else {
                 let k = done.iter().position(|&d| d == t).unwrap();
                 let src = &grids[k];
                 let w = src.shape[1];
-                reduce_minmax(src.shape[0], w, m, c, |r, c0, c1| {
-                    let lo = src.lo[r * w + c0..r * w + c1]
-                        .iter()
-                        .fold(f64::INFINITY, |a, &b| a.min(b));
-                    let hi = src.hi[r * w + c0..r * w + c1]
-                        .iter()
-                        .fold(f64::NEG_INFINITY, |a, &b| a.max(b));
-                    (lo, hi)
+                reduce_minmax(src.shape[0], w, m, c, |r| {
+                    (&src.lo[r * w..(r + 1) * w], &src.hi[r * w..(r + 1) * w])
                 })
             };
             let h = s as f64 * z_unit;

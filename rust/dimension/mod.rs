@@ -6,10 +6,12 @@
 //! * [`points`]: box counting of point sets given as coordinates.
 //! * [`dbc`]: differential box counting of grayscale images and DEMs.
 //! * [`affine`]: per-column height ranges for self-affine box counting of graphs.
+//! * [`higuchi`]: curve lengths of Higuchi's method for profiles.
 //! * [`lattice`]: the box lattices (sizes, grid shifts) shared by the counters.
 
 pub mod affine;
 pub mod boxcount;
 pub mod dbc;
+pub mod higuchi;
 pub mod lattice;
 pub mod points;

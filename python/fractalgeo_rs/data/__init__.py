@@ -13,7 +13,7 @@ from typing import Any, Dict, Tuple
 
 import numpy as np
 
-__all__ = ["srtm_alps", "srtm_po_plain", "kilauea_land_mask", "sentinel1_vv_db"]
+__all__ = ["srtm_alps", "srtm_po_plain", "kilauea_land_mask", "sentinel1_vv_db", "sentinel1_vh_db"]
 
 _HERE = os.path.dirname(__file__)
 _SRTM = "NASA SRTM 3 arc-second DEM, tile N44E007 (US public domain)"
@@ -66,14 +66,30 @@ def kilauea_land_mask() -> Tuple[np.ndarray, Dict[str, Any]]:
     }
 
 
-def sentinel1_vv_db() -> Tuple[np.ndarray, Dict[str, Any]]:
-    """Sentinel-1 sigma0 VV in dB, Vega Baja del Segura (Spain), 512 x 512 float32."""
-    with _load("s1_vega_baja_vv_db.npz") as f:
-        vv = f["vv_db"].copy()
-    return vv, {
-        "description": "Sentinel-1 IW GRD sigma0 VV (dB), Vega Baja del Segura, Sept 2019 flood",
+_S1_TRANSFORM = (8.983152841195215e-05, 0.0, -0.7818936232976315, 0.0, -8.983152841195215e-05, 38.12881257139627)
+
+
+def _sentinel1(key: str, pol: str) -> Tuple[np.ndarray, Dict[str, Any]]:
+    with _load("s1_vega_baja_vv_vh_db.npz") as f:
+        band = f[key].copy()
+    a, e, f0 = _S1_TRANSFORM[0], _S1_TRANSFORM[4], _S1_TRANSFORM[5]
+    lat = f0 + e * band.shape[0] / 2
+    cell = (abs(a) * 111_320.0 * np.cos(np.radians(lat)), abs(e) * 110_574.0)
+    return band, {
+        "description": f"Sentinel-1 IW GRD sigma0 {pol} (dB), Vega Baja del Segura, Sept 2019 flood",
         "attribution": "Contains modified Copernicus Sentinel data 2019 (Sen1Floods11 sample)",
         "crs": "EPSG:4326",
-        "transform": (8.983152841195215e-05, 0.0, -0.7818936232976315, 0.0, -8.983152841195215e-05, 38.12881257139627),
+        "transform": _S1_TRANSFORM,
+        "cell_size": cell,  # (x, y) metres, from latitude (the grid is in degrees)
         "units": "dB",
     }
+
+
+def sentinel1_vv_db() -> Tuple[np.ndarray, Dict[str, Any]]:
+    """Sentinel-1 sigma0 VV in dB, Vega Baja del Segura (Spain), 512 x 512 float32."""
+    return _sentinel1("vv_db", "VV")
+
+
+def sentinel1_vh_db() -> Tuple[np.ndarray, Dict[str, Any]]:
+    """Sentinel-1 sigma0 VH in dB, the same scene and grid as :func:`sentinel1_vv_db`."""
+    return _sentinel1("vh_db", "VH")

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import warnings
 from typing import Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -242,6 +243,16 @@ def box_counting_points(
     )
 
 
+def _nan_range(z: np.ndarray) -> Tuple[float, float]:
+    """Lowest and highest valid value (no copy of the data)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN slice
+        lo = float(np.nanmin(z))
+    if math.isnan(lo):
+        raise ValueError("image: no valid value (all NaN or nodata)")
+    return lo, float(np.nanmax(z))
+
+
 def _surface_float(data, nodata, name: str = "data", ndims=(2,)) -> np.ndarray:
     """A C-contiguous float32/float64 copy or view with nodata as NaN."""
     arr = as_array(data, name)
@@ -343,10 +354,7 @@ def differential_box_counting(
     offsets = check_positive_int(offsets, "offsets")
     check_choice(offset_reduce, "offset_reduce", ("mean", "min"))
     n_threads = check_n_threads(n_threads)
-    valid = z[~np.isnan(z)]
-    if valid.size == 0:
-        raise ValueError("image: no valid value (all NaN or nodata)")
-    zmin, zmax = float(valid.min()), float(valid.max())
+    zmin, zmax = _nan_range(z)
     rows, cols = z.shape
     if z_scale is None:
         z_unit = (zmax - zmin) / max(rows, cols) if zmax > zmin else 1.0

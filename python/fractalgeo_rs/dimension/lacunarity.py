@@ -93,17 +93,20 @@ def lacunarity(data, box_sizes: Optional[Sequence[int]] = None) -> Lacunarity:
     sizes = sorted(set(check_positive_int(v, "box_sizes") for v in box_sizes))
     if not sizes or sizes[-1] > min(z.shape):
         raise ValueError(f"box_sizes: sizes must be in [1, {min(z.shape)}], got {sizes}")
-    zz = np.where(nan, 0.0, z)
+    holes = bool(nan.any())
+    zz = np.where(nan, 0.0, z) if holes else z
     sat = np.zeros((z.shape[0] + 1, z.shape[1] + 1))
-    sat[1:, 1:] = zz.cumsum(0).cumsum(1)
-    nsat = np.zeros_like(sat)
-    nsat[1:, 1:] = nan.astype(float).cumsum(0).cumsum(1)
+    np.cumsum(zz, axis=0, out=sat[1:, 1:])
+    np.cumsum(sat[1:, 1:], axis=1, out=sat[1:, 1:])
+    if holes:
+        nsat = np.zeros_like(sat)
+        nsat[1:, 1:] = nan.astype(float).cumsum(0).cumsum(1)
     lam, nb = [], []
     for r in sizes:
         box = lambda s: s[r:, r:] - s[:-r, r:] - s[r:, :-r] + s[:-r, :-r]  # noqa: E731
         m = box(sat)
-        ok = box(nsat) == 0
-        m = m[ok]
+        if holes:
+            m = m[box(nsat) == 0]
         mean = m.mean() if m.size else np.nan
         lam.append(float(np.mean(m**2) / mean**2) if m.size and mean > 0 else np.nan)
         nb.append(int(m.size))

@@ -16,7 +16,8 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from fractalgeo_rs._validation import check_positive_float, check_positive_int
+from fractalgeo_rs import _core
+from fractalgeo_rs._validation import check_n_threads, check_positive_float, check_positive_int
 from fractalgeo_rs.dimension.variation import _real_array, _with_nodata
 from fractalgeo_rs.fit import DimensionFit, ScaleRange, fit_loglog
 
@@ -29,7 +30,7 @@ def _gap_free(z: np.ndarray, method: str) -> None:
 
 
 def higuchi(data, *, k_max: Optional[int] = None, nodata: Optional[float] = None,
-            scale_range: ScaleRange = None) -> DimensionFit:
+            scale_range: ScaleRange = None, n_threads: Optional[int] = None) -> DimensionFit:
     """Higuchi's (1988) dimension of a profile or time series.
 
     For ``k = 1 .. k_max`` and offsets ``m = 1 .. k`` the curve length is
@@ -48,6 +49,9 @@ def higuchi(data, *, k_max: Optional[int] = None, nodata: Optional[float] = None
         Gap-free series (NaN raises ValueError).
     k_max : int, optional
         Largest interval; default ``min(64, n // 10)`` (at least 3).
+    n_threads : int, optional
+        Threads of the Rust kernel (default: all cores); the result does not
+        depend on it.
 
     Returns
     -------
@@ -63,18 +67,53 @@ def higuchi(data, *, k_max: Optional[int] = None, nodata: Optional[float] = None
     if k_max < 3 or k_max > n // 2:
         raise ValueError(f"k_max: expected an int in [3, {n // 2}] for {n} samples, got {k_max}")
     ks = np.arange(1, k_max + 1)
-    L = np.empty(k_max)
-    for a, k in enumerate(ks):
-        lm = []
-        for m in range(k):  # 0-based offset m corresponds to Higuchi's m + 1
-            x = z[m::k]
-            cnt = x.size - 1
-            if cnt < 1:
-                continue
-            lm.append(np.abs(np.diff(x)).sum() * (n - 1) / (cnt * k) / k)
-        L[a] = np.mean(lm)
+    # Rust kernel: one streaming pass per k, k values in parallel
+    L = _core.higuchi_lengths(np.ascontiguousarray(z, dtype=np.float64), k_max, check_n_threads(n_threads))
     return fit_loglog(ks, L, method="higuchi", dim_offset=0.0, dim_factor=-1.0, scale_range=scale_range,
                       x_label="interval k (samples)", y_label="curve length L(k)")
+
+
+_FFT_SIGMA = 6.0  # above this width the filter bank runs through one shared FFT
+
+
+def _gaussian_bank(z: np.ndarray, sigmas: np.ndarray):
+    """Yield ``scipy.ndimage.gaussian_filter1d(z, s, mode="reflect")`` for
+    each width (same sampled kernel, radius ``int(4 s + 0.5)``, normalised).
+
+    Narrow kernels are applied directly; wide ones (whose direct cost grows
+    with ``s``) as products with the FFT of the signal, reflected once by the
+    largest radius and transformed once for all widths. A circular
+    convolution of that padded signal equals the linear one on the central
+    ``n`` samples because no kernel reaches past the padding; results agree
+    with the direct filter to rounding (about 1e-12 relative).
+    """
+    from scipy import fft as sfft
+    from scipy.ndimage import gaussian_filter1d
+
+    z = np.asarray(z, dtype=np.float64)
+    n = z.size
+    wide = [s for s in sigmas if s > _FFT_SIGMA]
+    if wide:
+        big = int(4.0 * max(wide) + 0.5)
+        if big >= n:
+            wide = []  # reflection by more than the profile: use the direct filter
+    spec = None
+    for s in sigmas:
+        if s not in wide:
+            yield gaussian_filter1d(z, s, mode="reflect")
+            continue
+        if spec is None:
+            y = np.pad(z, big, mode="symmetric")  # scipy's "reflect": d c b a | a b c d
+            size = sfft.next_fast_len(y.size, real=True)
+            spec = sfft.rfft(y, size)
+        r = int(4.0 * s + 0.5)
+        k = np.arange(-r, r + 1, dtype=np.float64)
+        w = np.exp(-0.5 * (k / s) ** 2)
+        w /= w.sum()
+        kern = np.zeros(size)
+        kern[: r + 1] = w[r:]
+        kern[size - r:] = w[:r]
+        yield sfft.irfft(spec * sfft.rfft(kern), size)[big:big + n]
 
 
 def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, sample_spacing: float = 0.0,
@@ -106,8 +145,6 @@ def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, sample_spacin
         ``D = 1 - slope``. Edges are handled by reflection
         (``scipy.ndimage.gaussian_filter1d``, mode "reflect").
     """
-    from scipy.ndimage import gaussian_filter1d
-
     z = _with_nodata(_real_array(data, (1,)), data, nodata)
     _gap_free(z, "scale space")
     if isinstance(sample_spacing, bool) or not np.isscalar(sample_spacing) or not sample_spacing >= 0:
@@ -118,7 +155,7 @@ def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, sample_spacin
     sig = np.asarray(sorted(set(float(s) for s in sigmas)))
     if sig.size < 3 or sig[0] <= 0 or not np.isfinite(sig).all():
         raise ValueError(f"sigmas: need at least 3 distinct positive widths, got {sig.tolist()}")
-    lengths = np.array([np.sum(np.hypot(dx, np.diff(gaussian_filter1d(z, s, mode="reflect")))) for s in sig])
+    lengths = np.array([np.sum(np.hypot(dx, np.diff(g))) for g in _gaussian_bank(z, sig)])
     return fit_loglog(sig, lengths, method="scale_space", dim_offset=1.0, dim_factor=-1.0,
                       scale_range=scale_range, x_label="sigma (samples)", y_label="length L(sigma)",
                       extra={"sample_spacing": dx})

@@ -37,10 +37,15 @@ def _detrend(z: np.ndarray) -> np.ndarray:
         x = np.arange(z.size, dtype=float)
         a, b = np.polyfit(x, z, 1)
         return z - (a * x + b)
-    i, j = np.indices(z.shape, dtype=float)
-    A = np.column_stack([np.ones(z.size), i.ravel(), j.ravel()])
-    coef, *_ = np.linalg.lstsq(A, z.ravel(), rcond=None)
-    return z - (A @ coef).reshape(z.shape)
+    # on a full grid the centred row and column indices are orthogonal to
+    # each other and to the constant, so the least-squares plane separates:
+    # slope along an axis = sum (i - mean i) z / sum (i - mean i)^2
+    zc = z - z.mean()
+    i = np.arange(z.shape[0], dtype=float) - (z.shape[0] - 1) / 2
+    j = np.arange(z.shape[1], dtype=float) - (z.shape[1] - 1) / 2
+    bi = (i @ zc.sum(axis=1)) / (z.shape[1] * (i @ i)) if z.shape[0] > 1 else 0.0
+    bj = (zc.sum(axis=0) @ j) / (z.shape[0] * (j @ j)) if z.shape[1] > 1 else 0.0
+    return zc - bi * i[:, None] - bj * j[None, :]
 
 
 def _window(shape, kind: str) -> np.ndarray:

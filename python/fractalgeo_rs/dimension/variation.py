@@ -77,17 +77,47 @@ def _check_lags(lags, n_max: int, name="lags") -> np.ndarray:
 def _increments(z: np.ndarray, lag: int, order: int, axis: int) -> np.ndarray:
     """First or second differences at ``lag`` along ``axis`` (NaN propagates)."""
     n = z.shape[axis]
-    take = lambda a, b: np.take(z, np.arange(a, b), axis=axis)  # noqa: E731
+
+    def take(a, b):  # a view, not a copy
+        idx = [slice(None)] * z.ndim
+        idx[axis] = slice(a, b)
+        return z[tuple(idx)]
+
     if order == 1:
         return take(lag, n) - take(0, n - lag)
     return take(2 * lag, n) - 2 * take(lag, n - lag) + take(0, n - 2 * lag)
 
 
+def _powers(inc: np.ndarray, p: float) -> np.ndarray:
+    """``|inc|^p`` (in place on the temporary ``inc``)."""
+    if p == 2.0:
+        return np.square(inc, out=inc)
+    np.abs(inc, out=inc)
+    return inc if p == 1.0 else np.power(inc, p, out=inc)
+
+
 def _mean_power(inc: np.ndarray, p: float) -> float:
-    v = inc[~np.isnan(inc)]
+    """Half the mean of ``|inc|^p`` over the non-NaN increments (``inc`` is
+    a temporary and is overwritten)."""
+    v = _powers(inc, p)
+    nan = np.isnan(v)
+    if nan.any():
+        v = v[~nan]
     if v.size == 0:
         return np.nan
-    return float(np.mean(np.abs(v) ** p)) / 2.0
+    return float(np.mean(v)) / 2.0
+
+
+def _line_means(z: np.ndarray, lag: int, p: float, axis: int) -> np.ndarray:
+    """Per line (rows for ``axis=1``) half mean of ``|first difference|^p``
+    at ``lag``, NaN increments left out (NaN for a line without any)."""
+    v = _powers(_increments(z, lag, 1, axis), p)
+    nan = np.isnan(v)
+    if not nan.any():
+        return v.mean(axis=axis) / 2.0
+    cnt = np.count_nonzero(~nan, axis=axis)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(cnt > 0, np.where(nan, 0.0, v).sum(axis=axis) / np.maximum(cnt, 1), np.nan) / 2.0
 
 
 def power_variation(
@@ -230,13 +260,16 @@ def surface_variation(
                      scale_range=scale_range, min_scales=2, x_label="dilation u (pixels)",
                      y_label=f"V_{p:g}(u)", extra={"p": p, "estimator": estimator})
     if estimator == "transect":
-        dims = []
-        for line in list(z) + list(z.T):
-            m = np.array([_mean_power(_increments(line, int(u), 1, 0), p) for u in fit.scales[fit.used].astype(int)])
-            if np.all(m > 0) and np.isfinite(m).all():
-                x = np.log(fit.scales[fit.used])
-                slope = np.polyfit(x, np.log(m), 1)[0]
-                dims.append(2.0 - slope / p)
+        used = fit.scales[fit.used].astype(int)
+        # (lines, lags) table of V_p per row, then per column; least-squares
+        # slope of every line at once (the same as np.polyfit per line)
+        m = np.concatenate([np.stack([_line_means(z, int(u), p, a) for u in used], axis=1) for a in (1, 0)])
+        ok = np.all(m > 0, axis=1) & np.isfinite(m).all(axis=1)
+        x = np.log(used.astype(np.float64))
+        xc = x - x.mean()
+        y = np.log(m[ok])
+        slope = (y - y.mean(axis=1, keepdims=True)) @ xc / np.dot(xc, xc)
+        dims = list(2.0 - slope / p)
         if not dims:
             raise ValueError("data: no row or column with valid increments")
         med = float(np.median(dims)) + 1.0

@@ -3,12 +3,15 @@ from __future__ import annotations
 
 import functools
 import math
+import numbers
+import os
 
 import numpy as np
 import scipy.fft as sfft
 
 from fractalgeo_rs import _core
 from fractalgeo_rs._validation import check_choice, check_n_threads, check_positive_int
+from fractalgeo_rs.synth import _additions
 from fractalgeo_rs.synth import _common as c
 
 __all__ = ["fbm", "fbm_surface"]
@@ -47,7 +50,7 @@ def fbm(n, hurst, *, method="exact", seed=None, sigma=1.0, n_threads=None):
         Hurst exponent ``H`` in (0, 1).
     method : {"exact", "midpoint", "additions", "spectral"}
         * ``"exact"``: circulant embedding of fGn (Davies & Harte 1987), exact
-          covariance, ``O(n log n)``;
+          covariance, ``O(n log n)``, real FFTs in Rust;
         * ``"midpoint"``: random midpoint displacement with the variance
           schedule of eq. 20, :math:`\sigma_n^2 = \sigma_{n-1}^2 / 2^{2H}`
           (Peitgen & Saupe 1988), started from 9 exact samples; neighbour
@@ -115,13 +118,9 @@ def fgn_autocovariance(k, hurst):
 
 @functools.lru_cache(maxsize=16)
 def _davies_harte_sqrt_eig(m: int, hurst: float) -> np.ndarray:
-    g = fgn_autocovariance(np.arange(m + 1), hurst)
-    row = np.concatenate([g, g[-2:0:-1]])  # circulant first row, length 2m
-    lam = sfft.rfft(row).real
-    if lam.min() < -1e-10 * lam.max():  # pragma: no cover - fGn embeds for all H (Craigmile 2003)
-        raise RuntimeError("Davies-Harte embedding is not non-negative definite")
-    lam = np.clip(lam, 0.0, None)
-    out = np.sqrt(lam / (2 * m))
+    """sqrt(lambda_k / 2m), k = 0 .. m, of the circulant embedding of unit fGn
+    (Rust real FFT of the symmetric circulant row); cached read-only."""
+    out = _core.fgn_sqrt_eigenvalues(m, hurst)
     out.setflags(write=False)
     return out
 
@@ -129,25 +128,13 @@ def _davies_harte_sqrt_eig(m: int, hurst: float) -> np.ndarray:
 def _fbm_exact(n, h, seed, n_threads):
     # Davies & Harte (1987) in the form of Wood & Chan (1994): a Hermitian
     # random vector W with E|W_k|^2 = lambda_k / (2m) (lambda: eigenvalues of
-    # the circulant of size 2m holding the fGn autocovariance), whose FFT is
-    # real with exactly the fGn covariance on its first m entries.
+    # the circulant of size 2m holding the fGn autocovariance), whose inverse
+    # real FFT has exactly the fGn covariance on its first m entries. Noise,
+    # FFT and cumulative sum run in Rust (rust/synth/davies_harte.rs).
     m = sfft.next_fast_len(n - 1, real=True)
     m += m % 2
-    s = _davies_harte_sqrt_eig(m, h)  # sqrt(lambda_k / (2m)), k = 0 .. m
-    z = _noise(2 * m, seed, c.STREAM_EXACT_1D, n_threads)
-    w = np.empty(m + 1, dtype=np.complex128)
-    w.real[0], w.imag[0] = z[0], 0.0
-    w.real[m], w.imag[m] = z[1], 0.0
-    w.real[1:m] = z[2 : m + 1]
-    w.imag[1:m] = z[m + 1 : 2 * m]
-    w[1:m] *= math.sqrt(0.5)
-    w *= s
-    inc = sfft.irfft(w, 2 * m, workers=_workers(n_threads))[: n - 1]
-    inc *= 2 * m  # irfft divides by the length
-    x = np.empty(n)
-    x[0] = 0.0
-    np.cumsum(inc, out=x[1:])
-    return x
+    s = _davies_harte_sqrt_eig(m, h)
+    return _core.davies_harte_fbm(s, n, seed, c.STREAM_EXACT_1D, n_threads)
 
 
 def _spectral_lag1_variance_1d(amp2: np.ndarray, n: int) -> float:
@@ -209,7 +196,7 @@ def _fbm_midpoint(n, h, seed, additions, n_threads):
 # --------------------------------------------------------------------- 2D
 
 def fbm_surface(shape, hurst, *, method="exact", seed=None, cell_size=1.0, sigma=1.0,
-                periodic=False, n_threads=None):
+                periodic=False, n_threads=None, max_memory=None):
     r"""Fractional Brownian surface (isotropic fBm on a grid).
 
     The target statistics are those of 2D fBm,
@@ -250,8 +237,14 @@ def fbm_surface(shape, hurst, *, method="exact", seed=None, cell_size=1.0, sigma
           ``MidPointFM2D``) from an exact coarse grid, variance schedule of
           eq. 20 per level; existing samples are kept (the kernel is
           ``_core.midpoint_refine_2d``, reused for fractal resampling).
-        * ``"additions"``: the same with Voss's random additions to all
-          samples at each half step, which removes most creases.
+        * ``"additions"``: Voss's successive random additions in
+          diamond-square order with 4-point interpolating rules (tension
+          rising with ``H``): cell centres and edge points get displacements,
+          old samples and centres additions, with variances derived so that
+          second differences have the same variance at every kind of
+          position (no creases: crease ratio 1.03-1.07 at 1024²) and the
+          lag-one variance is that of fBm (docs/synthesis.md; Dyn, Levin &
+          Gregory 1987 for the 4-point rule).
     seed : int or None
         Seed in ``[0, 2**64)``; the same field for any ``n_threads``.
     cell_size : float
@@ -265,6 +258,12 @@ def fbm_surface(shape, hurst, *, method="exact", seed=None, cell_size=1.0, sigma
         the shape is ``(2**k, 2**k)``; ``"exact"`` fBm cannot be periodic.
     n_threads : int or None
         Threads for the Rust kernels and the FFTs; ``None`` = all cores.
+    max_memory : int or None
+        Limit in bytes for the working memory of ``"exact"``, estimated
+        before anything is allocated as 48 bytes per cell of the embedding
+        torus (see ``exact_memory_bytes``); above it a ``ValueError`` naming
+        ``shape`` is raised. ``None``: half the physical memory (4 GiB when
+        it cannot be read). Ignored by the other methods.
 
     Returns
     -------
@@ -302,6 +301,7 @@ def fbm_surface(shape, hurst, *, method="exact", seed=None, cell_size=1.0, sigma
         if periodic:
             raise ValueError('periodic: fBm is not periodic; "exact" cannot give periodic output '
                              '(use method="spectral")')
+        _check_exact_memory(rows, cols, h, max_memory)
         z = _surface_exact(rows, cols, h, seed, n_threads)
     elif method == "spectral":
         z = _surface_spectral(rows, cols, h, seed, bool(periodic), n_threads)
@@ -317,8 +317,7 @@ def _surface_midpoint(rows, cols, h, seed, additions, periodic, n_threads):
         if rows != cols or 2**k != rows:
             raise ValueError(f"periodic: the midpoint methods give periodic output for shapes (2**k, 2**k) "
                              f"only, got {(rows, cols)}")
-        coarse = np.zeros((1, 1))
-        return _core.midpoint_refine_2d(coarse, k, h, 1.0, float(rows), additions, True, seed, 0, n_threads)
+        return _refine(np.zeros((1, 1)), k, h, float(rows), additions, True, seed, n_threads)
     levels = _levels_for(max(rows, cols) - 1)
     step = 2**levels
     nr = max(-(-(rows - 1) // step) + 1, 2)
@@ -326,8 +325,16 @@ def _surface_midpoint(rows, cols, h, seed, additions, periodic, n_threads):
     ii, jj = np.meshgrid(np.arange(nr), np.arange(nc), indexing="ij")
     pos = np.column_stack([ii.ravel(), jj.ravel()]).astype(np.float64) * step
     coarse = _exact_coarse(pos, h, seed, c.STREAM_COARSE_2D, n_threads).reshape(nr, nc)
-    z = _core.midpoint_refine_2d(coarse, levels, h, 1.0, float(step), additions, False, seed, 0, n_threads)
+    z = _refine(coarse, levels, h, float(step), additions, False, seed, n_threads)
     return np.ascontiguousarray(z[:rows, :cols])
+
+
+def _refine(coarse, levels, h, spacing, additions, periodic, seed, n_threads):
+    if additions:
+        w, var = _additions.schedule(h)
+        return _core.additions_refine_2d(coarse, levels, h, 1.0, spacing, w, list(var), periodic, seed, 0,
+                                         n_threads)
+    return _core.midpoint_refine_2d(coarse, levels, h, 1.0, spacing, False, periodic, seed, 0, n_threads)
 
 
 @functools.lru_cache(maxsize=2)
@@ -418,14 +425,58 @@ def _stein_rho(dist, alpha, r_max, beta, c2, c0):
     return out
 
 
-def _surface_exact(rows, cols, h, seed, n_threads):
-    alpha = 2.0 * h
-    r_max, beta, c2, c0 = _stein_rho_params(alpha)
-    diag = math.hypot(rows - 1, cols - 1)
-    unit = 1.0 / diag  # grid step in Stein's units: the grid's diagonal is 1
+def _stein_torus(rows, cols, h):
+    """Sides (n0, n1) of Stein's embedding torus and the grid step in his units."""
+    r_max = _stein_rho_params(2.0 * h)[0]
+    unit = 1.0 / math.hypot(rows - 1, cols - 1)  # grid step: the grid's diagonal is 1
     # Torus sides: the image of a lag inside the grid must stay >= R away.
     n0 = sfft.next_fast_len(max(rows, int(math.ceil(r_max / unit)) + rows))
     n1 = sfft.next_fast_len(max(cols, int(math.ceil(r_max / unit)) + cols))
+    return n0, n1, unit
+
+
+#: Bytes per torus cell at the peak of ``_surface_exact``: the complex
+#: spectrum (16), the noise pairs (16) and the eigenvalue amplitudes (8), plus
+#: 8 for the float64 temporaries of the covariance and the FFT output.
+EXACT_BYTES_PER_CELL = 48
+
+
+def exact_memory_bytes(rows, cols, hurst):
+    """Estimated peak working memory (bytes) of ``fbm_surface(..., method="exact")``."""
+    n0, n1, _ = _stein_torus(rows, cols, hurst)
+    return EXACT_BYTES_PER_CELL * n0 * n1
+
+
+def _default_max_memory():
+    try:
+        return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE") // 2
+    except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
+        return 4 * 2**30
+
+
+def _check_exact_memory(rows, cols, h, max_memory):
+    if max_memory is None:
+        limit = _default_max_memory()
+    else:
+        if isinstance(max_memory, bool) or not isinstance(max_memory, numbers.Real):
+            raise TypeError(f"max_memory: expected a number of bytes or None, got {max_memory!r}")
+        if not (max_memory > 0 and math.isfinite(max_memory)):
+            raise ValueError(f"max_memory: expected a positive number of bytes, got {max_memory}")
+        limit = max_memory
+    need = exact_memory_bytes(rows, cols, h)
+    if need > limit:
+        n0, n1, _ = _stein_torus(rows, cols, h)
+        raise ValueError(
+            f"shape: method=\"exact\" for {(rows, cols)} at hurst={h} embeds the grid in a "
+            f"{n0} x {n1} torus and needs about {need / 2**30:.1f} GiB, above max_memory = "
+            f"{limit / 2**30:.1f} GiB; use method=\"spectral\" (or \"additions\") for large grids, "
+            f"or raise max_memory")
+
+
+def _surface_exact(rows, cols, h, seed, n_threads):
+    alpha = 2.0 * h
+    r_max, beta, c2, c0 = _stein_rho_params(alpha)
+    n0, n1, unit = _stein_torus(rows, cols, h)
     l0 = np.arange(n0, dtype=np.float64)
     l1 = np.arange(n1, dtype=np.float64)
     # Periodised covariance: sum over the images that can be within R.
