@@ -11,7 +11,16 @@ Scene: the bundled Sentinel-1 VV scene (512 x 512, dB) mirrored into a
 - numpy SAT: the same summed-area-table algorithm as ours, vectorised in
   numpy over the whole image (the best plain-numpy version we could write).
 
-Run: ``python benches/bench_transform.py [--size 4096]``.
+DBC and covering-blanket maps (window 33, default options, 1 dB per pixel)
+against the best plain-numpy versions we could write: for each output row,
+``view_as_windows`` of the row's band gives all of its windows at once; DBC
+reduces blocks by reshape (nanmin/nanmax), the blanket grows all windows of
+the row together (shifted maxima on a (cols, w + 2, w + 2) stack). Both are
+timed on a few rows and extrapolated (printed so), after checking that they
+give our values on those rows. The blanket map itself costs O(w^2 e_max) per
+pixel: ours is timed on a strip of rows of the scene and extrapolated too.
+
+Run: ``python benches/bench_transform.py [--size 4096] [--methods dbc,blanket]``.
 """
 from __future__ import annotations
 
@@ -19,6 +28,7 @@ import argparse
 import os
 import platform
 import time
+import warnings
 
 import numpy as np
 
@@ -121,6 +131,109 @@ def numpy_mass_windows_rows(z: np.ndarray, w: int, rows: int) -> float:
     return time.perf_counter() - t0
 
 
+def numpy_dbc_rows(z: np.ndarray, w: int, rows, sizes=(2, 4, 8, 16), z_unit=1.0) -> np.ndarray:
+    """DBC map rows (partial blocks dropped, z0 = 0) vectorised over the
+    windows of each row (view_as_windows)."""
+    try:
+        from skimage.util import view_as_windows
+    except ImportError:  # the same view
+        from numpy.lib.stride_tricks import sliding_window_view as view_as_windows
+
+    h = w // 2
+    zp = np.pad(z.astype(np.float64), h, constant_values=np.nan)
+    x = np.log(np.asarray(sizes, dtype=float))
+    out = []
+    for i in rows:
+        win = view_as_windows(zp[i:i + w], (w, w))[0]  # (cols, w, w)
+        y = []
+        for s in sizes:
+            nf = w // s
+            blk = win[:, :nf * s, :nf * s].reshape(-1, nf, s, nf, s)
+            with warnings.catch_warnings():  # all-NaN blocks outside the image
+                warnings.simplefilter("ignore", RuntimeWarning)
+                hi = np.nanmax(blk, axis=(2, 4))
+                lo = np.nanmin(blk, axis=(2, 4))
+            n = np.floor(hi / (s * z_unit)) - np.floor(lo / (s * z_unit)) + 1
+            y.append(np.log(np.nansum(n, axis=(1, 2))))
+        y = np.array(y)
+        out.append(-((x - x.mean())[:, None] * (y - y.mean(0))).sum(0) / ((x - x.mean()) ** 2).sum())
+    return np.array(out)
+
+
+def numpy_blanket_rows(z: np.ndarray, w: int, rows, eps=(1, 2, 3, 4)) -> np.ndarray:
+    """Blanket map rows: the blankets of all windows of a row grown together
+    (missing samples and the window frame are -inf / +inf)."""
+    try:
+        from skimage.util import view_as_windows
+    except ImportError:  # the same view
+        from numpy.lib.stride_tricks import sliding_window_view as view_as_windows
+
+    h = w // 2
+    zp = np.pad(z.astype(np.float64), h, constant_values=np.nan)
+    x = np.log(np.asarray(eps, dtype=float))
+    out = []
+    for i in rows:
+        win = view_as_windows(zp[i:i + w], (w, w))[0]
+        ok = np.pad(~np.isnan(win), ((0, 0), (1, 1), (1, 1)))
+        u = np.pad(np.where(np.isnan(win), -np.inf, win), ((0, 0), (1, 1), (1, 1)), constant_values=-np.inf)
+        b = np.pad(np.where(np.isnan(win), np.inf, win), ((0, 0), (1, 1), (1, 1)), constant_values=np.inf)
+        areas = []
+        for e in range(1, max(eps) + 1):
+            nu = u + 1
+            nb = b - 1
+            for sl in ((slice(None), slice(0, -2), slice(1, -1)), (slice(None), slice(2, None), slice(1, -1)),
+                       (slice(None), slice(1, -1), slice(0, -2)), (slice(None), slice(1, -1), slice(2, None))):
+                np.maximum(nu[:, 1:-1, 1:-1], u[sl], out=nu[:, 1:-1, 1:-1])
+                np.minimum(nb[:, 1:-1, 1:-1], b[sl], out=nb[:, 1:-1, 1:-1])
+            u = np.where(ok, nu, -np.inf)
+            b = np.where(ok, nb, np.inf)
+            if e in eps:
+                areas.append(np.where(ok, u - b, 0.0).sum(axis=(1, 2)) / (2 * e))
+        y = np.log(np.array(areas))
+        out.append(2.0 - ((x - x.mean())[:, None] * (y - y.mean(0))).sum(0) / ((x - x.mean()) ** 2).sum())
+    return np.array(out)
+
+
+def time_rows(fn, z, w, rows):
+    t0 = time.perf_counter()
+    fn(z, w, rows)
+    return time.perf_counter() - t0
+
+
+def new_methods(z: np.ndarray) -> None:
+    """DBC and blanket maps: ours against numpy, and window 17 vs 65."""
+    n = z.shape[0]
+    # numpy versions agree with ours on sample rows (edge and interior)
+    for m, fn in (("dbc", numpy_dbc_rows), ("blanket", numpy_blanket_rows)):
+        sub = z[:64, :256]
+        ours = fg.fractal_transform(sub, 33, method=m, min_valid=0.0)
+        rows = [0, 20, 40]
+        assert np.allclose(fn(sub, 33, rows), ours[rows], atol=1e-4, equal_nan=True), f"numpy {m} disagrees"
+    t = {}
+    for w in (17, 33, 65):
+        t[("dbc", w)] = best(lambda: fg.fractal_transform(z, w, method="dbc"), 2)
+        print(f"ours dbc        w={w:2d}: {t[('dbc', w)]:.3f} s", flush=True)
+    for w in (9, 65):
+        t[("dbc248", w)] = best(lambda: fg.fractal_transform(z, w, method="dbc", box_sizes=(2, 4, 8)), 2)
+        print(f"ours dbc, sizes 2, 4, 8 only, w={w:2d}: {t[('dbc248', w)]:.3f} s", flush=True)
+    for w, strip in ((17, 512), (33, 256), (65, 128)):
+        ts = best(lambda: fg.fractal_transform(z[:strip], w, method="blanket"), 1)
+        t[("blanket", w)] = ts * n / strip
+        print(f"ours blanket    w={w:2d}: {t[('blanket', w)]:.1f} s extrapolated from {strip} rows "
+              f"({ts:.2f} s)", flush=True)
+    nrows = 8
+    t_dbc = time_rows(numpy_dbc_rows, z, 33, range(100, 100 + nrows)) * n / nrows
+    print(f"numpy DBC (view_as_windows, per row), w=33: {t_dbc:.1f} s extrapolated from {nrows} rows "
+          f"({t_dbc / t[('dbc', 33)]:.0f} x ours)")
+    nrows = 4
+    t_bl = time_rows(numpy_blanket_rows, z, 33, range(100, 100 + nrows)) * n / nrows
+    print(f"numpy blanket (view_as_windows, per row), w=33: {t_bl:.1f} s extrapolated from {nrows} rows "
+          f"({t_bl / t[('blanket', 33)]:.1f} x ours)")
+    print(f"window 65 / window 17 time (dbc):       {t[('dbc', 65)] / t[('dbc', 17)]:.2f}")
+    print(f"window 65 / window 9 time (dbc, sizes 2, 4, 8 at both): {t[('dbc248', 65)] / t[('dbc248', 9)]:.2f}")
+    print(f"window 65 / window 17 time (blanket):   {t[('blanket', 65)] / t[('blanket', 17)]:.2f}")
+
+
 def best(fn, repeat=3):
     out = []
     for _ in range(repeat):
@@ -133,11 +246,18 @@ def best(fn, repeat=3):
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--size", type=int, default=4096)
+    ap.add_argument("--methods", default="increments,mass,dbc,blanket",
+                    help="comma-separated groups: increments and mass (the first four maps), dbc,blanket")
     args = ap.parse_args()
     n = args.size
     z = mosaic(n)
     print(f"machine: {platform.machine()}, {os.cpu_count()} cores; scene {n} x {n} float32 "
           "(Sentinel-1 VV dB, mirrored tiles)")
+    groups = set(args.methods.split(","))
+    if groups & {"dbc", "blanket"}:
+        new_methods(z)
+    if not groups & {"increments", "mass"}:
+        return
     ref = fg.fractal_transform(z[:512, :512], 33, method="variogram", min_valid=0.0)
     assert np.allclose(ref, numpy_sat(z[:512, :512], 33), atol=1e-4, equal_nan=True), "numpy SAT disagrees"
     times = {}

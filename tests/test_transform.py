@@ -94,7 +94,18 @@ def test_plane_is_two_in_the_interior_and_rough_is_higher():
         (dict(window_size=8), ValueError, "window_size"),
         (dict(window_size=1), ValueError, "window_size"),
         (dict(window_size=201), ValueError, "window_size"),
-        (dict(window_size=9, method="dbc"), ValueError, "method"),
+        (dict(window_size=9, method="fractal"), ValueError, "method"),
+        (dict(window_size=9, method="dbc", box_sizes=[2, 4]), ValueError, "box_sizes"),
+        (dict(window_size=9, method="dbc", box_sizes=[2, 4, 10]), ValueError, "box_sizes"),
+        (dict(window_size=9, method="dbc", box_sizes=[0, 2, 4]), ValueError, "box_sizes"),
+        (dict(window_size=9, method="dbc", box_sizes=[2.5, 3, 4]), TypeError, "box_sizes"),
+        (dict(window_size=9, method="dbc", z_scale=-1.0), ValueError, "z_scale"),
+        (dict(window_size=9, method="blanket", epsilons=[1, 2]), ValueError, "epsilons"),
+        (dict(window_size=9, method="blanket", epsilons=[0, 1, 2]), ValueError, "epsilons"),
+        (dict(window_size=9, method="blanket", z_scale=float("nan")), ValueError, "z_scale"),
+        (dict(window_size=9, method="dbc", step=0), ValueError, "step"),
+        (dict(window_size=9, step=1.5), TypeError, "step"),
+        (dict(window_size=9, method="dbc", edge_blocks="keep"), ValueError, "edge_blocks"),
         (dict(window_size=9, box_sizes=[3, 4]), ValueError, "box_sizes"),
         (dict(window_size=9, box_sizes=[3, 11]), ValueError, "box_sizes"),
         (dict(window_size=9, z_scale=0), ValueError, "z_scale"),
@@ -253,3 +264,202 @@ def test_lacunarity_map_equals_per_window_lacunarity():
         fg.lacunarity_map(z - 5, 9)
     with pytest.raises(ValueError, match="box_sizes"):
         fg.lacunarity_map(z, 9, [10])
+
+
+# ---- DBC and covering-blanket maps ----------------------------------------
+
+
+def windows(z, w):
+    """Every w x w window of the NaN-padded image (skimage's view_as_windows;
+    numpy's sliding_window_view, the same view, where skimage is missing:
+    it is not a test dependency)."""
+    try:
+        from skimage.util import view_as_windows
+    except ImportError:
+        from numpy.lib.stride_tricks import sliding_window_view as view_as_windows
+
+    zp = np.pad(np.asarray(z, dtype=float), w // 2, constant_values=np.nan)
+    return view_as_windows(zp, (w, w))
+
+
+def per_window_estimator(z, w, estimator, min_valid=0.5, step=1, **kw):
+    win = windows(z, w)
+    out = np.full(z.shape, np.nan)[::step, ::step]
+    for a, i in enumerate(range(0, z.shape[0], step)):
+        for b, j in enumerate(range(0, z.shape[1], step)):
+            x = win[i, j]
+            if np.count_nonzero(~np.isnan(x)) >= min_valid * w * w:
+                out[a, b] = estimator(x, **kw).dimension
+    return out
+
+
+def numpy_dbc_counts(z, sizes, z0, z_unit, drop=False):
+    """DBC counts from the definition: s x s blocks from the top-left
+    corner, partial blocks at the right and bottom (or none: drop), NaN
+    skipped."""
+    out = []
+    for s in sizes:
+        h = s * z_unit
+        n = 0.0
+        for r in range(0, z.shape[0], s):
+            for c in range(0, z.shape[1], s):
+                blk = z[r:r + s, c:c + s]
+                if drop and blk.shape != (s, s):
+                    continue
+                blk = blk[~np.isnan(blk)]
+                if blk.size:
+                    n += np.floor((blk.max() - z0) / h) - np.floor((blk.min() - z0) / h) + 1
+        out.append(n)
+    return out
+
+
+def numpy_blanket_areas_nan(z, eps_max, z_scale=1.0):
+    """Peleg blanket from the definition with missing samples: NaN pixels
+    hold no blanket (-inf / +inf) and the plane is framed by missing pixels."""
+    ok = ~np.isnan(z)
+    u = np.pad(np.where(ok, z / z_scale, -np.inf), 1, constant_values=-np.inf)
+    b = np.pad(np.where(ok, z / z_scale, np.inf), 1, constant_values=np.inf)
+    okp = np.pad(ok, 1)
+    out = []
+    for e in range(1, eps_max + 1):
+        nu = np.max([u + 1, np.roll(u, 1, 0), np.roll(u, -1, 0), np.roll(u, 1, 1), np.roll(u, -1, 1)], axis=0)
+        nb = np.min([b - 1, np.roll(b, 1, 0), np.roll(b, -1, 0), np.roll(b, 1, 1), np.roll(b, -1, 1)], axis=0)
+        u = np.where(okp, nu, -np.inf)
+        b = np.where(okp, nb, np.inf)
+        out.append(float(np.sum((u - b)[okp])) / (2 * e))
+    return out
+
+
+def holed(shape, seed, scale=10.0):
+    rng = np.random.default_rng(seed)
+    z = spectral_surface(64, 0.5, seed)[: shape[0], : shape[1]] * scale
+    z[rng.random(z.shape) < 0.08] = np.nan
+    z[5:12, 3:9] = np.nan
+    return z
+
+
+def test_dbc_estimator_z0_equals_numpy_counts():
+    z = holed((40, 29), 3)
+    for z0, zs in [(0.0, 0.5), (-3.0, 1.7)]:
+        fit = fg.differential_box_counting(z, box_sizes=[2, 3, 5, 8], z_scale=zs, z0=z0)
+        assert fit.measures.tolist() == numpy_dbc_counts(z, [2, 3, 5, 8], z0, zs)
+        fit = fg.differential_box_counting(z, box_sizes=[2, 3, 5, 8], z_scale=zs, z0=z0, edge_blocks="drop")
+        assert fit.measures.tolist() == numpy_dbc_counts(z, [2, 3, 5, 8], z0, zs, drop=True)
+    with pytest.raises(ValueError, match="edge_blocks"):
+        fg.differential_box_counting(z, box_sizes=[2, 3, 5], edge_blocks="drop", offsets=2)
+    with pytest.raises(ValueError, match="z0"):
+        fg.differential_box_counting(z, z0=float("nan"))
+
+
+@pytest.mark.parametrize("w, sizes, zs, edge", [(7, [2, 3, 4], 0.5, "count"), (9, [1, 2, 4, 9], 2.0, "drop"),
+                                                 (11, [2, 3, 5], 1.0, "drop"), (11, [2, 3, 5], 1.0, "count")])
+def test_dbc_map_equals_per_window_estimator_with_holes(w, sizes, zs, edge):
+    z = holed((40, 29), 1)
+    d, r2 = fg.fractal_transform(z, w, method="dbc", box_sizes=sizes, z_scale=zs, edge_blocks=edge, return_fit=True)
+    kw = dict(box_sizes=sizes, z_scale=zs, z0=0.0, edge_blocks=edge)
+    ref = per_window_estimator(z, w, fg.differential_box_counting, **kw)
+    assert np.array_equal(np.isnan(d), np.isnan(ref))
+    assert np.allclose(d, ref, atol=1e-5, equal_nan=True)
+    ref_r2 = per_window_estimator(
+        z, w, lambda x, **k: type("F", (), {"dimension": fg.differential_box_counting(x, **k).r_squared})(), **kw)
+    assert np.allclose(r2, ref_r2, atol=1e-5, equal_nan=True)
+    # the counts themselves: one window against the numpy definition
+    win = windows(z, w)[20, 14]
+    fit = fg.differential_box_counting(win, **kw)
+    assert fit.measures.tolist() == numpy_dbc_counts(win, sizes, 0.0, zs, drop=edge == "drop")
+
+
+def test_dbc_map_random_image_step_and_nodata():
+    rng = np.random.default_rng(7)
+    z = rng.integers(0, 40, size=(37, 45)).astype(np.float32)
+    z[10:14, 20:30] = -9999
+    d = fg.fractal_transform(z, 13, method="dbc", nodata=-9999, step=3, z_scale=1.0)
+    zn = np.where(z == -9999, np.nan, z.astype(float))
+    ref = per_window_estimator(zn, 13, fg.differential_box_counting, step=3, box_sizes=[2, 3, 4], z_scale=1.0, z0=0.0,
+                               edge_blocks="drop")
+    assert d.shape == (13, 15)
+    assert np.allclose(d, ref, atol=1e-5, equal_nan=True) and np.isfinite(d).sum() > 100
+
+
+def test_dbc_map_real_sar_window():
+    vv, _ = fg.data.sentinel1_vv_db()
+    z = vv[100:160, 200:250]
+    d = fg.fractal_transform(z, 17, method="dbc")  # sizes 2, 4, 8; 1 dB per pixel
+    ref = per_window_estimator(z, 17, fg.differential_box_counting, box_sizes=[2, 4, 8], z_scale=1.0, z0=0.0,
+                               edge_blocks="drop")
+    assert np.allclose(d, ref, atol=1e-5, equal_nan=True)
+    assert np.isfinite(d[8:-8, 8:-8]).all()
+
+
+@pytest.mark.parametrize("w, eps, zs", [(7, [1, 2, 3], 1.0), (9, [1, 2, 4], 0.3)])
+def test_blanket_map_equals_per_window_estimator_with_holes(w, eps, zs):
+    z = holed((30, 23), 2, scale=4.0)
+    d, r2 = fg.fractal_transform(z, w, method="blanket", epsilons=eps, z_scale=zs, return_fit=True)
+    ref = per_window_estimator(z, w, fg.blanket, epsilons=eps, z_scale=zs)
+    assert np.array_equal(np.isnan(d), np.isnan(ref))
+    assert np.allclose(d, ref, atol=1e-5, equal_nan=True)
+    # the areas of one edge window and one holed window: numpy definition
+    for i, j in [(0, 3), (8, 6), (15, 11)]:
+        win = windows(z, w)[i, j]
+        fit = fg.blanket(win, epsilons=range(1, max(eps) + 1), z_scale=zs)
+        assert fit.measures.tolist() == pytest.approx(numpy_blanket_areas_nan(win, max(eps), zs), rel=1e-12)
+
+
+def test_blanket_map_real_sar_window_and_step():
+    vv, _ = fg.data.sentinel1_vv_db()
+    z = vv[100:150, 200:240]
+    d = fg.fractal_transform(z, 11, method="blanket", step=2)
+    ref = per_window_estimator(z, 11, fg.blanket, step=2, epsilons=[1, 2, 3, 4])
+    assert d.shape == (25, 20)
+    assert np.allclose(d, ref, atol=1e-5, equal_nan=True)
+
+
+def test_blanket_estimator_equals_numpy_with_holes():
+    rng = np.random.default_rng(5)
+    for shape in [(300, 41), (33, 290)]:  # several of the kernel's 128-row bands
+        z = np.round(rng.normal(0, 3, size=shape).cumsum(axis=1))
+        z[rng.random(shape) < 0.05] = np.nan
+        z[20:30, 10:25] = np.nan
+        for zs in (1.0, 2.5):
+            fit = fg.blanket(z, epsilons=range(1, 11), z_scale=zs)
+            assert fit.measures.tolist() == pytest.approx(numpy_blanket_areas_nan(z, 10, zs), rel=1e-12)
+            assert fit.extra["n_valid"] == np.count_nonzero(~np.isnan(z))
+        assert fg.blanket(z, n_threads=1).measures.tolist() == fg.blanket(z, n_threads=3).measures.tolist()
+
+
+@pytest.mark.parametrize("method", ["dbc", "blanket"])
+def test_new_methods_threads_dask_xarray(method):
+    z = spectral_surface(128, 0.6, 4)[:100, :90] * 20
+    z[40:44, 10:70] = np.nan
+    z32 = z.astype(np.float32)
+    before = z32.copy()
+    ref = fg.fractal_transform(z32, 11, method=method, n_threads=1, return_fit=True)
+    for t in (2, 3):
+        out = fg.fractal_transform(z32, 11, method=method, n_threads=t, return_fit=True)
+        assert all(np.array_equal(a, b, equal_nan=True) for a, b in zip(out, ref))
+    assert np.array_equal(z32, before, equal_nan=True)
+    assert ref[0].dtype == np.float32 and ref[0].shape == z.shape
+    da = pytest.importorskip("dask.array")
+    for chunks in [(50, 45), (33, 90), (100, 20), (4, 4)]:
+        for step in (1, 3):
+            out = fg.fractal_transform(da.from_array(z32, chunks=chunks), 11, method=method, step=step,
+                                       return_fit=True)
+            for a, b in zip(out, ref):
+                a = a.compute()
+                assert a.shape == b[::step, ::step].shape
+                assert np.allclose(a, b[::step, ::step], atol=1e-6, equal_nan=True), (chunks, step)
+    xr = pytest.importorskip("xarray")
+    arr = xr.DataArray(z32, dims=("y", "x"), coords={"y": np.arange(100) * -10.0, "x": np.arange(90) * 10.0},
+                       attrs={"crs": "EPSG:32633"})
+    out = fg.fractal_transform(arr, 11, method=method, step=2)
+    assert out.attrs["crs"] == "EPSG:32633" and np.array_equal(out["x"].values, arr["x"].values[::2])
+    assert np.allclose(out.values, ref[0][::2, ::2], equal_nan=True)
+
+
+def test_new_methods_plane_and_roughness():
+    i, j = np.indices((80, 80))
+    plane = 0.5 * i + 0.25 * j
+    assert np.allclose(fg.fractal_transform(plane, 9, method="blanket")[4:-4, 4:-4], 2.0, atol=1e-5)
+    rough = fg.fractal_transform(spectral_surface(128, 0.2, 1) * 30, 17, method="dbc")
+    smooth = fg.fractal_transform(spectral_surface(128, 0.8, 1) * 30, 17, method="dbc")
+    assert np.nanmean(rough) > np.nanmean(smooth) + 0.1

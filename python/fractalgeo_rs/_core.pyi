@@ -13,11 +13,14 @@ __all__ = [
     "ModuleString",
     "__version__",
     "additions_refine_2d",
+    "blanket_areas_image",
+    "blanket_transform_map",
     "box_count_binary",
     "box_count_points",
     "column_ranges",
     "davies_harte_fbm",
     "dbc_count",
+    "dbc_transform_map",
     "fgn_sqrt_eigenvalues",
     "higuchi_lengths",
     "hillshade_f64",
@@ -253,6 +256,32 @@ def mass_transform_map(
     min_valid: float,
     n_threads: Optional[int] = None,
 ) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
+def dbc_transform_map(
+    image: npt.NDArray[np.float64],
+    window_size: int,
+    box_sizes: Sequence[int],
+    z_scale: float,
+    z0: float,
+    partial_blocks: bool,
+    min_valid: float,
+    step: int,
+    n_threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
+def blanket_transform_map(
+    image: npt.NDArray[np.float64],
+    window_size: int,
+    epsilons: Sequence[int],
+    z_scale: float,
+    min_valid: float,
+    step: int,
+    n_threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
+def blanket_areas_image(
+    image: npt.NDArray[np.float64],
+    eps_max: int,
+    z_scale: float,
+    n_threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.float64], int]: ...
 def lacunarity_transform_map(
     image: npt.NDArray[np.float64],
     window_size: int,

@@ -1,5 +1,7 @@
 //! Bindings of `crate::transform`.
 use crate::parallel::run_in_pool;
+use crate::transform::blanket::{blanket_areas, blanket_transform, BlanketMapOptions};
+use crate::transform::dbc::{dbc_transform, DbcMapOptions, LocalMap};
 use crate::transform::lacunarity::lacunarity_transform;
 use crate::transform::mass::{mass_curve, mass_transform, MassOptions};
 use crate::transform::variation::{variation_transform, Increments, VariationOptions};
@@ -88,6 +90,104 @@ fn mass_transform_map<'py>(
     ))
 }
 
+type MapPair<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>);
+
+fn local_map_arrays(py: Python<'_>, m: LocalMap) -> PyResult<MapPair<'_>> {
+    let bad = |_| PyValueError::new_err("internal: map size");
+    Ok((
+        Array2::from_shape_vec((m.rows, m.cols), m.dim)
+            .map_err(bad)?
+            .into_pyarray(py),
+        Array2::from_shape_vec((m.rows, m.cols), m.r2)
+            .map_err(bad)?
+            .into_pyarray(py),
+    ))
+}
+
+/// Moving-window differential box counting on the grid of every `step`-th
+/// pixel. Returns (dimension, r_squared) float32 maps.
+#[pyfunction]
+#[pyo3(signature = (image, window_size, box_sizes, z_scale, z0, partial_blocks, min_valid, step, n_threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn dbc_transform_map<'py>(
+    py: Python<'py>,
+    image: PyReadonlyArray2<'py, f64>,
+    window_size: usize,
+    box_sizes: Vec<usize>,
+    z_scale: f64,
+    z0: f64,
+    partial_blocks: bool,
+    min_valid: f64,
+    step: usize,
+    n_threads: Option<usize>,
+) -> PyResult<MapPair<'py>> {
+    let (rows, cols) = (image.shape()[0], image.shape()[1]);
+    let z = image
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
+    let opt = DbcMapOptions {
+        window: window_size,
+        box_sizes,
+        z_unit: z_scale,
+        z0,
+        min_valid,
+        step,
+        partial_blocks,
+    };
+    let m = py.detach(|| run_in_pool(n_threads, || dbc_transform(z, rows, cols, &opt)))?;
+    local_map_arrays(py, m)
+}
+
+/// Moving-window covering blanket on the grid of every `step`-th pixel.
+/// Returns (dimension, r_squared) float32 maps.
+#[pyfunction]
+#[pyo3(signature = (image, window_size, epsilons, z_scale, min_valid, step, n_threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn blanket_transform_map<'py>(
+    py: Python<'py>,
+    image: PyReadonlyArray2<'py, f64>,
+    window_size: usize,
+    epsilons: Vec<usize>,
+    z_scale: f64,
+    min_valid: f64,
+    step: usize,
+    n_threads: Option<usize>,
+) -> PyResult<MapPair<'py>> {
+    let (rows, cols) = (image.shape()[0], image.shape()[1]);
+    let z = image
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
+    let opt = BlanketMapOptions {
+        window: window_size,
+        epsilons,
+        z_scale,
+        min_valid,
+        step,
+    };
+    let m = py.detach(|| run_in_pool(n_threads, || blanket_transform(z, rows, cols, &opt)))?;
+    local_map_arrays(py, m)
+}
+
+/// Image-wide covering-blanket areas A(e), e = 1 ..= eps_max, and the number
+/// of valid pixels.
+#[pyfunction]
+#[pyo3(signature = (image, eps_max, z_scale, n_threads=None))]
+fn blanket_areas_image<'py>(
+    py: Python<'py>,
+    image: PyReadonlyArray2<'py, f64>,
+    eps_max: usize,
+    z_scale: f64,
+    n_threads: Option<usize>,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, usize)> {
+    let (rows, cols) = (image.shape()[0], image.shape()[1]);
+    let z = image
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("data: internal: must be C-contiguous"))?;
+    let (a, n) =
+        py.detach(|| run_in_pool(n_threads, || blanket_areas(z, rows, cols, eps_max, z_scale)))?;
+    Ok((a.into_pyarray(py), n))
+}
+
 /// Moving-window gliding-box lacunarity, shape (n_sizes, rows, cols) float32.
 #[pyfunction]
 #[pyo3(signature = (image, window_size, box_sizes, min_valid, n_threads=None))]
@@ -138,5 +238,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(lacunarity_transform_map, m)?)?;
     m.add_function(wrap_pyfunction!(variation_transform_map, m)?)?;
     m.add_function(wrap_pyfunction!(mass_transform_map, m)?)?;
+    m.add_function(wrap_pyfunction!(dbc_transform_map, m)?)?;
+    m.add_function(wrap_pyfunction!(blanket_transform_map, m)?)?;
+    m.add_function(wrap_pyfunction!(blanket_areas_image, m)?)?;
     Ok(())
 }

@@ -6,8 +6,14 @@
 //!   with the window.
 //! * [`lacunarity`]: gliding-box lacunarity per window.
 //! * [`mass`]: Voss's P(m, L) mass dimension, boxes counted over the image.
+//! * [`blanket`]: Peleg's covering blanket, image-wide areas and per-window map.
+//! * [`dbc`]: differential box counting per window (sliding min/max and
+//!   summed-area tables strided by the box size).
 
+pub mod blanket;
+pub mod dbc;
 pub mod lacunarity;
 pub mod mass;
 mod sat;
+mod sliding;
 pub mod variation;

@@ -19,6 +19,7 @@ Computer Graphics*, Springer, 805-835. (Self-affine scaling of graphs.)
 from __future__ import annotations
 
 import math
+import numbers
 import warnings
 from typing import Optional, Sequence, Tuple, Union
 
@@ -286,6 +287,8 @@ def differential_box_counting(
     *,
     box_sizes: Optional[Sequence[int]] = None,
     z_scale: Optional[float] = None,
+    z0: Optional[float] = None,
+    edge_blocks: str = "count",
     nodata: Optional[float] = None,
     offsets: int = 1,
     offset_reduce: str = "mean",
@@ -298,7 +301,8 @@ def differential_box_counting(
     is cut into ``s x s`` blocks and each block column is stacked with boxes
     of height ``h = s * z_scale``. A block whose values span ``[zmin, zmax]``
     needs ``floor((zmax - z0)/h) - floor((zmin - z0)/h) + 1`` boxes (``z0``:
-    the lowest valid value), ``N(s)`` is their sum, and ``D = -slope`` of
+    the base of the box stacks, by default the lowest valid value), ``N(s)``
+    is their sum, and ``D = -slope`` of
     ``log N`` against ``log s`` (Sarkar and Chaudhuri 1994), between 2 and 3.
 
     Parameters
@@ -316,6 +320,19 @@ def differential_box_counting(
         M x M image); for a DEM, ``z_scale = cell_size`` gives cubic boxes in
         physical units. Estimates depend on this choice: compare surfaces with
         the same convention.
+    z0 : float, optional
+        Base height of the box stacks, in data units. Default: the lowest
+        valid value. A fixed ``z0`` (with a fixed ``z_scale``) makes a
+        block's count independent of the rest of the image: this is how
+        ``fractal_transform(method="dbc")`` defines its windows (``z0 = 0``).
+    edge_blocks : {"count", "drop"}, default "count"
+        Blocks of the last row and column that hold fewer than ``s`` rows or
+        columns (when ``s`` does not divide the side): ``"count"`` counts them
+        with the pixels they hold; ``"drop"`` leaves them out, so size ``s``
+        covers the top-left ``floor(rows/s) s x floor(cols/s) s`` part (needs
+        ``offsets=1``). On small images (moving windows) counting partial
+        blocks biases ``D`` low: a 33-pixel side has 5 rows of 8-pixel
+        blocks, not 4.
     nodata : float, optional
         Value marking missing data, in addition to NaN.
     offsets, offset_reduce, scale_range, n_threads
@@ -337,23 +354,60 @@ def differential_box_counting(
     offsets = check_positive_int(offsets, "offsets")
     check_choice(offset_reduce, "offset_reduce", ("mean", "min"))
     n_threads = check_n_threads(n_threads)
-    z0, z1 = _nan_range(z)
+    zmin, zmax = _nan_range(z)
     rows, cols = z.shape
     if z_scale is None:
-        z_unit = (z1 - z0) / max(rows, cols) if z1 > z0 else 1.0
+        z_unit = (zmax - zmin) / max(rows, cols) if zmax > zmin else 1.0
     else:
         z_unit = check_positive_float(z_scale, "z_scale")
+    if z0 is None:
+        z0 = zmin
+    else:
+        if isinstance(z0, bool) or not isinstance(z0, numbers.Real) or not np.isfinite(z0):
+            raise ValueError(f"z0: expected a finite number, got {z0!r}")
+        z0 = float(z0)
     if sizes is None:
         sizes = dyadic_up_to(min(rows, cols) / 4, start=2)
         if len(sizes) < 3:
             raise ValueError(
                 f"image: shape {z.shape} is too small for the default box sizes 2, 4, 8 (needs at least 32 pixels a side); give box_sizes"
             )
+    check_choice(edge_blocks, "edge_blocks", ("count", "drop"))
+    if edge_blocks == "drop" and offsets != 1:
+        raise ValueError("edge_blocks: 'drop' needs offsets=1 (the partial blocks of shifted lattices differ)")
     s, counts = _core.dbc_count(z, sizes, offsets, z0, z_unit, n_threads)
+    if edge_blocks == "drop":
+        counts = np.array(counts, dtype=float, copy=True)
+        for k, size in enumerate(np.asarray(s).tolist()):
+            counts[k] -= _partial_block_counts(z, int(size), z0, z_unit)
     return _lattice_fit(
         "dbc", s, counts, offset_reduce, scale_range, "box size s (pixels)", "box count N(s)",
-        {"z_scale": z_unit, "z0": z0, "offsets": offsets},
+        {"z_scale": z_unit, "z0": z0, "offsets": offsets, "edge_blocks": edge_blocks},
     )
+
+
+def _partial_block_counts(z: np.ndarray, s: int, z0: float, z_unit: float) -> float:
+    """DBC boxes of the partial blocks (the last row and column of blocks
+    when ``s`` does not divide the side), with the counter's arithmetic."""
+    rows, cols = z.shape
+    nr, nc = rows // s, cols // s
+    h = s * z_unit
+    total = 0.0
+    # bottom strip (all columns, partial ones too) and right strip (full rows of blocks)
+    for strip in (z[nr * s:, :], z[: nr * s, nc * s:].T):
+        if strip.size == 0:
+            continue
+        t, n = strip.shape
+        nb = -(-n // s)
+        pad = np.full((t, nb * s), np.nan)
+        pad[:, :n] = strip
+        blk = pad.reshape(t, nb, s).transpose(1, 0, 2).reshape(nb, t * s)
+        ok = ~np.isnan(blk)
+        has = ok.any(axis=1)
+        lo = np.where(ok, blk, np.inf).min(axis=1)[has]
+        hi = np.where(ok, blk, -np.inf).max(axis=1)[has]
+        total += float(np.sum(np.floor((hi - z0) / h) - np.floor((lo - z0) / h) + 1))
+    return total
 
 
 def self_affine_box_counting(

@@ -197,7 +197,8 @@ def mass_dimension(
 
 
 def blanket(data, *, epsilons: Optional[Sequence[int]] = None, z_scale: float = 1.0,
-            nodata: Optional[float] = None, scale_range: ScaleRange = None) -> DimensionFit:
+            nodata: Optional[float] = None, scale_range: ScaleRange = None,
+            n_threads: Optional[int] = None) -> DimensionFit:
     """Covering-blanket dimension of a grayscale surface (Peleg et al. 1984).
 
     Upper and lower blankets grow one step at a time,
@@ -207,42 +208,69 @@ def blanket(data, *, epsilons: Optional[Sequence[int]] = None, z_scale: float = 
         u_\\epsilon = \\max(u_{\\epsilon-1} + 1, \\max_{N} u_{\\epsilon-1}), \\qquad
         b_\\epsilon = \\min(b_{\\epsilon-1} - 1, \\min_{N} b_{\\epsilon-1}),
 
-    from ``u_0 = b_0 = z / z_scale`` over the 4-neighbourhood ``N``; the
-    area is ``A(epsilon) = sum(u - b) / (2 epsilon)`` and ``A ~ epsilon^(2 - D)``.
+    from ``u_0 = b_0 = z / z_scale`` over the 4-neighbourhood ``N`` (clipped
+    at the edge of the data); the area is ``A(epsilon) = sum(u - b) /
+    (2 epsilon)`` over the valid pixels and ``A ~ epsilon^(2 - D)``, so
+    ``D = 2 - slope`` of ``log A`` against ``log epsilon``.
 
     Parameters
     ----------
     data : array_like, shape (rows, cols)
-        Gap-free surface (NaN or ``nodata`` raise ValueError).
+        Grayscale surface. NaN and ``nodata`` are missing samples: they are
+        not part of the surface, hold no blanket and pass none on (blankets
+        grow around holes, as at the edge of the data).
     epsilons : sequence of int, optional
         Blanket thicknesses used in the fit; default ``1 .. 16`` (every
         thickness up to the largest is computed).
     z_scale : float, default 1
-        Value units per blanket step (e.g. grey levels).
+        Value units per blanket step (e.g. grey levels): the blanket grows by
+        ``z_scale`` data units per step and the result depends on this unit.
+    nodata : float, optional
+        Value marking missing data, in addition to NaN.
+    scale_range : None, "auto" or (float, float)
+        As in :func:`fractalgeo_rs.fit.fit_loglog`.
+    n_threads : int, optional
+        Threads (default all cores); results are identical for any value.
 
     Returns
     -------
     DimensionFit
-        ``D = 2 - slope``.
+        ``D = 2 - slope``; ``measures`` are the areas ``A(epsilon)`` (in
+        pixels times ``z_scale`` units); ``extra`` holds ``z_scale`` and
+        ``n_valid``.
+
+    Notes
+    -----
+    The growth runs in Rust (rows in bands of 128 with a halo of
+    ``max(epsilons)`` rows, GIL released), the same step as the moving-window
+    map ``fractal_transform(method="blanket")``.
+
+    References
+    ----------
+    Peleg, S., Naor, J., Hartley, R., Avnir, D. (1984). Multiple resolution
+    texture analysis and classification. *IEEE Trans. PAMI* 6(4), 518-523.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> i, j = np.indices((64, 64))
+    >>> round(fg.blanket(0.5 * i + 0.25 * j).dimension, 6)
+    2.0
     """
-    from scipy.ndimage import grey_dilation, grey_erosion
+    from fractalgeo_rs import _core
+    from fractalgeo_rs._validation import check_n_threads
 
     z = _with_nodata(_real_array(data, (2,)), data, nodata)
-    if np.isnan(z).any():
-        raise ValueError("data: NaN or nodata present; the blanket needs a gap-free surface (fill or crop first)")
-    z = z / check_positive_float(z_scale, "z_scale")
+    if np.isnan(z).all():
+        raise ValueError("data: no valid value (all NaN or nodata)")
+    if np.isinf(z).any():
+        raise ValueError("data: contains inf; mark invalid samples with NaN or nodata")
+    zs = check_positive_float(z_scale, "z_scale")
     eps = list(range(1, 17)) if epsilons is None else sorted(set(check_positive_int(e, "epsilons") for e in epsilons))
     if len(eps) < 3:
         raise ValueError(f"epsilons: need at least 3 distinct thicknesses, got {eps}")
-    cross = np.array([[0, 1, 0], [1, 1, 1], [0, 1, 0]], dtype=bool)
-    u = z.copy()
-    b = z.copy()
-    areas = {}
-    for e in range(1, eps[-1] + 1):
-        u = np.maximum(u + 1, grey_dilation(u, footprint=cross, mode="nearest"))
-        b = np.minimum(b - 1, grey_erosion(b, footprint=cross, mode="nearest"))
-        if e in eps:
-            areas[e] = float(np.sum(u - b)) / (2.0 * e)
-    return fit_loglog(eps, [areas[e] for e in eps], method="blanket", dim_offset=2.0, dim_factor=-1.0,
+    areas, n_valid = _core.blanket_areas_image(np.ascontiguousarray(z, dtype=np.float64), eps[-1], zs,
+                                               check_n_threads(n_threads))
+    return fit_loglog(eps, [float(areas[e - 1]) for e in eps], method="blanket", dim_offset=2.0, dim_factor=-1.0,
                       scale_range=scale_range, x_label="epsilon", y_label="blanket area A(epsilon)",
-                      extra={"z_scale": z_scale})
+                      extra={"z_scale": z_scale, "n_valid": int(n_valid)})

@@ -16,10 +16,10 @@ def add_parsers(sub) -> None:
     p.add_argument("input", help="input raster")
     p.add_argument("output", help="output map (.tif or .npy)")
     p.add_argument("--window", type=int, default=33, help="odd window side in pixels (default 33)")
-    p.add_argument("--method", default="mass", choices=["mass", "variogram", "madogram", "square"],
+    p.add_argument("--method", default="mass", choices=["mass", "variogram", "madogram", "square", "dbc", "blanket"],
                    help="estimator (default mass: Voss's P(m, L), the paper's method)")
     p.add_argument("--z-scale", type=float, default=1.0,
-                   help="mass method: height units per pixel (default 1, e.g. 1 dB or 1 grey level)")
+                   help="mass, dbc, blanket: height units per pixel (default 1, e.g. 1 dB or 1 grey level)")
     p.add_argument("--band", type=int, default=1, help="1-based band (default 1)")
     p.add_argument("--chunks", type=int, default=None, help="process with Dask in chunks of this side")
     p.add_argument("--workers", type=int, default=None, help="threads (default: all cores)")
