@@ -38,6 +38,10 @@ pub struct VariationOptions {
 
 /// Local dimension and r² maps (row-major, `rows x cols`, NaN where the
 /// window has too few valid pixels or a lag has no valid increment).
+/// Summed-area tables of one increment component: (power SAT, count SAT,
+/// row offset, column offset).
+type LagTables = (Vec<f64>, Vec<f64>, usize, usize);
+
 pub fn variation_transform(
     z: &[f64],
     rows: usize,
@@ -98,8 +102,7 @@ pub fn variation_transform(
                 .collect();
             let vsat = sat(&valid, nr, cols);
             // per lag: (power SAT, count SAT) for each component
-            let mut tables: Vec<Vec<(Vec<f64>, Vec<f64>, usize, usize)>> =
-                Vec::with_capacity(lags.len());
+            let mut tables: Vec<Vec<LagTables>> = Vec::with_capacity(lags.len());
             for &u in &lags {
                 let comps: Vec<(usize, usize)> = match opt.increments {
                     Increments::First => vec![(0, u), (u, 0)],
