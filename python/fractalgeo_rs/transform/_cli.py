@@ -16,10 +16,13 @@ def add_parsers(sub) -> None:
     p.add_argument("input", help="input raster")
     p.add_argument("output", help="output map (.tif or .npy)")
     p.add_argument("--window", type=int, default=33, help="odd window side in pixels (default 33)")
-    p.add_argument("--method", default="mass", choices=["mass", "variogram", "madogram", "square", "dbc", "blanket"],
+    p.add_argument("--method", default="mass", choices=["mass", "variogram", "madogram", "square", "dbc", "blanket", "whittle"],
                    help="estimator (default mass: Voss's P(m, L), the paper's method)")
     p.add_argument("--z-scale", type=float, default=1.0,
                    help="mass, dbc, blanket: height units per pixel (default 1, e.g. 1 dB or 1 grey level)")
+    p.add_argument("--step", type=int, default=1,
+                   help="compute every STEP-th row and column only (output cells STEP pixels wide, "
+                        "centred on the input pixels they sample; default 1)")
     p.add_argument("--band", type=int, default=1, help="1-based band (default 1)")
     p.add_argument("--chunks", type=int, default=None, help="process with Dask in chunks of this side")
     p.add_argument("--workers", type=int, default=None, help="threads (default: all cores)")
@@ -40,16 +43,22 @@ def _run(args: argparse.Namespace) -> int:
 
         arr = da.from_array(data, chunks=args.chunks)
         lazy = fractal_transform(arr, args.window, method=args.method, nodata=nodata, n_threads=args.workers,
-                                 z_scale=args.z_scale)
+                                 z_scale=args.z_scale, step=args.step)
         with ProgressBar():
             dmap = lazy.compute(scheduler="threads", num_workers=1)
     else:
         dmap = fractal_transform(data, args.window, method=args.method, nodata=nodata, n_threads=args.workers,
-                                 z_scale=args.z_scale)
+                                 z_scale=args.z_scale, step=args.step)
     dmap = np.asarray(dmap, dtype=np.float32)
     if args.output.lower().endswith((".tif", ".tiff")):
-        write_raster(args.output, dmap, crs=(profile or {}).get("crs"), transform=(profile or {}).get("transform"),
-                     nodata=float("nan"))
+        transform = (profile or {}).get("transform")
+        if transform is not None and args.step > 1:
+            # output cell (k, l) is centred on input pixel (k step, l step)
+            from rasterio import Affine
+
+            shift = 0.5 - args.step / 2.0
+            transform = transform * Affine.translation(shift, shift) * Affine.scale(args.step)
+        write_raster(args.output, dmap, crs=(profile or {}).get("crs"), transform=transform, nodata=float("nan"))
     else:
         write_raster(args.output, dmap)
     finite = dmap[np.isfinite(dmap)]

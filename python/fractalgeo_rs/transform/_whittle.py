@@ -1,0 +1,242 @@
+"""Debiased Whittle map: the local Hurst exponent of every window by the
+debiased Whittle likelihood (Sykulski et al. 2019; Guillaumin et al. 2022),
+the estimator :func:`fractalgeo_rs.whittle` with the square-increment filter.
+
+Why not a loop over :func:`fractalgeo_rs.whittle`: its cost per window is one
+Brent search, ~20 model evaluations of one FFT each. Here the expected
+periodogram ``f_H`` depends only on ``H`` and on the window's validity mask,
+so it is tabulated once on a grid of ``H`` per distinct mask (every interior
+window shares one mask), and a window costs one small FFT (its periodogram)
+and one row of a matrix product (``sum_k I(k) / f_H(k)`` for every grid
+``H``). The minimum of the profile contrast is then located by a cubic
+through the four grid values around the grid minimum; on exact fBm windows
+this agrees with the Brent search of :func:`fractalgeo_rs.whittle` to about
+1e-4 in ``D`` (tested), far below the estimator's spread.
+"""
+from __future__ import annotations
+
+import math
+import os
+import threading
+from typing import Dict, Tuple
+
+import numpy as np
+
+from fractalgeo_rs.dimension.likelihood import _FILTERS_2D, _lag_autocorrelation
+
+# grid of H: the bounds of fractalgeo_rs.whittle's search, ~0.02 apart
+_H_GRID = np.linspace(0.001, 0.999, 51)
+_FILTER = _FILTERS_2D["square"]
+_MIN_FILTERED = 16  # fractalgeo_rs.whittle needs at least 16 valid filtered samples
+
+
+def _lag_base(m: int) -> np.ndarray:
+    """``c_H(h) = -1/2 sum_d v_d |h + d|^{2H}`` for every grid ``H`` on the
+    lag grid ``h = -m..m-1`` per axis (index ``j`` <-> lag ``j - m``)."""
+    offsets = np.array(list(_FILTER.keys()), dtype=np.int64)
+    weights = np.array(list(_FILTER.values()), dtype=float)
+    v = _lag_autocorrelation(offsets, weights)
+    lag = np.arange(-m, m)
+    out = np.zeros((_H_GRID.size, 2 * m, 2 * m))
+    for (d0, d1), wv in v.items():
+        r2 = (lag[:, None] + d0) ** 2 + (lag[None, :] + d1) ** 2
+        with np.errstate(divide="ignore"):
+            logd = 0.5 * np.log(r2.astype(float))
+        with np.errstate(under="ignore"):
+            p = np.exp((2.0 * _H_GRID)[:, None, None] * logd[None])  # 0 at distance 0
+        out += wv * p
+    return -0.5 * out
+
+
+class _Tables:
+    """Contrast tables of one window size: ``1 / f_H(k)`` and
+    ``sum_k log f_H(k)`` per validity mask (cached), over the half spectrum
+    of ``rfft2`` with the weights that make half sums equal full sums."""
+
+    def __init__(self, m: int):
+        self.m = m
+        self.base = _lag_base(m)
+        nk = m // 2 + 1
+        wk = np.full((m, nk), 2.0)
+        wk[:, 0] = 1.0
+        if m % 2 == 0:
+            wk[:, -1] = 1.0
+        wk[0, 0] = 0.0  # the zero frequency is left out
+        self.wk = wk.ravel()
+        self.n_ord = m * m - 1
+        self.cache: Dict[bytes, Tuple[np.ndarray, np.ndarray]] = {}
+
+    def model(self, valid: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+        """(``wk / f_H`` of shape (K, n_H), ``sum_k log f_H`` of shape (n_H,))."""
+        # the model depends on the mask only up to a translation (K(h) is a
+        # sum over all positions): shift the valid samples to the corner
+        # first, so that edge windows of one clipped shape share a model
+        r = np.nonzero(valid.any(axis=1))[0][0]
+        c = np.nonzero(valid.any(axis=0))[0][0]
+        valid = np.roll(valid, (-r, -c), axis=(0, 1))
+        key = np.packbits(valid).tobytes()
+        hit = self.cache.get(key)
+        if hit is not None:
+            return hit
+        from scipy import fft
+
+        m = self.m
+        g = valid / math.sqrt(float(np.count_nonzero(valid)))
+        G = fft.rfft2(g, s=(2 * m, 2 * m))
+        kern = fft.fftshift(fft.irfft2(np.abs(G) ** 2, s=(2 * m, 2 * m)))
+        c = self.base * kern[None]
+        b = c.reshape(-1, 2, m, 2, m).sum(axis=(1, 3))  # fold the lags modulo m
+        f = fft.rfft2(b).real.reshape(b.shape[0], -1)
+        f = np.maximum(f, 1e-300 * np.max(np.abs(f), axis=1, keepdims=True))
+        inv = np.ascontiguousarray((self.wk[None, :] / f).T)
+        logsum = np.log(f) @ self.wk
+        hit = (inv, logsum)
+        if len(self.cache) * inv.nbytes > _CACHE_BYTES:
+            self.cache.clear()
+        self.cache[key] = hit
+        return hit
+
+
+_CACHE_BYTES = 256 << 20  # models kept per window size
+_TABLES: Dict[int, _Tables] = {}
+_TABLES_LOCK = threading.Lock()
+
+
+def _tables(m: int) -> _Tables:
+    """The tables of one window size, shared by calls and Dask blocks."""
+    with _TABLES_LOCK:
+        t = _TABLES.get(m)
+        if t is None:
+            t = _TABLES[m] = _Tables(m)
+        return t
+
+
+def _argmin_cubic(c: np.ndarray):
+    """Minimiser and curvature of each row of contrasts ``c`` (n, n_H) on
+    ``_H_GRID``: a cubic through the four grid values around the grid
+    minimum, minimised between the minimum's neighbours."""
+    n, nh = c.shape
+    dh = _H_GRID[1] - _H_GRID[0]
+    j = np.argmin(c, axis=1)
+    rows = np.arange(n)
+    # four consecutive points: the minimum, its neighbours and the next
+    # point on the lower side, kept inside the grid
+    lo_side = np.zeros(n, dtype=bool)
+    inner = (j > 0) & (j < nh - 1)
+    lo_side[inner] = c[rows[inner], j[inner] - 1] < c[rows[inner], j[inner] + 1]
+    s = np.clip(np.where(lo_side, j - 2, j - 1), 0, nh - 4)
+    y = np.stack([c[rows, s + q] for q in range(4)], axis=1)
+    # Newton form of the cubic in t = (H - H_s) / dh, nodes t = 0, 1, 2, 3
+    d1 = np.diff(y, axis=1)
+    d2 = np.diff(d1, axis=1) / 2.0
+    a1, a2, a3 = d1[:, 0], d2[:, 0], (d2[:, 1] - d2[:, 0]) / 3.0
+    # p(t) = y0 + a1 t + a2 t (t-1) + a3 t (t-1)(t-2); p'(t) = A t^2 + B t + C
+    A = 3.0 * a3
+    B = 2.0 * a2 - 6.0 * a3
+    C = a1 - a2 + 2.0 * a3
+    t_lo = (np.maximum(j - 1, 0) - s).astype(float)
+    t_hi = (np.minimum(j + 1, nh - 1) - s).astype(float)
+    t0 = (j - s).astype(float)
+    cand = [t_lo, t_hi, t0]
+    disc = B * B - 4.0 * A * C
+    with np.errstate(invalid="ignore", divide="ignore"):
+        sq = np.sqrt(np.maximum(disc, 0.0))
+        for root in ((-B + sq) / (2.0 * A), (-B - sq) / (2.0 * A), -C / B):
+            ok = np.isfinite(root) & (root >= t_lo) & (root <= t_hi)
+            cand.append(np.where(ok, root, t0))
+    cand = np.stack(cand, axis=1)
+    t = cand
+    vals = y[:, :1] + a1[:, None] * t + a2[:, None] * t * (t - 1) + a3[:, None] * t * (t - 1) * (t - 2)
+    best = np.take_along_axis(cand, np.argmin(vals, axis=1)[:, None], axis=1)[:, 0]
+    h = _H_GRID[s] + best * dh
+    curv = (2.0 * A * best + B) / dh**2
+    return h, curv
+
+
+def _window_sums(a: np.ndarray, k: int) -> np.ndarray:
+    """Sums of ``a`` over every ``k`` x ``k`` window anchored at its top-left
+    pixel (exact integer counts for boolean ``a``)."""
+    s = np.zeros((a.shape[0] + 1, a.shape[1] + 1), dtype=np.int64)
+    s[1:, 1:] = np.cumsum(np.cumsum(a, axis=0, dtype=np.int64), axis=1)
+    return s[k:, k:] - s[:-k, k:] - s[k:, :-k] + s[:-k, :-k]
+
+
+def _fill_contrast(contrast, gram, nf, masks_all, m, n_ord, tables):
+    """Profile contrasts of every window on the grid of H: complete windows
+    share one model, the others are grouped by validity mask."""
+    full = nf == m * m
+    if np.any(full):
+        inv, logsum = tables.model(np.ones((m, m), dtype=bool))
+        g = gram[full] / (m * m)
+        contrast[full] = n_ord * np.log(g @ inv / n_ord) + logsum[None]
+    part = np.nonzero(~full)[0]
+    if part.size:
+        masks = masks_all[part]
+        keys = np.packbits(masks.reshape(part.size, -1), axis=1)
+        _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+        inverse = inverse.ravel()
+        order = np.argsort(inverse, kind="stable")
+        bounds = np.concatenate([[0], np.cumsum(np.bincount(inverse))])
+        for u in range(first.size):
+            sel = part[order[bounds[u]:bounds[u + 1]]]
+            inv, logsum = tables.model(masks[first[u]])
+            g = gram[sel] / nf[sel][:, None]
+            contrast[sel] = n_ord * np.log(g @ inv / n_ord) + logsum[None]
+
+
+def whittle_grid(z: np.ndarray, w: int, min_valid: float, step: int, n_threads: int):
+    """(dimension, standard error) maps on the ``step`` grid of ``z`` (NaN =
+    missing, image read as padded with NaN)."""
+    from numpy.lib.stride_tricks import sliding_window_view
+    from scipy import fft, ndimage
+
+    workers = n_threads or os.cpu_count() or 1
+    rows, cols = z.shape
+    half = w // 2
+    m = w - 1
+    zp = np.pad(z, half, mode="constant", constant_values=np.nan)
+    # square increments of the padded image: window (r, c) <-> y[r:r+m, c:c+m]
+    y = zp[1:, 1:] - zp[1:, :-1] - zp[:-1, 1:] + zp[:-1, :-1]
+    yvalid = ~np.isnan(y)
+    y0 = np.where(yvalid, y, 0.0)
+    # per-window counts from integral images: valid pixels, valid filtered
+    # samples; and the largest |z| (the scale of "vanishing")
+    zpv = ~np.isnan(zp)
+    frac = _window_sums(zpv, w)[::step, ::step] / float(w * w)
+    n_filt = _window_sums(yvalid, m)[::step, ::step]
+    zabs = ndimage.maximum_filter(np.where(np.isnan(z), 0.0, np.abs(z)), size=w, mode="constant",
+                                  cval=0.0)[::step, ::step]
+
+    nr, nc = frac.shape
+    dim = np.full((nr, nc), np.nan)
+    se = np.full((nr, nc), np.nan)
+    tables = _tables(m)
+    yv = sliding_window_view(y0, (m, m))[::step, ::step]
+    mv = sliding_window_view(yvalid, (m, m))[::step, ::step]
+    n_ord = tables.n_ord
+    batch = max(1, (1 << 23) // (m * m * nc))  # ~64 MB of windows per batch
+    for r0 in range(0, nr, batch):
+        r1 = min(nr, r0 + batch)
+        ok = (frac[r0:r1] >= min_valid - 1e-12) & (n_filt[r0:r1] >= _MIN_FILTERED)
+        if not np.any(ok):
+            continue
+        idx = np.nonzero(ok)
+        nf = n_filt[r0:r1][idx]
+        win = yv[r0:r1][idx]  # (n, m, m) copy
+        spec = fft.rfft2(win, workers=workers)
+        gram = (spec.real**2 + spec.imag**2).reshape(win.shape[0], -1)
+        contrast = np.empty((win.shape[0], _H_GRID.size))
+        with np.errstate(divide="ignore", invalid="ignore"):  # vanishing windows: found below
+            _fill_contrast(contrast, gram, nf, mv[r0:r1][idx], m, n_ord, tables)
+        # a vanishing filtered field (constant or planar window): no dimension
+        level = np.sum(gram * tables.wk[None], axis=1) / n_ord / nf
+        alive = level > 1e-24 * zabs[r0:r1][idx] ** 2
+        alive &= np.all(np.isfinite(contrast), axis=1)
+        h, curv = _argmin_cubic(np.where(alive[:, None], contrast, 0.0))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            s = np.where(curv > 0, np.sqrt(2.0 / curv), np.nan)
+        d_out = np.where(alive, 3.0 - h, np.nan)
+        s_out = np.where(alive, s, np.nan)
+        dim[r0:r1][idx] = d_out
+        se[r0:r1][idx] = s_out
+    return dim.astype(np.float32), se.astype(np.float32)
