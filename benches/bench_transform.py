@@ -20,7 +20,12 @@ timed on a few rows and extrapolated (printed so), after checking that they
 give our values on those rows. The blanket map itself costs O(w^2 e_max) per
 pixel: ours is timed on a strip of rows of the scene and extrapolated too.
 
-Run: ``python benches/bench_transform.py [--size 4096] [--methods dbc,blanket]``.
+The debiased Whittle map (``--methods whittle``) is timed against the loop a
+user would write with our own estimator, ``fractalgeo_rs.whittle`` on every
+window (timed on 40 windows and extrapolated), at step 1 (ours timed on 256
+rows and extrapolated) and step 4.
+
+Run: ``python benches/bench_transform.py [--size 4096] [--methods dbc,blanket,whittle]``.
 """
 from __future__ import annotations
 
@@ -234,6 +239,29 @@ def new_methods(z: np.ndarray) -> None:
     print(f"window 65 / window 17 time (blanket):   {t[('blanket', 65)] / t[('blanket', 17)]:.2f}")
 
 
+def whittle_maps(z: np.ndarray) -> None:
+    """Debiased Whittle map against the loop a user writes: fractalgeo_rs.whittle
+    (square filter) on every window, timed on a sample of windows."""
+    n = z.shape[0]
+    zz = z.astype(np.float64)
+    for w in (17, 33, 65):
+        strip = 256
+        ts = best(lambda: fg.fractal_transform(zz[:strip], w, method="whittle"), 1)
+        t1 = ts * n / strip
+        t4 = best(lambda: fg.fractal_transform(zz, w, method="whittle", step=4), 1)
+        h = w // 2
+        rng = np.random.default_rng(0)
+        pos = rng.integers(h, n - h, size=(40, 2))
+        t0 = time.perf_counter()
+        for i, j in pos:
+            fg.whittle(zz[i - h:i + h + 1, j - h:j + h + 1], filter="square")
+        per = (time.perf_counter() - t0) / len(pos)
+        print(f"ours whittle    w={w:2d}: step 1 {t1:.1f} s extrapolated from {strip} rows ({ts:.2f} s); "
+              f"step 4 {t4:.2f} s; loop of fg.whittle per window {per * 1e3:.2f} ms -> step 1 {per * n * n:.0f} s "
+              f"({per * n * n / t1:.0f} x ours), step 4 {per * n * n / 16:.0f} s ({per * n * n / 16 / t4:.0f} x ours)",
+              flush=True)
+
+
 def best(fn, repeat=3):
     out = []
     for _ in range(repeat):
@@ -247,7 +275,8 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--size", type=int, default=4096)
     ap.add_argument("--methods", default="increments,mass,dbc,blanket",
-                    help="comma-separated groups: increments and mass (the first four maps), dbc,blanket")
+                    help="comma-separated groups: increments and mass (the first four maps), dbc,blanket, "
+                         "whittle (not in the default: slow)")
     args = ap.parse_args()
     n = args.size
     z = mosaic(n)
@@ -256,6 +285,8 @@ def main() -> None:
     groups = set(args.methods.split(","))
     if groups & {"dbc", "blanket"}:
         new_methods(z)
+    if "whittle" in groups:
+        whittle_maps(z)
     if not groups & {"increments", "mass"}:
         return
     ref = fg.fractal_transform(z[:512, :512], 33, method="variogram", min_valid=0.0)

@@ -57,7 +57,8 @@ def _run(args: argparse.Namespace) -> int:
             from rasterio import Affine
 
             shift = 0.5 - args.step / 2.0
-            transform = transform * Affine.translation(shift, shift) * Affine.scale(args.step)
+            cell = Affine.translation(shift, shift) * Affine.scale(args.step)
+            transform = transform @ cell if hasattr(transform, "__matmul__") else transform * cell
         write_raster(args.output, dmap, crs=(profile or {}).get("crs"), transform=transform, nodata=float("nan"))
     else:
         write_raster(args.output, dmap)
