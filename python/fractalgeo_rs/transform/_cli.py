@@ -57,7 +57,9 @@ def _run(args: argparse.Namespace) -> int:
             from rasterio import Affine
 
             shift = 0.5 - args.step / 2.0
-            cell = Affine.translation(shift, shift) * Affine.scale(args.step)
+            # Affine(a, b, c, d, e, f): x = a col + b row + c; the cell is step
+            # pixels wide with its corner shifted by (1 - step) / 2 pixels
+            cell = Affine(args.step, 0.0, shift, 0.0, args.step, shift)
             transform = transform @ cell if hasattr(transform, "__matmul__") else transform * cell
         write_raster(args.output, dmap, crs=(profile or {}).get("crs"), transform=transform, nodata=float("nan"))
     else:
