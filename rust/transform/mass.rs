@@ -32,10 +32,10 @@ pub struct MassOptions {
 /// `m_p(L)` for every pixel of rows `[r0, r1)` and every box size; invalid
 /// pixels get 0. Layout: `[size][row - r0][col]`.
 ///
-/// Loops run over the neighbourhood offsets outside and over a row of pixels
-/// inside, so the comparisons vectorise; a pair counts for box `k` when its
+/// `ks` (box half-sides) ascending. A pair counts for box `k` when its
 /// spatial offset is within `k` and `|z_q - z_p| <= (k + 1/2) z_scale`
-/// (NaN on either side never counts).
+/// (NaN on either side never counts). Pixels go by blocks of [`BLOCK`] along
+/// a row, their counters kept in registers while the offsets are walked.
 pub fn box_masses(
     z: &[f64],
     rows: usize,
