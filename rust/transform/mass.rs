@@ -32,10 +32,10 @@ pub struct MassOptions {
 /// `m_p(L)` for every pixel of rows `[r0, r1)` and every box size; invalid
 /// pixels get 0. Layout: `[size][row - r0][col]`.
 ///
-/// Loops run over the neighbourhood offsets outside and over a row of pixels
-/// inside, so the comparisons vectorise; a pair counts for box `k` when its
+/// `ks` (box half-sides) ascending. A pair counts for box `k` when its
 /// spatial offset is within `k` and `|z_q - z_p| <= (k + 1/2) z_scale`
-/// (NaN on either side never counts).
+/// (NaN on either side never counts). Pixels go by blocks of [`BLOCK`] along
+/// a row, their counters kept in registers while the offsets are walked.
 pub fn box_masses(
     z: &[f64],
     rows: usize,
@@ -52,7 +52,7 @@ pub fn box_masses(
             return unsafe { box_masses_avx2(z, rows, cols, r0, r1, ks, z_scale) };
         }
     }
-    box_masses_impl(z, rows, cols, r0, r1, ks, z_scale)
+    box_masses_impl::<false>(z, rows, cols, r0, r1, ks, z_scale)
 }
 
 /// [`box_masses`] compiled for AVX2 (4 doubles per compare). The arithmetic
@@ -69,11 +69,19 @@ unsafe fn box_masses_avx2(
     ks: &[usize],
     z_scale: f64,
 ) -> Vec<Vec<f64>> {
-    box_masses_impl(z, rows, cols, r0, r1, ks, z_scale)
+    box_masses_impl::<true>(z, rows, cols, r0, r1, ks, z_scale)
 }
 
+/// Pixels per block of [`box_masses_impl`]: the block's counters stay in
+/// registers while the neighbourhood offsets are walked.
+const BLOCK: usize = 16;
+/// At most this many thresholds (box sizes) per pass over a ring of offsets.
+const MAX_THR: usize = 2;
+
+/// `AVX2`: count with the AVX2 intrinsics of [`avx2::ring`] (only
+/// instantiated by [`box_masses_avx2`], which runs once AVX2 is detected).
 #[inline(always)]
-fn box_masses_impl(
+fn box_masses_impl<const AVX2: bool>(
     z: &[f64],
     rows: usize,
     cols: usize,
@@ -82,60 +90,188 @@ fn box_masses_impl(
     ks: &[usize],
     z_scale: f64,
 ) -> Vec<Vec<f64>> {
-    let kmax = *ks.last().unwrap_or(&0) as isize;
+    let kmax = *ks.last().unwrap_or(&0);
     let nr = r1 - r0;
     let thr: Vec<f64> = ks.iter().map(|&k| (k as f64 + 0.5) * z_scale).collect();
     let mut out = vec![vec![0.0f64; nr * cols]; ks.len()];
-    // counts kept as f64 (exact below 2^53) so compare, mask and add stay
-    // in 64-bit lanes; |z_q - z_p| of one offset is computed once for all k
-    let mut acc = vec![vec![0f64; cols]; ks.len()];
-    let mut dbuf = vec![0f64; cols];
-    for r in r0..r1 {
-        acc.iter_mut()
-            .for_each(|a| a.iter_mut().for_each(|v| *v = 0.0));
-        let zp = &z[r * cols..(r + 1) * cols];
-        for di in -kmax..=kmax {
-            let q = r as isize + di;
-            if q < 0 || q >= rows as isize {
-                continue;
-            }
-            let zq = &z[q as usize * cols..(q as usize + 1) * cols];
-            for dj in -kmax..=kmax {
-                let ds = di.unsigned_abs().max(dj.unsigned_abs());
-                // pixels c with 0 <= c + dj < cols
-                let (c0, c1) = if dj >= 0 {
-                    (0usize, cols.saturating_sub(dj as usize))
-                } else {
-                    ((-dj) as usize, cols)
-                };
-                if c1 <= c0 {
+    if nr == 0 || cols == 0 || ks.is_empty() {
+        return out;
+    }
+    // The band's rows with a NaN margin of `kmax` on every side (and the
+    // columns rounded up to whole blocks): NaN never counts, so the offsets
+    // need no bounds tests.
+    let ncb = cols.div_ceil(BLOCK);
+    let pw = ncb * BLOCK + 2 * kmax;
+    let ph = nr + 2 * kmax;
+    let mut zp = vec![f64::NAN; ph * pw];
+    for (pr, prow) in zp.chunks_exact_mut(pw).enumerate() {
+        let r = (r0 + pr).wrapping_sub(kmax);
+        if r < rows {
+            prow[kmax..kmax + cols].copy_from_slice(&z[r * cols..(r + 1) * cols]);
+        }
+    }
+    // Box k counts the offsets with Chebyshev radius <= k. Ring s holds the
+    // radii (k_{s-1}, k_s]; its pairs count for boxes s, s + 1, .. with their
+    // own thresholds, so m_p(k_s) = sum over rings t <= s of ring t's count
+    // at threshold s. A pass walks one ring with up to MAX_THR thresholds.
+    let mut passes: Vec<(usize, usize, usize, usize)> = Vec::new(); // (lo, hi, first box, boxes)
+    for (s, &hi) in ks.iter().enumerate() {
+        let lo = if s == 0 { 0 } else { ks[s - 1] + 1 };
+        if lo > hi {
+            continue;
+        }
+        let mut b = s;
+        while b < ks.len() {
+            let n = (ks.len() - b).min(MAX_THR);
+            passes.push((lo, hi, b, n));
+            b += n;
+        }
+    }
+    let mut cnt = vec![[0u64; BLOCK]; ks.len()];
+    for r in 0..nr {
+        for cb in 0..ncb {
+            let c = cb * BLOCK;
+            let centre = (r + kmax) * pw + kmax + c;
+            cnt.iter_mut().for_each(|a| *a = [0; BLOCK]);
+            for &(lo, hi, b, n) in &passes {
+                let (t, c) = (&thr[b..b + n], &mut cnt[b..b + n]);
+                #[cfg(target_arch = "x86_64")]
+                if AVX2 {
+                    // SAFETY: AVX2 is available (see the const parameter).
+                    unsafe {
+                        match n {
+                            1 => avx2::ring::<1>(&zp, pw, centre, lo, hi, t, c),
+                            _ => avx2::ring::<2>(&zp, pw, centre, lo, hi, t, c),
+                        }
+                    }
                     continue;
                 }
-                let n = c1 - c0;
-                let qs = (c0 as isize + dj) as usize;
-                let a = &zp[c0..c0 + n];
-                let b = &zq[qs..qs + n];
-                let d = &mut dbuf[..n];
-                for ((d, &x), &y) in d.iter_mut().zip(a).zip(b) {
-                    *d = (y - x).abs();
-                }
-                for (s, &k) in ks.iter().enumerate() {
-                    if k < ds {
-                        continue;
-                    }
-                    let t = thr[s];
-                    for (m, &d) in acc[s][c0..c0 + n].iter_mut().zip(d.iter()) {
-                        *m += if d <= t { 1.0 } else { 0.0 };
-                    }
+                match n {
+                    1 => ring::<1>(&zp, pw, centre, lo, hi, t, c),
+                    _ => ring::<2>(&zp, pw, centre, lo, hi, t, c),
                 }
             }
-        }
-        for s in 0..ks.len() {
-            let row = &mut out[s][(r - r0) * cols..(r - r0 + 1) * cols];
-            row.copy_from_slice(&acc[s]);
+            let m = BLOCK.min(cols - c);
+            for (o, a) in out.iter_mut().zip(&cnt) {
+                let dst = &mut o[r * cols + c..r * cols + c + m];
+                for (d, &v) in dst.iter_mut().zip(a.iter()) {
+                    *d = v as f64;
+                }
+            }
         }
     }
     out
+}
+
+/// Adds to `cnt[t][l]` the pairs (pixel `centre + l`, pixel at offset
+/// `(di, dj)`) with Chebyshev radius `max(|di|, |dj|)` in `[lo, hi]` and
+/// `|z_q - z_p| <= thr[t]`, for the `N` thresholds.
+#[inline(always)]
+fn ring<const N: usize>(
+    zp: &[f64],
+    pw: usize,
+    centre: usize,
+    lo: usize,
+    hi: usize,
+    thr: &[f64],
+    cnt: &mut [[u64; BLOCK]],
+) {
+    let p: [f64; BLOCK] = zp[centre..centre + BLOCK].try_into().unwrap();
+    let t: [f64; N] = thr.try_into().unwrap();
+    let mut acc = [[0u64; BLOCK]; N];
+    for di in 0..=2 * hi {
+        // row offset di - hi; columns centre - hi ..= centre + hi
+        let base = centre + di * pw - hi * pw - hi;
+        if di.abs_diff(hi) >= lo {
+            run(&zp[base..base + 2 * hi + BLOCK], &p, &t, &mut acc);
+        } else {
+            // |di - hi| < lo: only the columns with |dj| >= lo
+            run(&zp[base..base + hi - lo + BLOCK], &p, &t, &mut acc);
+            run(&zp[base + hi + lo..base + 2 * hi + BLOCK], &p, &t, &mut acc);
+        }
+    }
+    for (c, a) in cnt.iter_mut().zip(&acc) {
+        for (c, &a) in c.iter_mut().zip(a) {
+            *c += a;
+        }
+    }
+}
+
+/// The pairs of the block `p` with every block-long window of `seg`.
+#[inline(always)]
+fn run<const N: usize>(seg: &[f64], p: &[f64; BLOCK], t: &[f64; N], acc: &mut [[u64; BLOCK]; N]) {
+    for zq in seg.windows(BLOCK) {
+        let zq: &[f64; BLOCK] = zq.try_into().unwrap();
+        for l in 0..BLOCK {
+            let d = (zq[l] - p[l]).abs();
+            for n in 0..N {
+                acc[n][l] += (d <= t[n]) as u64;
+            }
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use super::BLOCK;
+    use std::arch::x86_64::*;
+
+    /// [`super::ring`] with AVX2 intrinsics: the block is four vectors of
+    /// four doubles and its `4 N` counters stay in registers. Same IEEE
+    /// operations per pair (subtract, clear the sign, ordered `<=`), so the
+    /// counts are the same.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(super) unsafe fn ring<const N: usize>(
+        zp: &[f64],
+        pw: usize,
+        centre: usize,
+        lo: usize,
+        hi: usize,
+        thr: &[f64],
+        cnt: &mut [[u64; BLOCK]],
+    ) {
+        // every window read below lies in rows centre -+ hi, columns -+ hi
+        assert!(centre >= hi * pw + hi && centre + hi * pw + hi + BLOCK <= zp.len());
+        assert!(thr.len() == N && cnt.len() == N && lo <= hi + 1);
+        let z = zp.as_ptr();
+        let p = [0, 4, 8, 12].map(|o| _mm256_loadu_pd(z.add(centre + o)));
+        let t: [__m256d; N] = std::array::from_fn(|n| _mm256_set1_pd(thr[n]));
+        let sign = _mm256_set1_pd(-0.0);
+        let mut acc = [[_mm256_setzero_si256(); 4]; N];
+        let mut run = |q0: usize, q1: usize| {
+            for q in q0..=q1 {
+                let w = z.add(q);
+                for v in 0..4 {
+                    let d =
+                        _mm256_andnot_pd(sign, _mm256_sub_pd(_mm256_loadu_pd(w.add(4 * v)), p[v]));
+                    for n in 0..N {
+                        let m = _mm256_castpd_si256(_mm256_cmp_pd::<_CMP_LE_OQ>(d, t[n]));
+                        // the mask is -1 where the pair counts
+                        acc[n][v] = _mm256_sub_epi64(acc[n][v], m);
+                    }
+                }
+            }
+        };
+        for di in 0..=2 * hi {
+            let base = centre + di * pw - hi * pw - hi;
+            if di.abs_diff(hi) >= lo {
+                run(base, base + 2 * hi);
+            } else {
+                run(base, base + hi - lo);
+                run(base + hi + lo, base + 2 * hi);
+            }
+        }
+        for (c, a) in cnt.iter_mut().zip(&acc) {
+            let mut buf = [0u64; BLOCK];
+            for (v, x) in a.iter().enumerate() {
+                _mm256_storeu_si256(buf.as_mut_ptr().add(4 * v) as *mut __m256i, *x);
+            }
+            for (c, b) in c.iter_mut().zip(buf) {
+                *c += b;
+            }
+        }
+    }
 }
 
 /// Image-wide `N(L) = mean over valid pixels of 1 / m_p(L)` for every box
@@ -301,6 +437,79 @@ mod tests {
         for i in 10..rows - 10 {
             for j in 10..cols - 10 {
                 assert!((d[i * cols + j] - 2.0).abs() < 1e-5);
+            }
+        }
+    }
+
+    /// `m_p(k)` by direct pairwise counting over the whole image.
+    fn naive_masses(
+        z: &[f64],
+        rows: usize,
+        cols: usize,
+        r: usize,
+        c: usize,
+        k: usize,
+        zs: f64,
+    ) -> f64 {
+        let zp = z[r * cols + c];
+        let t = (k as f64 + 0.5) * zs;
+        let mut n = 0.0;
+        for q in r.saturating_sub(k)..(r + k + 1).min(rows) {
+            for qc in c.saturating_sub(k)..(c + k + 1).min(cols) {
+                if (z[q * cols + qc] - zp).abs() <= t {
+                    n += 1.0;
+                }
+            }
+        }
+        n
+    }
+
+    #[test]
+    fn masses_match_naive_pairs_on_bands_and_box_lists() {
+        let mut seed = 5u64;
+        for &(rows, cols) in &[(1usize, 1usize), (7, 40), (31, 17), (40, 53), (5, 3)] {
+            let z: Vec<f64> = (0..rows * cols)
+                .map(|k| {
+                    seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
+                    match k % 23 {
+                        4 => f64::NAN,
+                        9 => f64::INFINITY,
+                        15 => f64::NEG_INFINITY,
+                        11 => -0.0,
+                        _ => ((seed >> 40) % 11) as f64 * 0.37 - 1.0,
+                    }
+                })
+                .collect();
+            let lists: [&[usize]; 6] = [
+                &[0],
+                &[0, 1, 2],
+                &[1, 2, 4, 8],
+                &[2, 2, 3],
+                &[3, 5, 6, 7, 9, 10],
+                &[20],
+            ];
+            for ks in lists {
+                for &(r0, r1) in &[(0, rows), (rows / 3, rows), (rows / 2, rows / 2 + 1)] {
+                    for m in [
+                        box_masses(&z, rows, cols, r0, r1, ks, 0.61),
+                        box_masses_impl::<false>(&z, rows, cols, r0, r1, ks, 0.61),
+                    ] {
+                        assert_eq!(m.len(), ks.len());
+                        for (s, &k) in ks.iter().enumerate() {
+                            assert_eq!(m[s].len(), (r1 - r0) * cols);
+                            for r in r0..r1 {
+                                for c in 0..cols {
+                                    let want = naive_masses(&z, rows, cols, r, c, k, 0.61);
+                                    assert_eq!(
+                                        m[s][(r - r0) * cols + c],
+                                        want,
+                                        "{rows}x{cols} ks={ks:?} r={r} c={c} k={k}"
+                                    );
+                                }
+                            }
+                        }
+                    }
+                }
             }
         }
     }
