@@ -402,17 +402,40 @@ pub fn refine_2d_levels(
     levels: u32,
     base: &AdditionsParams,
 ) -> CoreResult<Array2<f64>> {
+    refine_2d_levels_window(coarse, levels, base, None)
+}
+
+/// [`refine_2d_levels`] keeping only the first `shape = (rows, cols)` of the
+/// final grid (`None`: all of it): the last level computes no sample outside
+/// it, and the samples are those of the whole grid.
+pub fn refine_2d_levels_window(
+    coarse: ArrayView2<f64>,
+    levels: u32,
+    base: &AdditionsParams,
+    shape: Option<(usize, usize)>,
+) -> CoreResult<Array2<f64>> {
     check(base)?;
+    if levels == 0 {
+        let (r, c) = coarse.dim();
+        let (or, oc) = shape.unwrap_or((r, c));
+        if or < 1 || oc < 1 || or > r || oc > c {
+            return Err(CoreError::invalid(
+                "shape",
+                format!("expected 1 .. {r} rows and 1 .. {c} columns, got {or} x {oc}"),
+            ));
+        }
+        return Ok(coarse.slice(ndarray::s![..or, ..oc]).to_owned());
+    }
     let mut grid = coarse.to_owned();
     let mut p = *base;
     for l in 0..levels {
-        let (r, c) = grid.dim();
+        let c = grid.ncols();
         let fc = if p.periodic { 2 * c } else { 2 * c - 1 };
-        let _ = r;
         p.level = base.level + l;
         p.global_cols = fc as u64;
         p.origin = (0, 0);
-        grid = refine_2d(grid.view(), &p)?;
+        let window = if l + 1 == levels { shape } else { None };
+        grid = refine_2d_window(grid.view(), &p, window)?;
         p.coarse_spacing /= 2.0;
     }
     Ok(grid)
@@ -510,6 +533,20 @@ mod tests {
             assert!(refine_2d_window(coarse.view(), &p, Some((fr + 1, fc))).is_err());
             assert!(refine_2d_window(coarse.view(), &p, Some((0, fc))).is_err());
         }
+    }
+
+    #[test]
+    fn levels_window_is_the_top_left_of_the_whole() {
+        let coarse = Array2::from_shape_fn((3, 4), |(i, j)| (i as f64) - 0.5 * j as f64);
+        let p = params(false);
+        let whole = refine_2d_levels(coarse.view(), 3, &p).unwrap();
+        assert_eq!(whole.dim(), (17, 25));
+        let w = refine_2d_levels_window(coarse.view(), 3, &p, Some((16, 20))).unwrap();
+        assert_eq!(w, whole.slice(ndarray::s![..16, ..20]));
+        let w0 = refine_2d_levels_window(coarse.view(), 0, &p, Some((2, 3))).unwrap();
+        assert_eq!(w0, coarse.slice(ndarray::s![..2, ..3]));
+        assert!(refine_2d_levels_window(coarse.view(), 0, &p, Some((4, 3))).is_err());
+        assert!(refine_2d_levels_window(coarse.view(), 3, &p, Some((18, 3))).is_err());
     }
 
     #[test]
