@@ -215,15 +215,22 @@ impl Level<'_> {
     /// coarse rows `a - 1 .. a + 2` (`rows`), plus `c1`.
     fn centre_row(&self, a: usize, rows: [&[f64]; 4], dst: &mut [f64]) {
         let wt = self.wt;
-        let g = self.gidx(2 * a + 1, 1);
-        for (b, v) in dst[2..self.nc + 2].iter_mut().enumerate() {
+        let nc = self.nc;
+        let out = &mut dst[2..nc + 2];
+        // The rule first (a loop the compiler vectorises), then the noise.
+        let [r0, r1, r2, r3] = rows.map(|cp| &cp[..nc + 4]);
+        for (b, v) in out.iter_mut().enumerate() {
             let mut s = 0.0;
-            for (wi, cp) in wt.iter().zip(rows) {
+            for (wi, cp) in wt.iter().zip([r0, r1, r2, r3]) {
                 let line =
                     wt[0] * cp[b + 1] + wt[1] * cp[b + 2] + wt[2] * cp[b + 3] + wt[3] * cp[b + 4];
                 s += wi * line;
             }
-            *v = s + self.sd[1] * self.kc1.normal(g + 2 * b as u64);
+            *v = s;
+        }
+        let g = self.gidx(2 * a + 1, 1);
+        for (b, v) in out.iter_mut().enumerate() {
+            *v += self.sd[1] * self.kc1.normal(g + 2 * b as u64);
         }
         pad_ends(dst, self.periodic);
     }
@@ -281,47 +288,68 @@ impl Level<'_> {
         };
         let wt = self.wt;
         let [sd_a2, _, sd_c2, sd_e] = self.sd;
+        // Per row, the rules first (vectorisable loops), then the noise.
         for (t, row) in out.chunks_mut(cols).enumerate() {
             let i = i0 + t;
             let a = (i / 2) as isize;
-            let g = self.gidx(i, 0);
+            let mut pairs = row.chunks_exact_mut(2);
             if i % 2 == 0 {
                 // Old samples (+ a2) and edges (2a, 2b+1): the rule along the
                 // row on old samples b-1 .. b+2, along the column on centres
                 // a-2 .. a+1.
                 let cp = crow(a);
                 let (e0, e1, e2, e3) = (erow(a - 2), erow(a - 1), erow(a), erow(a + 1));
-                for (b, v) in row.chunks_mut(2).enumerate() {
-                    let gj = g + 2 * b as u64;
-                    v[0] = cp[b + 2] + sd_a2 * self.ka2.normal(gj);
-                    if v.len() == 2 {
-                        let hor = wt[0] * cp[b + 1]
-                            + wt[1] * cp[b + 2]
-                            + wt[2] * cp[b + 3]
-                            + wt[3] * cp[b + 4];
-                        let col = b + 2;
-                        let ver =
-                            wt[0] * e0[col] + wt[1] * e1[col] + wt[2] * e2[col] + wt[3] * e3[col];
-                        v[1] = 0.5 * (hor + ver) + sd_e * self.ke.normal(gj + 1);
-                    }
+                for (b, v) in pairs.by_ref().enumerate() {
+                    let hor = wt[0] * cp[b + 1]
+                        + wt[1] * cp[b + 2]
+                        + wt[2] * cp[b + 3]
+                        + wt[3] * cp[b + 4];
+                    let col = b + 2;
+                    let ver = wt[0] * e0[col] + wt[1] * e1[col] + wt[2] * e2[col] + wt[3] * e3[col];
+                    v[0] = cp[b + 2];
+                    v[1] = 0.5 * (hor + ver);
                 }
+                if let [v] = pairs.into_remainder() {
+                    *v = cp[cols / 2 + 2];
+                }
+                self.add_noise(row, self.gidx(i, 0), (sd_a2, self.ka2), (sd_e, self.ke));
             } else {
                 // Edges (2a+1, 2b): the rule along the column on old samples
                 // a-1 .. a+2, along the row on centres b-2 .. b+1; centres (+ c2).
                 let (c0, c1, c2, c3) = (crow(a - 1), crow(a), crow(a + 1), crow(a + 2));
                 let ep = erow(a);
-                for (b, v) in row.chunks_mut(2).enumerate() {
-                    let gj = g + 2 * b as u64;
+                let edge = |b: usize| {
                     let col = b + 2;
                     let ver = wt[0] * c0[col] + wt[1] * c1[col] + wt[2] * c2[col] + wt[3] * c3[col];
                     let hor =
                         wt[0] * ep[b] + wt[1] * ep[b + 1] + wt[2] * ep[b + 2] + wt[3] * ep[b + 3];
-                    v[0] = 0.5 * (hor + ver) + sd_e * self.ke.normal(gj);
-                    if v.len() == 2 {
-                        v[1] = ep[b + 2] + sd_c2 * self.kc2.normal(gj + 1);
-                    }
+                    0.5 * (hor + ver)
+                };
+                for (b, v) in pairs.by_ref().enumerate() {
+                    v[0] = edge(b);
+                    v[1] = ep[b + 2];
                 }
+                if let [v] = pairs.into_remainder() {
+                    *v = edge(cols / 2);
+                }
+                self.add_noise(row, self.gidx(i, 0), (sd_e, self.ke), (sd_c2, self.kc2));
             }
+        }
+    }
+
+    /// Add the noise of a fine row whose first sample has the key index `g`:
+    /// `sd * normal` of stream `even` at even columns, of `odd` at odd ones.
+    #[inline(always)]
+    fn add_noise(&self, row: &mut [f64], g: u64, even: (f64, StreamKey), odd: (f64, StreamKey)) {
+        let mut pairs = row.chunks_exact_mut(2);
+        for (b, v) in pairs.by_ref().enumerate() {
+            let gj = g + 2 * b as u64;
+            v[0] += even.0 * even.1.normal(gj);
+            v[1] += odd.0 * odd.1.normal(gj + 1);
+        }
+        let n = row.len();
+        if n % 2 == 1 {
+            row[n - 1] += even.0 * even.1.normal(g + (n - 1) as u64);
         }
     }
 }
