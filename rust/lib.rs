@@ -15,6 +15,7 @@
 //! | [`lsystem`] | L-systems, turtle geometry and IFS |
 //! | [`transform`] | moving-window maps of local dimension |
 
+pub mod buffers;
 pub mod dem;
 pub mod dimension;
 pub mod error;

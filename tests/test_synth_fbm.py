@@ -471,6 +471,22 @@ def test_additions_kernel_matches_numpy_reference(periodic):
     np.testing.assert_array_equal(coarse, before)
 
 
+@pytest.mark.parametrize("periodic", [False, True])
+def test_additions_kernel_shape_is_the_corner_of_the_whole(periodic):
+    # shape= computes the top-left corner alone (tiles of rows in parallel);
+    # its samples are those of the whole grid, bit for bit.
+    coarse = np.random.default_rng(2).normal(size=(9, 7))
+    var = [0.01, 0.09, 0.02, 0.08]
+    whole = _core.additions_refine_2d(coarse, 3, 0.6, 1.0, 8.0, 0.1, var, periodic, 5, 0, 2)
+    for shape in [whole.shape, (whole.shape[0] - 1, whole.shape[1] - 2), (1, 3), (50, 1)]:
+        got = _core.additions_refine_2d(coarse, 3, 0.6, 1.0, 8.0, 0.1, var, periodic, 5, 0, 1, shape)
+        assert got.shape == shape and got.flags.c_contiguous
+        np.testing.assert_array_equal(got, whole[: shape[0], : shape[1]])
+    with pytest.raises(ValueError, match="shape"):
+        _core.additions_refine_2d(coarse, 3, 0.6, 1.0, 8.0, 0.1, var, periodic, 5, 0, 1,
+                                  (whole.shape[0] + 1, 2))
+
+
 def test_additions_schedule_balances_the_second_differences():
     # The derived variances make the second-difference variance equal at the
     # four kinds of positions and the lag-one variance (1/2)^(2H) when the

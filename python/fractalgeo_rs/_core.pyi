@@ -127,6 +127,7 @@ def additions_refine_2d(
     seed: int,
     first_level: int = 0,
     n_threads: Optional[int] = None,
+    shape: Optional[Tuple[int, int]] = None,
 ) -> npt.NDArray[np.float64]: ...
 def fgn_sqrt_eigenvalues(m: int, hurst: float, n_threads: Optional[int] = None) -> npt.NDArray[np.float64]: ...
 def davies_harte_fbm(

@@ -123,9 +123,10 @@ fn midpoint_refine_2d<'py>(
 
 /// Refine a 2D grid `levels` times by successive random additions with the
 /// 4-point rule of tension `tension` and the variances `[a2, c1, c2, e]` in
-/// units of `sigma^2 s^(2H)` (see `crate::synth::additions`).
+/// units of `sigma^2 s^(2H)` (see `crate::synth::additions`). `shape`:
+/// keep only the top-left `(rows, cols)` of the result (computed alone).
 #[pyfunction]
-#[pyo3(signature = (coarse, levels, hurst, sigma, coarse_spacing, tension, variances, periodic, seed, first_level=0, n_threads=None))]
+#[pyo3(signature = (coarse, levels, hurst, sigma, coarse_spacing, tension, variances, periodic, seed, first_level=0, n_threads=None, shape=None))]
 #[allow(clippy::too_many_arguments)]
 fn additions_refine_2d<'py>(
     py: Python<'py>,
@@ -140,6 +141,7 @@ fn additions_refine_2d<'py>(
     seed: u64,
     first_level: u32,
     n_threads: Option<usize>,
+    shape: Option<(usize, usize)>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let c = coarse.as_array();
     let p = AdditionsParams {
@@ -154,7 +156,11 @@ fn additions_refine_2d<'py>(
         origin: (0, 0),
         global_cols: 0,
     };
-    let v = py.detach(|| run_in_pool(n_threads, || additions::refine_2d_levels(c, levels, &p)))?;
+    let v = py.detach(|| {
+        run_in_pool(n_threads, || {
+            additions::refine_2d_levels_window(c, levels, &p, shape)
+        })
+    })?;
     Ok(v.into_pyarray(py))
 }
 

@@ -25,6 +25,11 @@
 //! Random numbers are keyed by `(seed, level, phase, global fine index)`, so
 //! the result does not depend on the number of threads and a tile (`origin`)
 //! agrees with the whole.
+//!
+//! A level is one parallel pass over blocks of fine rows: a block pads the
+//! coarse rows it reads and computes the centre rows it reads (3 more than
+//! its own) into per-thread scratch, then writes its fine rows with their
+//! noise; there is no padded copy of a whole grid and no grid of centres.
 use super::rng::StreamKey;
 use crate::error::{CoreError, CoreResult};
 use ndarray::{Array2, ArrayView2};
@@ -100,75 +105,267 @@ fn check(p: &AdditionsParams) -> CoreResult<()> {
     Ok(())
 }
 
-/// Pad a grid by 2 on every side: wrap-around (periodic) or linear
-/// extrapolation (`x[-k] = x[0] + k (x[0] - x[1])`; constant for 1 sample).
-fn pad2(g: &[f64], r: usize, c: usize, periodic: bool) -> Vec<f64> {
-    let (pr, pc) = (r + 4, c + 4);
-    let mut out = vec![0.0; pr * pc];
-    // Values at -2, -1 and n, n+1 of a line `v` of length n.
-    let ends = |v0: f64, v1: f64, w1: f64, w0: f64, n: usize| -> [f64; 4] {
-        // v0 = v[0], v1 = v[1], w1 = v[n-2], w0 = v[n-1]
-        if n == 1 {
-            [v0; 4]
-        } else {
-            let (d0, d1) = (v0 - v1, w0 - w1);
-            [v0 + 2.0 * d0, v0 + d0, w0 + d1, w0 + 2.0 * d1]
-        }
+/// Values at -2, -1 and n, n+1 of a line of length `n` from `v0 = v[0]`,
+/// `v1 = v[1]`, `w1 = v[n-2]`, `w0 = v[n-1]`: linear extrapolation
+/// (`x[-k] = x[0] + k (x[0] - x[1])`; constant for 1 sample).
+#[inline]
+fn ends(v0: f64, v1: f64, w1: f64, w0: f64, n: usize) -> [f64; 4] {
+    if n == 1 {
+        [v0; 4]
+    } else {
+        let (d0, d1) = (v0 - v1, w0 - w1);
+        [v0 + 2.0 * d0, v0 + d0, w0 + d1, w0 + 2.0 * d1]
+    }
+}
+
+/// Pad a line in place: `line[2..n + 2]` holds the `n` values, `line[0..2]`
+/// and `line[n + 2..n + 4]` receive the wrap-around (periodic) or the linear
+/// extension.
+#[inline]
+fn pad_ends(line: &mut [f64], periodic: bool) {
+    let n = line.len() - 4;
+    let v = &line[2..n + 2];
+    let e = if periodic {
+        [v[(2 * n - 2) % n], v[n - 1], v[0], v[1 % n]]
+    } else {
+        ends(v[0], v[n.min(2) - 1], v[n.saturating_sub(2)], v[n - 1], n)
     };
-    out[2 * pc..(r + 2) * pc]
-        .par_chunks_mut(pc)
-        .enumerate()
-        .for_each(|(i, dst)| {
-            let row = &g[i * c..(i + 1) * c];
-            dst[2..c + 2].copy_from_slice(row);
-            let e = if periodic {
-                [row[(2 * c - 2) % c], row[c - 1], row[0], row[1 % c]]
-            } else {
-                ends(
-                    row[0],
-                    row[c.min(2) - 1],
-                    row[c.saturating_sub(2)],
-                    row[c - 1],
-                    c,
-                )
-            };
-            dst[0] = e[0];
-            dst[1] = e[1];
-            dst[c + 2] = e[2];
-            dst[c + 3] = e[3];
+    line[0] = e[0];
+    line[1] = e[1];
+    line[n + 2] = e[2];
+    line[n + 3] = e[3];
+}
+
+/// Padded row `k` (in `-2 .. n + 2`) of a grid of `n` rows that is padded by
+/// 2 on every side, rows outside the grid wrapped (periodic) or extended
+/// linearly from the padded rows (so the corners extend the padded columns).
+/// `row(i, dst)` writes the padded row `i` in `0 .. n` (`dst.len()` values).
+fn padded_row(
+    k: isize,
+    n: usize,
+    periodic: bool,
+    dst: &mut [f64],
+    row: &mut impl FnMut(usize, &mut [f64]),
+) {
+    if k >= 0 && (k as usize) < n {
+        return row(k as usize, dst);
+    }
+    if periodic {
+        return row(k.rem_euclid(n as isize) as usize, dst);
+    }
+    // Rows 0, 1 (above) or n-1, n-2 (below): x0 + (1 or 2) (x0 - x1).
+    let (first, second) = if k < 0 {
+        (0, n.min(2) - 1)
+    } else {
+        (n - 1, n.saturating_sub(2))
+    };
+    row(first, dst);
+    if n == 1 {
+        return;
+    }
+    let mut x1 = vec![0.0; dst.len()];
+    row(second, &mut x1);
+    let far = k < -1 || k > n as isize;
+    for (d, x1) in dst.iter_mut().zip(&x1) {
+        let x0 = *d;
+        let dd = x0 - x1;
+        *d = if far { x0 + 2.0 * dd } else { x0 + dd };
+    }
+}
+
+/// Pairs of fine rows (an even and an odd one) per parallel block; a block
+/// recomputes the 3 rows of centres it shares with its neighbours.
+const BLOCK_PAIRS: usize = 32;
+
+/// One level, read-only: the coarse grid, the rules and the random streams.
+struct Level<'a> {
+    cs: &'a [f64],
+    r: usize,
+    c: usize,
+    nr: usize,
+    nc: usize,
+    periodic: bool,
+    wt: [f64; 4],
+    /// Standard deviations `[a2, c1, c2, e]`.
+    sd: [f64; 4],
+    kc1: StreamKey,
+    kc2: StreamKey,
+    ka2: StreamKey,
+    ke: StreamKey,
+    origin: (u64, u64),
+    gc: u64,
+}
+
+impl Level<'_> {
+    #[inline(always)]
+    fn gidx(&self, i: usize, j: usize) -> u64 {
+        (self.origin.0 + i as u64) * self.gc + self.origin.1 + j as u64
+    }
+
+    /// Padded coarse row `k` in `-2 .. r + 2` (`c + 4` values).
+    fn coarse_row(&self, k: isize, dst: &mut [f64]) {
+        let c = self.c;
+        padded_row(k, self.r, self.periodic, dst, &mut |i, d: &mut [f64]| {
+            d[2..c + 2].copy_from_slice(&self.cs[i * c..(i + 1) * c]);
+            pad_ends(d, self.periodic);
         });
-    // Padded rows -2, -1, r, r+1 from whole padded rows.
-    let src = |k: usize| (k + 2) * pc; // start of padded row of original row k
-    let mut extra = vec![0.0; 4 * pc];
-    for jj in 0..pc {
-        let e = if periodic {
-            [
-                out[src((2 * r - 2) % r) + jj],
-                out[src(r - 1) + jj],
-                out[src(0) + jj],
-                out[src(1 % r) + jj],
-            ]
-        } else {
-            ends(
-                out[src(0) + jj],
-                out[src(r.min(2) - 1) + jj],
-                out[src(r.saturating_sub(2)) + jj],
-                out[src(r - 1) + jj],
-                r,
-            )
+    }
+
+    /// Padded centre row `a` (`nc + 4` values): the 4 x 4 rule on the padded
+    /// coarse rows `a - 1 .. a + 2` (`rows`), plus `c1`.
+    fn centre_row(&self, a: usize, rows: [&[f64]; 4], dst: &mut [f64]) {
+        let wt = self.wt;
+        let nc = self.nc;
+        let out = &mut dst[2..nc + 2];
+        // The rule first (a loop the compiler vectorises), then the noise.
+        let [r0, r1, r2, r3] = rows.map(|cp| &cp[..nc + 4]);
+        for (b, v) in out.iter_mut().enumerate() {
+            let mut s = 0.0;
+            for (wi, cp) in wt.iter().zip([r0, r1, r2, r3]) {
+                let line =
+                    wt[0] * cp[b + 1] + wt[1] * cp[b + 2] + wt[2] * cp[b + 3] + wt[3] * cp[b + 4];
+                s += wi * line;
+            }
+            *v = s;
+        }
+        let g = self.gidx(2 * a + 1, 1);
+        for (b, v) in out.iter_mut().enumerate() {
+            *v += self.sd[1] * self.kc1.normal(g + 2 * b as u64);
+        }
+        pad_ends(dst, self.periodic);
+    }
+
+    /// Padded centre row `k` in `-2 .. nr + 2`, computed from the coarse grid
+    /// alone (rows outside the grid and the edges of a block).
+    fn centre_row_alone(&self, k: isize, dst: &mut [f64]) {
+        let pc = self.c + 4;
+        let mut buf = vec![0.0; 4 * pc];
+        padded_row(k, self.nr, self.periodic, dst, &mut |a, d: &mut [f64]| {
+            for (t, chunk) in buf.chunks_mut(pc).enumerate() {
+                self.coarse_row(a as isize - 1 + t as isize, chunk);
+            }
+            let rows = [
+                &buf[..pc],
+                &buf[pc..2 * pc],
+                &buf[2 * pc..3 * pc],
+                &buf[3 * pc..],
+            ];
+            self.centre_row(a, rows, d);
+        });
+    }
+
+    /// Fine rows `i0 .. i0 + out.len() / cols` (`cols` columns from column 0)
+    /// into `out`; `co` and `ce` are scratch buffers.
+    fn block(&self, i0: usize, cols: usize, out: &mut [f64], co: &mut Vec<f64>, ce: &mut Vec<f64>) {
+        let (pc, pn) = (self.c + 4, self.nc + 4);
+        let i1 = i0 + out.len() / cols;
+        let (a0, a1) = ((i0 / 2) as isize, ((i1 - 1) / 2 + 1) as isize);
+        // Padded coarse rows kc0 ..= kc1 and centre rows a0 - 2 ..= a1.
+        let kc0 = (a0 - 3).max(-2);
+        let kc1 = (a1 + 2).min(self.r as isize + 1);
+        co.resize(((kc1 - kc0 + 1) as usize) * pc, 0.0);
+        for (t, chunk) in co.chunks_mut(pc).enumerate() {
+            self.coarse_row(kc0 + t as isize, chunk);
+        }
+        let crow = |k: isize| -> &[f64] {
+            let s = ((k - kc0) as usize) * pc;
+            &co[s..s + pc]
         };
-        for (t, v) in e.iter().enumerate() {
-            extra[t * pc + jj] = *v;
+        let ka0 = a0 - 2;
+        ce.resize(((a1 - ka0 + 1) as usize) * pn, 0.0);
+        for (t, chunk) in ce.chunks_mut(pn).enumerate() {
+            let k = ka0 + t as isize;
+            if k >= 0 && (k as usize) < self.nr {
+                let rows = [crow(k - 1), crow(k), crow(k + 1), crow(k + 2)];
+                self.centre_row(k as usize, rows, chunk);
+            } else {
+                self.centre_row_alone(k, chunk);
+            }
+        }
+        let erow = |k: isize| -> &[f64] {
+            let s = ((k - ka0) as usize) * pn;
+            &ce[s..s + pn]
+        };
+        let wt = self.wt;
+        let [sd_a2, _, sd_c2, sd_e] = self.sd;
+        // Per row, the rules first (vectorisable loops), then the noise.
+        for (t, row) in out.chunks_mut(cols).enumerate() {
+            let i = i0 + t;
+            let a = (i / 2) as isize;
+            let mut pairs = row.chunks_exact_mut(2);
+            if i % 2 == 0 {
+                // Old samples (+ a2) and edges (2a, 2b+1): the rule along the
+                // row on old samples b-1 .. b+2, along the column on centres
+                // a-2 .. a+1.
+                let cp = crow(a);
+                let (e0, e1, e2, e3) = (erow(a - 2), erow(a - 1), erow(a), erow(a + 1));
+                for (b, v) in pairs.by_ref().enumerate() {
+                    let hor = wt[0] * cp[b + 1]
+                        + wt[1] * cp[b + 2]
+                        + wt[2] * cp[b + 3]
+                        + wt[3] * cp[b + 4];
+                    let col = b + 2;
+                    let ver = wt[0] * e0[col] + wt[1] * e1[col] + wt[2] * e2[col] + wt[3] * e3[col];
+                    v[0] = cp[b + 2];
+                    v[1] = 0.5 * (hor + ver);
+                }
+                if let [v] = pairs.into_remainder() {
+                    *v = cp[cols / 2 + 2];
+                }
+                self.add_noise(row, self.gidx(i, 0), (sd_a2, self.ka2), (sd_e, self.ke));
+            } else {
+                // Edges (2a+1, 2b): the rule along the column on old samples
+                // a-1 .. a+2, along the row on centres b-2 .. b+1; centres (+ c2).
+                let (c0, c1, c2, c3) = (crow(a - 1), crow(a), crow(a + 1), crow(a + 2));
+                let ep = erow(a);
+                let edge = |b: usize| {
+                    let col = b + 2;
+                    let ver = wt[0] * c0[col] + wt[1] * c1[col] + wt[2] * c2[col] + wt[3] * c3[col];
+                    let hor =
+                        wt[0] * ep[b] + wt[1] * ep[b + 1] + wt[2] * ep[b + 2] + wt[3] * ep[b + 3];
+                    0.5 * (hor + ver)
+                };
+                for (b, v) in pairs.by_ref().enumerate() {
+                    v[0] = edge(b);
+                    v[1] = ep[b + 2];
+                }
+                if let [v] = pairs.into_remainder() {
+                    *v = edge(cols / 2);
+                }
+                self.add_noise(row, self.gidx(i, 0), (sd_e, self.ke), (sd_c2, self.kc2));
+            }
         }
     }
-    for (t, ii) in [0usize, 1, r + 2, r + 3].iter().enumerate() {
-        out[ii * pc..(ii + 1) * pc].copy_from_slice(&extra[t * pc..(t + 1) * pc]);
+
+    /// Add the noise of a fine row whose first sample has the key index `g`:
+    /// `sd * normal` of stream `even` at even columns, of `odd` at odd ones.
+    #[inline(always)]
+    fn add_noise(&self, row: &mut [f64], g: u64, even: (f64, StreamKey), odd: (f64, StreamKey)) {
+        let mut pairs = row.chunks_exact_mut(2);
+        for (b, v) in pairs.by_ref().enumerate() {
+            let gj = g + 2 * b as u64;
+            v[0] += even.0 * even.1.normal(gj);
+            v[1] += odd.0 * odd.1.normal(gj + 1);
+        }
+        let n = row.len();
+        if n % 2 == 1 {
+            row[n - 1] += even.0 * even.1.normal(g + (n - 1) as u64);
+        }
     }
-    out
 }
 
 /// One level: `(r, c) -> (2r - 1, 2c - 1)` (periodic: `(2r, 2c)`).
 pub fn refine_2d(coarse: ArrayView2<f64>, p: &AdditionsParams) -> CoreResult<Array2<f64>> {
+    refine_2d_window(coarse, p, None)
+}
+
+/// One level, keeping only the first `shape = (rows, cols)` of the fine grid
+/// (`None`: all of it); the samples are those of [`refine_2d`].
+pub fn refine_2d_window(
+    coarse: ArrayView2<f64>,
+    p: &AdditionsParams,
+    shape: Option<(usize, usize)>,
+) -> CoreResult<Array2<f64>> {
     check(p)?;
     let (r, c) = coarse.dim();
     if !p.periodic && (r < 2 || c < 2) {
@@ -189,88 +386,41 @@ pub fn refine_2d(coarse: ArrayView2<f64>, p: &AdditionsParams) -> CoreResult<Arr
     } else {
         (2 * r - 1, 2 * c - 1)
     };
+    let (or, oc) = shape.unwrap_or((fr, fc));
+    if or < 1 || oc < 1 || or > fr || oc > fc {
+        return Err(CoreError::invalid(
+            "shape",
+            format!("expected 1 .. {fr} rows and 1 .. {fc} columns, got {or} x {oc}"),
+        ));
+    }
     // Centres: (nr, nc) of them at fine (2a+1, 2b+1).
     let (nr, nc) = if p.periodic { (r, c) } else { (r - 1, c - 1) };
     let scale = p.sigma * p.coarse_spacing.powf(p.hurst);
-    let sd = p.variances.map(|v| scale * v.sqrt());
-    let (sd_a2, sd_c1, sd_c2, sd_e) = (sd[0], sd[1], sd[2], sd[3]);
     let w = p.tension;
-    let wt = [-w, 0.5 + w, 0.5 + w, -w];
-    let (kc1, kc2, ka2, ke) = (key(p, PH_C1), key(p, PH_C2), key(p, PH_A2), key(p, PH_E));
-    let (o0, o1) = p.origin;
-    let gc = p.global_cols.max(o1 + fc as u64);
-    let gidx = |i: usize, j: usize| (o0 + i as u64) * gc + o1 + j as u64;
-
-    let cp = pad2(cs, r, c, p.periodic);
-    let pc = c + 4;
-    // Diamond step: centres from the 4 x 4 old samples, plus c1.
-    let mut cen = vec![0.0; nr * nc];
-    cen.par_chunks_mut(nc).enumerate().for_each(|(a, row)| {
-        for (b, v) in row.iter_mut().enumerate() {
-            let mut s = 0.0;
-            for (pi, wi) in wt.iter().enumerate() {
-                let base = (a + 1 + pi) * pc + b + 1;
-                let line = wt[0] * cp[base]
-                    + wt[1] * cp[base + 1]
-                    + wt[2] * cp[base + 2]
-                    + wt[3] * cp[base + 3];
-                s += wi * line;
-            }
-            *v = s + sd_c1 * kc1.normal(gidx(2 * a + 1, 2 * b + 1));
-        }
-    });
-    let ep = pad2(&cen, nr, nc, p.periodic);
-    let pn = nc + 4;
-
-    let mut fine = vec![0.0f64; fr * fc];
-    fine.par_chunks_mut(fc).enumerate().for_each(|(i, row)| {
-        let a = i / 2;
-        if i % 2 == 0 {
-            // Old samples (+ a2) and edges (2a, 2b+1).
-            let crow = (a + 2) * pc;
-            for (j, v) in row.iter_mut().enumerate() {
-                let b = j / 2;
-                let g = gidx(i, j);
-                *v = if j % 2 == 0 {
-                    cs[a * c + b] + sd_a2 * ka2.normal(g)
-                } else {
-                    let k = crow + b + 1; // old b-1 .. b+2
-                    let hor =
-                        wt[0] * cp[k] + wt[1] * cp[k + 1] + wt[2] * cp[k + 2] + wt[3] * cp[k + 3];
-                    // centres a-2 .. a+1 at column b -> padded rows a .. a+3
-                    let col = b + 2;
-                    let ver = wt[0] * ep[a * pn + col]
-                        + wt[1] * ep[(a + 1) * pn + col]
-                        + wt[2] * ep[(a + 2) * pn + col]
-                        + wt[3] * ep[(a + 3) * pn + col];
-                    0.5 * (hor + ver) + sd_e * ke.normal(g)
-                };
-            }
-        } else {
-            // Centres (+ c2) and edges (2a+1, 2b).
-            let erow = (a + 2) * pn;
-            for (j, v) in row.iter_mut().enumerate() {
-                let b = j / 2;
-                let g = gidx(i, j);
-                *v = if j % 2 == 1 {
-                    cen[a * nc + b] + sd_c2 * kc2.normal(g)
-                } else {
-                    // old a-1 .. a+2 at column b -> padded rows a+1 .. a+4
-                    let col = b + 2;
-                    let ver = wt[0] * cp[(a + 1) * pc + col]
-                        + wt[1] * cp[(a + 2) * pc + col]
-                        + wt[2] * cp[(a + 3) * pc + col]
-                        + wt[3] * cp[(a + 4) * pc + col];
-                    // centres b-2 .. b+1 in row a -> padded columns b .. b+3
-                    let k = erow + b;
-                    let hor =
-                        wt[0] * ep[k] + wt[1] * ep[k + 1] + wt[2] * ep[k + 2] + wt[3] * ep[k + 3];
-                    0.5 * (hor + ver) + sd_e * ke.normal(g)
-                };
-            }
-        }
-    });
-    Array2::from_shape_vec((fr, fc), fine).map_err(|e| CoreError::Internal(e.to_string()))
+    let lv = Level {
+        cs,
+        r,
+        c,
+        nr,
+        nc,
+        periodic: p.periodic,
+        wt: [-w, 0.5 + w, 0.5 + w, -w],
+        sd: p.variances.map(|v| scale * v.sqrt()),
+        kc1: key(p, PH_C1),
+        kc2: key(p, PH_C2),
+        ka2: key(p, PH_A2),
+        ke: key(p, PH_E),
+        origin: p.origin,
+        gc: p.global_cols.max(p.origin.1 + fc as u64),
+    };
+    let mut fine = crate::buffers::zeroed(or * oc);
+    fine.par_chunks_mut(2 * BLOCK_PAIRS * oc)
+        .enumerate()
+        .for_each_init(
+            || (Vec::new(), Vec::new()),
+            |(co, ce), (bi, out)| lv.block(2 * BLOCK_PAIRS * bi, oc, out, co, ce),
+        );
+    Array2::from_shape_vec((or, oc), fine).map_err(|e| CoreError::Internal(e.to_string()))
 }
 
 /// Refine `levels` times (levels numbered from `base.level`), halving the
@@ -280,17 +430,40 @@ pub fn refine_2d_levels(
     levels: u32,
     base: &AdditionsParams,
 ) -> CoreResult<Array2<f64>> {
+    refine_2d_levels_window(coarse, levels, base, None)
+}
+
+/// [`refine_2d_levels`] keeping only the first `shape = (rows, cols)` of the
+/// final grid (`None`: all of it): the last level computes no sample outside
+/// it, and the samples are those of the whole grid.
+pub fn refine_2d_levels_window(
+    coarse: ArrayView2<f64>,
+    levels: u32,
+    base: &AdditionsParams,
+    shape: Option<(usize, usize)>,
+) -> CoreResult<Array2<f64>> {
     check(base)?;
+    if levels == 0 {
+        let (r, c) = coarse.dim();
+        let (or, oc) = shape.unwrap_or((r, c));
+        if or < 1 || oc < 1 || or > r || oc > c {
+            return Err(CoreError::invalid(
+                "shape",
+                format!("expected 1 .. {r} rows and 1 .. {c} columns, got {or} x {oc}"),
+            ));
+        }
+        return Ok(coarse.slice(ndarray::s![..or, ..oc]).to_owned());
+    }
     let mut grid = coarse.to_owned();
     let mut p = *base;
     for l in 0..levels {
-        let (r, c) = grid.dim();
+        let c = grid.ncols();
         let fc = if p.periodic { 2 * c } else { 2 * c - 1 };
-        let _ = r;
         p.level = base.level + l;
         p.global_cols = fc as u64;
         p.origin = (0, 0);
-        grid = refine_2d(grid.view(), &p)?;
+        let window = if l + 1 == levels { shape } else { None };
+        grid = refine_2d_window(grid.view(), &p, window)?;
         p.coarse_spacing /= 2.0;
     }
     Ok(grid)
@@ -361,6 +534,47 @@ mod tests {
         .unwrap();
         assert_eq!(a, b);
         assert_eq!(a.dim(), (65, 65));
+    }
+
+    #[test]
+    fn window_is_the_top_left_of_the_whole() {
+        // Several parallel blocks (2 x BLOCK_PAIRS fine rows each), odd sizes.
+        for periodic in [false, true] {
+            let coarse = Array2::from_shape_fn((2 * BLOCK_PAIRS + 7, 37), |(i, j)| {
+                ((i * 13 + j * 7) % 11) as f64 - 5.0
+            });
+            let p = params(periodic);
+            let whole = refine_2d(coarse.view(), &p).unwrap();
+            let (fr, fc) = whole.dim();
+            for (rows, cols) in [
+                (fr, fc),
+                (fr - 1, fc - 2),
+                (2 * BLOCK_PAIRS + 1, 1),
+                (1, fc),
+            ] {
+                let w = run_in_pool(Some(2), || {
+                    refine_2d_window(coarse.view(), &p, Some((rows, cols)))
+                })
+                .unwrap();
+                assert_eq!(w, whole.slice(ndarray::s![..rows, ..cols]));
+            }
+            assert!(refine_2d_window(coarse.view(), &p, Some((fr + 1, fc))).is_err());
+            assert!(refine_2d_window(coarse.view(), &p, Some((0, fc))).is_err());
+        }
+    }
+
+    #[test]
+    fn levels_window_is_the_top_left_of_the_whole() {
+        let coarse = Array2::from_shape_fn((3, 4), |(i, j)| (i as f64) - 0.5 * j as f64);
+        let p = params(false);
+        let whole = refine_2d_levels(coarse.view(), 3, &p).unwrap();
+        assert_eq!(whole.dim(), (17, 25));
+        let w = refine_2d_levels_window(coarse.view(), 3, &p, Some((16, 20))).unwrap();
+        assert_eq!(w, whole.slice(ndarray::s![..16, ..20]));
+        let w0 = refine_2d_levels_window(coarse.view(), 0, &p, Some((2, 3))).unwrap();
+        assert_eq!(w0, coarse.slice(ndarray::s![..2, ..3]));
+        assert!(refine_2d_levels_window(coarse.view(), 0, &p, Some((4, 3))).is_err());
+        assert!(refine_2d_levels_window(coarse.view(), 3, &p, Some((18, 3))).is_err());
     }
 
     #[test]

@@ -188,7 +188,7 @@ pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2
     let add = p.additions;
 
     // Pass A (diamond step): old samples and cell centres, row by row.
-    let mut fine = vec![0.0f64; fr * fc];
+    let mut fine = crate::buffers::zeroed(fr * fc);
     fine.par_chunks_mut(fc).enumerate().for_each(|(i, row)| {
         let gbase = (o0 + i as u64) * gc + o1;
         let a = i / 2;

@@ -107,8 +107,25 @@ fn zig_tables() -> &'static ZigTables {
 /// A standard normal from 64 random bits, by the ziggurat method (Marsaglia
 /// & Tsang 2000, 128 layers). Rejections (about 1.2 %) draw new bits by
 /// re-hashing, so the value stays a pure function of `bits`.
-#[inline]
-pub fn ziggurat_normal(mut bits: u64) -> f64 {
+///
+/// The test of the first rectangle (98.8 % of the calls) is inlined; the rest
+/// is [`ziggurat_loop`], which starts over with the same bits.
+#[inline(always)]
+pub fn ziggurat_normal(bits: u64) -> f64 {
+    let t = zig_tables();
+    let i = (bits & 0x7f) as usize;
+    let u = ((bits >> 11) as f64) * (2.0 / 9_007_199_254_740_992.0) - 1.0; // [-1, 1)
+    let z = u * t.x[i];
+    if z.abs() < t.x[i + 1] {
+        return z;
+    }
+    ziggurat_loop(bits)
+}
+
+/// The whole ziggurat method (see [`ziggurat_normal`]), out of line.
+#[cold]
+#[inline(never)]
+fn ziggurat_loop(mut bits: u64) -> f64 {
     let t = zig_tables();
     loop {
         let i = (bits & 0x7f) as usize;
@@ -305,6 +322,16 @@ mod zig_tests {
             (last_area - ZIG_V).abs() < 1e-6 * ZIG_V * 1000.0,
             "{last_area}"
         );
+    }
+
+    #[test]
+    fn inline_first_rectangle_agrees_with_the_whole_method() {
+        // About 12 000 of these draws leave the first rectangle.
+        let k = StreamKey::new(8, 2);
+        for i in 0..1_000_000u64 {
+            let b = k.bits(i);
+            assert_eq!(ziggurat_normal(b).to_bits(), ziggurat_loop(b).to_bits());
+        }
     }
 
     #[test]

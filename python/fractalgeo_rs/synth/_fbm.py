@@ -312,7 +312,8 @@ def fbm_surface(shape, hurst, *, method="exact", seed=None, cell_size=1.0, sigma
         z = _surface_spectral(rows, cols, h, seed, bool(periodic), n_threads)
     else:
         z = _surface_midpoint(rows, cols, h, seed, method == "additions", bool(periodic), n_threads)
-    z *= scale
+    if scale != 1.0:  # x * 1.0 == x: skip a pass over the grid
+        z *= scale
     return z
 
 
@@ -330,15 +331,17 @@ def _surface_midpoint(rows, cols, h, seed, additions, periodic, n_threads):
     ii, jj = np.meshgrid(np.arange(nr), np.arange(nc), indexing="ij")
     pos = np.column_stack([ii.ravel(), jj.ravel()]).astype(np.float64) * step
     coarse = _exact_coarse(pos, h, seed, c.STREAM_COARSE_2D, n_threads).reshape(nr, nc)
+    if additions:  # the kernel computes the (rows, cols) corner only
+        return _refine(coarse, levels, h, float(step), True, False, seed, n_threads, shape=(rows, cols))
     z = _refine(coarse, levels, h, float(step), additions, False, seed, n_threads)
     return np.ascontiguousarray(z[:rows, :cols])
 
 
-def _refine(coarse, levels, h, spacing, additions, periodic, seed, n_threads):
+def _refine(coarse, levels, h, spacing, additions, periodic, seed, n_threads, shape=None):
     if additions:
         w, var = _additions.schedule(h)
         return _core.additions_refine_2d(coarse, levels, h, 1.0, spacing, w, list(var), periodic, seed, 0,
-                                         n_threads)
+                                         n_threads, shape)
     return _core.midpoint_refine_2d(coarse, levels, h, 1.0, spacing, False, periodic, seed, 0, n_threads)
 
 
