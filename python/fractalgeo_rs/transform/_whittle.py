@@ -161,7 +161,7 @@ def _window_sums(a: np.ndarray, k: int) -> np.ndarray:
     return s[k:, k:] - s[:-k, k:] - s[k:, :-k] + s[:-k, :-k]
 
 
-def _fill_contrast(contrast, gram, nf, masks_all, m, n_ord, tables):
+def _fill_contrast(contrast, gram, nf, mv, pos, m, n_ord, tables):
     """Profile contrasts of every window on the grid of H: complete windows
     share one model, the others are grouped by validity mask."""
     full = nf == m * m
@@ -171,7 +171,7 @@ def _fill_contrast(contrast, gram, nf, masks_all, m, n_ord, tables):
         contrast[full] = n_ord * np.log(g @ inv / n_ord) + logsum[None]
     part = np.nonzero(~full)[0]
     if part.size:
-        masks = masks_all[part]
+        masks = mv[pos[0][part], pos[1][part]]  # the masks of the incomplete windows only
         keys = np.packbits(masks.reshape(part.size, -1), axis=1)
         _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
         inverse = inverse.ravel()
@@ -214,29 +214,26 @@ def whittle_grid(z: np.ndarray, w: int, min_valid: float, step: int, n_threads: 
     yv = sliding_window_view(y0, (m, m))[::step, ::step]
     mv = sliding_window_view(yvalid, (m, m))[::step, ::step]
     n_ord = tables.n_ord
-    batch = max(1, (1 << 23) // (m * m * nc))  # ~64 MB of windows per batch
-    for r0 in range(0, nr, batch):
-        r1 = min(nr, r0 + batch)
-        ok = (frac[r0:r1] >= min_valid - 1e-12) & (n_filt[r0:r1] >= _MIN_FILTERED)
-        if not np.any(ok):
-            continue
-        idx = np.nonzero(ok)
-        nf = n_filt[r0:r1][idx]
-        win = yv[r0:r1][idx]  # (n, m, m) copy
+    ok = (frac >= min_valid - 1e-12) & (n_filt >= _MIN_FILTERED)
+    ri, ci = np.nonzero(ok)  # row-major order
+    chunk = max(1, (1 << 23) // (m * m))  # ~64 MB of windows at a time
+    for k0 in range(0, ri.size, chunk):
+        r, c = ri[k0:k0 + chunk], ci[k0:k0 + chunk]
+        nf = n_filt[r, c]
+        win = yv[r, c]  # (n, m, m) copy
         spec = fft.rfft2(win, workers=workers)
         gram = (spec.real**2 + spec.imag**2).reshape(win.shape[0], -1)
-        contrast = np.empty((win.shape[0], _H_GRID.size))
+        del spec, win
+        contrast = np.empty((gram.shape[0], _H_GRID.size))
         with np.errstate(divide="ignore", invalid="ignore"):  # vanishing windows: found below
-            _fill_contrast(contrast, gram, nf, mv[r0:r1][idx], m, n_ord, tables)
+            _fill_contrast(contrast, gram, nf, mv, (r, c), m, n_ord, tables)
         # a vanishing filtered field (constant or planar window): no dimension
         level = np.sum(gram * tables.wk[None], axis=1) / n_ord / nf
-        alive = level > 1e-24 * zabs[r0:r1][idx] ** 2
+        alive = level > 1e-24 * zabs[r, c] ** 2
         alive &= np.all(np.isfinite(contrast), axis=1)
         h, curv = _argmin_cubic(np.where(alive[:, None], contrast, 0.0))
         with np.errstate(invalid="ignore", divide="ignore"):
-            s = np.where(curv > 0, np.sqrt(2.0 / curv), np.nan)
-        d_out = np.where(alive, 3.0 - h, np.nan)
-        s_out = np.where(alive, s, np.nan)
-        dim[r0:r1][idx] = d_out
-        se[r0:r1][idx] = s_out
+            sd = np.where(curv > 0, np.sqrt(2.0 / curv), np.nan)
+        dim[r, c] = np.where(alive, 3.0 - h, np.nan)
+        se[r, c] = np.where(alive, sd, np.nan)
     return dim.astype(np.float32), se.astype(np.float32)
