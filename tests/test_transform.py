@@ -173,13 +173,16 @@ def test_transform_cli_geotiff(tmp_path, capsys):
         assert np.allclose(got, fg.fractal_transform(z, 9), atol=1e-6, equal_nan=True)
     assert "local dimension" in capsys.readouterr().out
     # --step 4: cells 40 m wide whose centres are those of the sampled pixels
-    out = tmp_path / "step.tif"
-    assert main(["transform", str(src), str(out), "--window", "9", "--step", "4", "--method", "whittle"]) == 0
-    with rasterio.open(out) as r:
-        assert r.shape == (32, 32) and r.transform.a == 40.0 and r.transform.e == -40.0
-        assert r.xy(3, 5) == (500000 + (5 * 4 + 0.5) * 10, 4000000 - (3 * 4 + 0.5) * 10)
-        got = r.read(1)
-    assert np.allclose(got, fg.fractal_transform(z, 9, method="whittle", step=4), atol=1e-6, equal_nan=True)
+    ref = fg.fractal_transform(z, 9, method="whittle", step=4)
+    for extra in ([], ["--chunks", "40"]):
+        out = tmp_path / f"step{len(extra)}.tif"
+        assert main(["transform", str(src), str(out), "--window", "9", "--step", "4", "--method", "whittle",
+                     *extra]) == 0
+        with rasterio.open(out) as r:
+            assert r.shape == (32, 32) and r.transform.a == 40.0 and r.transform.e == -40.0
+            assert r.xy(3, 5) == (500000 + (5 * 4 + 0.5) * 10, 4000000 - (3 * 4 + 0.5) * 10)
+            got = r.read(1)
+        assert np.allclose(got, ref, atol=1e-6, equal_nan=True), extra
 
 
 def test_dask_distributed_two_worker_processes():
