@@ -71,9 +71,9 @@ class _Tables:
         # the model depends on the mask only up to a translation (K(h) is a
         # sum over all positions): shift the valid samples to the corner
         # first, so that edge windows of one clipped shape share a model
-        r = np.nonzero(valid.any(axis=1))[0][0]
-        c = np.nonzero(valid.any(axis=0))[0][0]
-        valid = np.roll(valid, (-r, -c), axis=(0, 1))
+        r0 = np.nonzero(valid.any(axis=1))[0][0]
+        c0 = np.nonzero(valid.any(axis=0))[0][0]
+        valid = np.roll(valid, (-r0, -c0), axis=(0, 1))  # only invalid rows/columns wrap
         key = np.packbits(valid).tobytes()
         hit = self.cache.get(key)
         if hit is not None:
