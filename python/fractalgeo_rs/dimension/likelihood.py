@@ -90,6 +90,64 @@ def _lag_autocorrelation(offsets: np.ndarray, weights: np.ndarray) -> Dict[Tuple
     return {d: w for d, w in v.items() if w != 0.0}
 
 
+class _LagPowers:
+    """``sum_d v_d |h + d|^{2H}`` on the lag grid ``h = -n..n-1`` per axis
+    (index ``j`` <-> lag ``j - n``), ``v`` the filter's autocorrelation:
+    ``-1/2`` of it is the filtered field's autocovariance under fBm. The
+    log distances are computed once; each call costs one elementwise power
+    per ``H``."""
+
+    def __init__(self, shape, offsets, weights, spacing):
+        self.shape = tuple(int(n) for n in shape)
+        self.v = _lag_autocorrelation(offsets, weights)
+        r = max(max(abs(t) for t in d) for d in self.v)
+        # log distances on the lag grid extended by the filter radius r
+        axes = [(np.arange(-n - r, n + r) * s) for n, s in zip(self.shape, spacing)]
+        grids = np.meshgrid(*axes, indexing="ij")
+        dist2 = sum(a**2 for a in grids)
+        with np.errstate(divide="ignore"):
+            self.logd = 0.5 * np.log(dist2)
+        self.r = r
+
+    def sums(self, hursts: np.ndarray) -> np.ndarray:
+        """Shape ``(len(hursts), 2 n1, ...)``."""
+        hursts = np.asarray(hursts, dtype=float)
+        ex = (slice(None),) + (None,) * len(self.shape)
+        with np.errstate(under="ignore"):
+            p = np.exp((2.0 * hursts)[ex] * self.logd[None])  # |h|^{2H}, 0 at h = 0
+        c = np.zeros((hursts.size,) + tuple(2 * n for n in self.shape))
+        r = self.r
+        for d, w in self.v.items():
+            sl = (slice(None),) + tuple(slice(r + di, r + di + 2 * n) for di, n in zip(d, self.shape))
+            c += w * p[sl]
+        return c
+
+
+def _lag_kernel(g: np.ndarray) -> np.ndarray:
+    """``K(h) = sum_x g(x) g(x + h)`` on the lag grid of ``g`` (index ``j``
+    <-> lag ``j - n``)."""
+    from scipy import fft
+
+    pad = tuple(2 * n for n in g.shape)
+    G = fft.rfftn(g, s=pad)
+    return fft.fftshift(fft.irfftn(np.abs(G) ** 2, s=pad))
+
+
+def _fold_spectrum(c: np.ndarray, shape, half: bool = False) -> np.ndarray:
+    """``E I(k) = sum_h c(h) K(h) exp(-2 pi i k h / n)`` from ``c K`` on the
+    lag grid (leading axes batched): lags folded modulo ``n``, then one FFT
+    (the result is real). ``half``: the ``rfft`` half spectrum along the
+    last axis."""
+    from scipy import fft
+
+    nd = len(shape)
+    lead = c.shape[: c.ndim - nd]
+    split = lead + sum(((2, n) for n in shape), ())
+    b = c.reshape(split).sum(axis=tuple(len(lead) + 2 * i for i in range(nd)))  # lags i - n and i, both = i (mod n)
+    axes = tuple(range(-nd, 0))
+    return (fft.rfftn(b, axes=axes) if half else fft.fftn(b, axes=axes)).real
+
+
 class _Model:
     """Expected periodogram ``E I(k; H)`` (for ``sigma^2 = 1``) of one
     filtered field observed through the weights ``g`` on a grid.
@@ -98,46 +156,14 @@ class _Model:
     evaluation costs one elementwise power and one FFT of the grid."""
 
     def __init__(self, shape, offsets, weights, g, spacing):
-        from scipy import fft
-
         self.shape = tuple(int(n) for n in shape)
-        nd = len(self.shape)
-        v = _lag_autocorrelation(offsets, weights)
-        r = max(max(abs(t) for t in d) for d in v)
-        # lag kernel K(h) for h = -n..n-1 on each axis (index j <-> h = j - n)
-        pad = tuple(2 * n for n in self.shape)
-        G = fft.rfftn(g, s=pad)
-        kern = fft.irfftn(np.abs(G) ** 2, s=pad)
-        self.kern = fft.fftshift(kern)  # index j <-> lag j - n
-        # log distances on the lag grid extended by the filter radius r
-        axes = [(np.arange(-n - r, n + r) * s) for n, s in zip(self.shape, spacing)]
-        grids = np.meshgrid(*axes, indexing="ij")
-        dist2 = sum(a**2 for a in grids)
-        with np.errstate(divide="ignore"):
-            self.logd = 0.5 * np.log(dist2)
-        self.r = r
-        self.v = v
-        self.nd = nd
+        self.powers = _LagPowers(self.shape, offsets, weights, spacing)
+        self.kern = _lag_kernel(g)
 
     def expected(self, hurst: float) -> np.ndarray:
-        from scipy import fft
-
-        with np.errstate(under="ignore"):
-            p = np.exp((2.0 * hurst) * self.logd)  # |h|^{2H}, 0 at h = 0
-        c = np.zeros(tuple(2 * n for n in self.shape))
-        r = self.r
-        for d, w in self.v.items():
-            sl = tuple(slice(r + di, r + di + 2 * n) for di, n in zip(d, self.shape))
-            c += w * p[sl]
+        c = self.powers.sums(np.array([hurst]))[0]
         c *= -0.5 * self.kern
-        # fold lags modulo n: E I(k) = sum_h c(h) K(h) exp(-2 pi i k h / n)
-        if self.nd == 1:
-            n = self.shape[0]
-            b = c.reshape(2, n).sum(axis=0)  # b[i]: lags i - n and i, both = i (mod n)
-            return fft.fft(b).real
-        n1, n2 = self.shape
-        b = c.reshape(2, n1, 2, n2).sum(axis=(0, 2))
-        return fft.fft2(b).real
+        return _fold_spectrum(c, self.shape)
 
 
 def _periodogram(y: np.ndarray, g: np.ndarray) -> np.ndarray:

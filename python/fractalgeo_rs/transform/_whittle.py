@@ -22,30 +22,12 @@ from typing import Dict, Tuple
 
 import numpy as np
 
-from fractalgeo_rs.dimension.likelihood import _FILTERS_2D, _lag_autocorrelation
+from fractalgeo_rs.dimension.likelihood import _FILTERS_2D, _fold_spectrum, _lag_kernel, _LagPowers
 
 # grid of H: the bounds of fractalgeo_rs.whittle's search, ~0.02 apart
 _H_GRID = np.linspace(0.001, 0.999, 51)
 _FILTER = _FILTERS_2D["square"]
 _MIN_FILTERED = 16  # fractalgeo_rs.whittle needs at least 16 valid filtered samples
-
-
-def _lag_base(m: int) -> np.ndarray:
-    """``c_H(h) = -1/2 sum_d v_d |h + d|^{2H}`` for every grid ``H`` on the
-    lag grid ``h = -m..m-1`` per axis (index ``j`` <-> lag ``j - m``)."""
-    offsets = np.array(list(_FILTER.keys()), dtype=np.int64)
-    weights = np.array(list(_FILTER.values()), dtype=float)
-    v = _lag_autocorrelation(offsets, weights)
-    lag = np.arange(-m, m)
-    out = np.zeros((_H_GRID.size, 2 * m, 2 * m))
-    for (d0, d1), wv in v.items():
-        r2 = (lag[:, None] + d0) ** 2 + (lag[None, :] + d1) ** 2
-        with np.errstate(divide="ignore"):
-            logd = 0.5 * np.log(r2.astype(float))
-        with np.errstate(under="ignore"):
-            p = np.exp((2.0 * _H_GRID)[:, None, None] * logd[None])  # 0 at distance 0
-        out += wv * p
-    return -0.5 * out
 
 
 class _Tables:
@@ -55,7 +37,10 @@ class _Tables:
 
     def __init__(self, m: int):
         self.m = m
-        self.base = _lag_base(m)
+        offsets = np.array(list(_FILTER.keys()), dtype=np.int64)
+        weights = np.array(list(_FILTER.values()), dtype=float)
+        # sum_d v_d |h + d|^{2H} for every grid H: shared by all masks
+        self.powers = _LagPowers((m, m), offsets, weights, (1.0, 1.0)).sums(_H_GRID)
         nk = m // 2 + 1
         wk = np.full((m, nk), 2.0)
         wk[:, 0] = 1.0
@@ -78,15 +63,10 @@ class _Tables:
         hit = self.cache.get(key)
         if hit is not None:
             return hit
-        from scipy import fft
-
         m = self.m
         g = valid / math.sqrt(float(np.count_nonzero(valid)))
-        G = fft.rfft2(g, s=(2 * m, 2 * m))
-        kern = fft.fftshift(fft.irfft2(np.abs(G) ** 2, s=(2 * m, 2 * m)))
-        c = self.base * kern[None]
-        b = c.reshape(-1, 2, m, 2, m).sum(axis=(1, 3))  # fold the lags modulo m
-        f = fft.rfft2(b).real.reshape(b.shape[0], -1)
+        c = self.powers * (-0.5 * _lag_kernel(g))[None]
+        f = _fold_spectrum(c, (m, m), half=True).reshape(_H_GRID.size, -1)
         f = np.maximum(f, 1e-300 * np.max(np.abs(f), axis=1, keepdims=True))
         inv = np.ascontiguousarray((self.wk[None, :] / f).T)
         logsum = np.log(f) @ self.wk
@@ -144,8 +124,7 @@ def _argmin_cubic(c: np.ndarray):
         for root in ((-B + sq) / (2.0 * A), (-B - sq) / (2.0 * A), -C / B):
             ok = np.isfinite(root) & (root >= t_lo) & (root <= t_hi)
             cand.append(np.where(ok, root, t0))
-    cand = np.stack(cand, axis=1)
-    t = cand
+    t = cand = np.stack(cand, axis=1)
     vals = y[:, :1] + a1[:, None] * t + a2[:, None] * t * (t - 1) + a3[:, None] * t * (t - 1) * (t - 2)
     best = np.take_along_axis(cand, np.argmin(vals, axis=1)[:, None], axis=1)[:, 0]
     h = _H_GRID[s] + best * dh
@@ -228,7 +207,7 @@ def whittle_grid(z: np.ndarray, w: int, min_valid: float, step: int, n_threads: 
         with np.errstate(divide="ignore", invalid="ignore"):  # vanishing windows: found below
             _fill_contrast(contrast, gram, nf, mv, (r, c), m, n_ord, tables)
         # a vanishing filtered field (constant or planar window): no dimension
-        level = np.sum(gram * tables.wk[None], axis=1) / n_ord / nf
+        level = gram @ tables.wk / n_ord / nf
         alive = level > 1e-24 * zabs[r, c] ** 2
         alive &= np.all(np.isfinite(contrast), axis=1)
         h, curv = _argmin_cubic(np.where(alive[:, None], contrast, 0.0))
