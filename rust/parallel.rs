@@ -1,9 +1,16 @@
 //! Thread pools sized by the caller's `n_threads`.
 //!
-//! Every public kernel runs inside a freshly built rayon pool instead of the
-//! global one. Building a pool costs tens of microseconds, and a fresh pool is
-//! safe after `fork()` (rayon's global pool is not: a forked child's first
-//! parallel call can hang), which matters for multiprocessing and Dask workers.
+//! Every public kernel runs inside a rayon pool of its own size instead of the
+//! global one. Pools are built once per thread count and kept (starting
+//! threads costs tens of microseconds, as much as a whole small kernel). A
+//! forked child does not have its parent's pool threads, so the cache
+//! remembers the process id and a child never touches the parent's pools: it
+//! builds its own (rayon's global pool has no such guard, and a forked child's
+//! first parallel call on it can hang), which matters for multiprocessing and
+//! Dask workers. If the cache is busy (another thread is looking up a pool, or
+//! a fork happened while it was), the call builds a private pool, as before.
+use std::sync::{Arc, Mutex};
+
 use crate::error::{CoreError, CoreResult};
 
 /// Resolve `n_threads`: `None` or `Some(0)` means all available cores.
@@ -16,6 +23,57 @@ pub fn resolve_threads(n_threads: Option<usize>) -> usize {
     }
 }
 
+/// Pools kept per thread count, with the process that built them.
+struct PoolCache {
+    pid: u32,
+    pools: Vec<(usize, Arc<rayon::ThreadPool>)>,
+}
+
+static POOLS: Mutex<Option<PoolCache>> = Mutex::new(None);
+
+/// At most this many thread counts keep a pool.
+const MAX_POOLS: usize = 4;
+
+fn build_pool(n: usize) -> CoreResult<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build()
+        .map_err(|e| CoreError::Internal(format!("cannot start a thread pool of {n}: {e}")))
+}
+
+/// The kept pool of `n` threads of this process, built on first use.
+fn pool_of(n: usize) -> CoreResult<Arc<rayon::ThreadPool>> {
+    match POOLS.try_lock() {
+        Ok(mut guard) => lookup(&mut guard, std::process::id(), n),
+        Err(_) => build_pool(n).map(Arc::new),
+    }
+}
+
+/// Find or build the pool of `n` threads in `cache`, for process `pid`.
+fn lookup(cache: &mut Option<PoolCache>, pid: u32, n: usize) -> CoreResult<Arc<rayon::ThreadPool>> {
+    let cache = cache.get_or_insert_with(|| PoolCache {
+        pid,
+        pools: Vec::new(),
+    });
+    if cache.pid != pid {
+        // a forked child: the parent's worker threads do not exist here, so
+        // its pools are neither used nor dropped (dropping signals them)
+        for (_, p) in cache.pools.drain(..) {
+            std::mem::forget(p);
+        }
+        cache.pid = pid;
+    }
+    if let Some((_, p)) = cache.pools.iter().find(|(k, _)| *k == n) {
+        return Ok(p.clone());
+    }
+    let pool = Arc::new(build_pool(n)?);
+    if cache.pools.len() >= MAX_POOLS {
+        cache.pools.remove(0);
+    }
+    cache.pools.push((n, pool.clone()));
+    Ok(pool)
+}
+
 /// Run `f` in a rayon pool of `n_threads` threads. A panic inside `f` is
 /// caught and turned into [`CoreError::Internal`], so it never unwinds into
 /// the caller (and never reaches Python).
@@ -25,10 +83,7 @@ where
     F: FnOnce() -> CoreResult<T> + Send,
 {
     let n = resolve_threads(n_threads);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(n)
-        .build()
-        .map_err(|e| CoreError::Internal(format!("cannot start a thread pool of {n}: {e}")))?;
+    let pool = pool_of(n)?;
     let result = pool.install(|| std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)));
     match result {
         Ok(r) => r,
@@ -57,5 +112,30 @@ mod tests {
         );
         let r: CoreResult<()> = run_in_pool(Some(1), || panic!("boom"));
         assert_eq!(r, Err(CoreError::Internal("boom".into())));
+        // the pool survives a caught panic and is reused
+        assert_eq!(
+            run_in_pool(Some(1), || Ok(rayon::current_num_threads())).unwrap(),
+            1
+        );
+    }
+
+    #[test]
+    fn pools_are_kept_per_thread_count_and_process() {
+        let mut cache = None;
+        let a = lookup(&mut cache, 10, 3).unwrap();
+        assert_eq!(a.current_num_threads(), 3);
+        assert!(Arc::ptr_eq(&a, &lookup(&mut cache, 10, 3).unwrap()));
+        let b = lookup(&mut cache, 10, 2).unwrap();
+        assert_eq!(b.current_num_threads(), 2);
+        assert!(!Arc::ptr_eq(&a, &b));
+        // another process id (a forked child) never gets the parent's pools
+        let c = lookup(&mut cache, 11, 3).unwrap();
+        assert!(!Arc::ptr_eq(&a, &c));
+        assert_eq!(cache.as_ref().unwrap().pools.len(), 1);
+        // at most MAX_POOLS thread counts are kept
+        for n in 1..=MAX_POOLS + 2 {
+            lookup(&mut cache, 11, n).unwrap();
+        }
+        assert_eq!(cache.as_ref().unwrap().pools.len(), MAX_POOLS);
     }
 }

@@ -92,15 +92,41 @@ struct Src<'a> {
     shape: Shape3,
 }
 
-/// Index of the first nonzero byte, scanning eight bytes at a time.
+/// Whether a 64-byte block holds a nonzero byte (SSE2: four loads OR-ed, one test).
+#[inline(always)]
+fn block_nonzero(b: &[u8]) -> bool {
+    debug_assert_eq!(b.len(), 64);
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::*;
+        assert!(b.len() >= 64);
+        // SAFETY: SSE2 is part of the x86_64 baseline; four unaligned 16-byte
+        // loads at offsets 0, 16, 32 and 48 stay inside the 64 bytes checked above.
+        unsafe {
+            let p = b.as_ptr() as *const __m128i;
+            let x = _mm_or_si128(
+                _mm_or_si128(_mm_loadu_si128(p), _mm_loadu_si128(p.add(1))),
+                _mm_or_si128(_mm_loadu_si128(p.add(2)), _mm_loadu_si128(p.add(3))),
+            );
+            _mm_movemask_epi8(_mm_cmpeq_epi8(x, _mm_setzero_si128())) != 0xFFFF
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        b.chunks_exact(8)
+            .fold(0u64, |a, w| a | u64::from_le_bytes(w.try_into().unwrap()))
+            != 0
+    }
+}
+
+/// Index of the first nonzero byte, skipping zero blocks of 64 bytes.
 #[inline]
 fn first_nonzero(row: &[u8]) -> Option<usize> {
-    let words = row.chunks_exact(8);
-    let rem_start = row.len() - words.remainder().len();
-    for (k, w) in words.enumerate() {
-        let v = u64::from_le_bytes(w.try_into().unwrap());
-        if v != 0 {
-            return Some(k * 8 + (v.trailing_zeros() / 8) as usize);
+    let blocks = row.chunks_exact(64);
+    let rem_start = row.len() - blocks.remainder().len();
+    for (k, b) in blocks.enumerate() {
+        if block_nonzero(b) {
+            return b.iter().position(|&v| v != 0).map(|p| 64 * k + p);
         }
     }
     row[rem_start..]
@@ -109,15 +135,15 @@ fn first_nonzero(row: &[u8]) -> Option<usize> {
         .map(|p| rem_start + p)
 }
 
-/// Index of the last nonzero byte, scanning eight bytes at a time from the end.
+/// Index of the last nonzero byte, skipping zero blocks of 64 bytes from the end.
 #[inline]
 fn last_nonzero(row: &[u8]) -> Option<usize> {
-    let words = row.rchunks_exact(8);
-    let rem_len = words.remainder().len();
-    for (k, w) in words.enumerate() {
-        let v = u64::from_le_bytes(w.try_into().unwrap());
-        if v != 0 {
-            return Some(row.len() - 8 * (k + 1) + 7 - (v.leading_zeros() / 8) as usize);
+    let blocks = row.rchunks_exact(64);
+    let rem_len = blocks.remainder().len();
+    for (k, b) in blocks.enumerate() {
+        if block_nonzero(b) {
+            let start = row.len() - 64 * (k + 1);
+            return b.iter().rposition(|&v| v != 0).map(|p| start + p);
         }
     }
     row[..rem_len].iter().rposition(|&v| v != 0)
@@ -324,6 +350,388 @@ fn reduce_or(src: &Src, m: Shape3, c: Shape3) -> (Grid, u64, u64) {
     )
 }
 
+/// Nonzero bytes of a 16-byte vector, accumulated as 0/1 per lane.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn nz_acc(
+    acc: std::arch::x86_64::__m128i,
+    x: std::arch::x86_64::__m128i,
+) -> std::arch::x86_64::__m128i {
+    use std::arch::x86_64::*;
+    _mm_add_epi8(acc, _mm_min_epu8(x, _mm_set1_epi8(1)))
+}
+
+/// Horizontal sum of the byte lanes of `acc`.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn lane_sum(acc: std::arch::x86_64::__m128i) -> u64 {
+    use std::arch::x86_64::*;
+    let s = _mm_sad_epu8(acc, _mm_setzero_si128());
+    (_mm_cvtsi128_si64(s) + _mm_cvtsi128_si64(_mm_unpackhi_epi64(s, s))) as u64
+}
+
+/// SSE2 body of [`level_row`] over the first `32 * n` bytes of `a` and `b`.
+/// Returns (nonzero output bytes, nonzero bytes of `a`, nonzero bytes of `b`).
+#[cfg(target_arch = "x86_64")]
+fn level_row_sse2(a: &[u8], b: &[u8], out: &mut [u8], n: usize, count_in: bool) -> (u64, u64, u64) {
+    use std::arch::x86_64::*;
+    assert!(a.len() >= 32 * n && b.len() >= 32 * n && out.len() >= 16 * n);
+    let (mut c_out, mut c_a, mut c_b) = (0u64, 0u64, 0u64);
+    // SAFETY: SSE2 is part of the x86_64 baseline; the assert above keeps
+    // every unaligned load (32 bytes of `a` and of `b` per step) and store
+    // (16 bytes of `out` per step) inside the slices.
+    unsafe {
+        let mask = _mm_set1_epi16(0x00FF);
+        let (pa, pb, po) = (a.as_ptr(), b.as_ptr(), out.as_mut_ptr());
+        let mut k = 0;
+        while k < n {
+            // byte lanes count at most 2 per step: flush before 127 steps
+            let end = (k + 120).min(n);
+            let (mut ao, mut aa, mut ab) = (
+                _mm_setzero_si128(),
+                _mm_setzero_si128(),
+                _mm_setzero_si128(),
+            );
+            while k < end {
+                let a0 = _mm_loadu_si128(pa.add(32 * k) as *const __m128i);
+                let a1 = _mm_loadu_si128(pa.add(32 * k + 16) as *const __m128i);
+                let b0 = _mm_loadu_si128(pb.add(32 * k) as *const __m128i);
+                let b1 = _mm_loadu_si128(pb.add(32 * k + 16) as *const __m128i);
+                if count_in {
+                    aa = nz_acc(nz_acc(aa, a0), a1);
+                    ab = nz_acc(nz_acc(ab, b0), b1);
+                }
+                let x0 = _mm_or_si128(a0, b0);
+                let x1 = _mm_or_si128(a1, b1);
+                let y0 = _mm_and_si128(_mm_or_si128(x0, _mm_srli_epi16(x0, 8)), mask);
+                let y1 = _mm_and_si128(_mm_or_si128(x1, _mm_srli_epi16(x1, 8)), mask);
+                let v = _mm_packus_epi16(y0, y1);
+                ao = nz_acc(ao, v);
+                _mm_storeu_si128(po.add(16 * k) as *mut __m128i, v);
+                k += 1;
+            }
+            c_out += lane_sum(ao);
+            c_a += lane_sum(aa);
+            c_b += lane_sum(ab);
+        }
+    }
+    (c_out, c_a, c_b)
+}
+
+/// AVX2 body of [`level_row`] over the first `64 * n` bytes of `a` and `b`
+/// (the same operation as [`level_row_sse2`], 32 output bytes per step).
+///
+/// # Safety
+/// The CPU must support AVX2 (checked by the caller at run time).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn level_row_avx2(
+    a: &[u8],
+    b: &[u8],
+    out: &mut [u8],
+    n: usize,
+    count_in: bool,
+) -> (u64, u64, u64) {
+    use std::arch::x86_64::*;
+    assert!(a.len() >= 64 * n && b.len() >= 64 * n && out.len() >= 32 * n);
+    let sum = |acc: __m256i| -> u64 {
+        let s = _mm256_sad_epu8(acc, _mm256_setzero_si256());
+        let s = _mm_add_epi64(_mm256_castsi256_si128(s), _mm256_extracti128_si256(s, 1));
+        (_mm_cvtsi128_si64(s) + _mm_cvtsi128_si64(_mm_unpackhi_epi64(s, s))) as u64
+    };
+    let (mut c_out, mut c_a, mut c_b) = (0u64, 0u64, 0u64);
+    let mask = _mm256_set1_epi16(0x00FF);
+    let one = _mm256_set1_epi8(1);
+    let (pa, pb, po) = (a.as_ptr(), b.as_ptr(), out.as_mut_ptr());
+    let mut k = 0;
+    while k < n {
+        // byte lanes count at most 2 per step: flush before 127 steps
+        let end = (k + 120).min(n);
+        let (mut ao, mut aa, mut ab) = (
+            _mm256_setzero_si256(),
+            _mm256_setzero_si256(),
+            _mm256_setzero_si256(),
+        );
+        while k < end {
+            // SAFETY: the assert above keeps the unaligned loads (64 bytes of
+            // `a` and of `b` per step) and the store (32 bytes) inside the slices.
+            let a0 = _mm256_loadu_si256(pa.add(64 * k) as *const __m256i);
+            let a1 = _mm256_loadu_si256(pa.add(64 * k + 32) as *const __m256i);
+            let b0 = _mm256_loadu_si256(pb.add(64 * k) as *const __m256i);
+            let b1 = _mm256_loadu_si256(pb.add(64 * k + 32) as *const __m256i);
+            if count_in {
+                aa = _mm256_add_epi8(
+                    aa,
+                    _mm256_add_epi8(_mm256_min_epu8(a0, one), _mm256_min_epu8(a1, one)),
+                );
+                ab = _mm256_add_epi8(
+                    ab,
+                    _mm256_add_epi8(_mm256_min_epu8(b0, one), _mm256_min_epu8(b1, one)),
+                );
+            }
+            let x0 = _mm256_or_si256(a0, b0);
+            let x1 = _mm256_or_si256(a1, b1);
+            let y0 = _mm256_and_si256(_mm256_or_si256(x0, _mm256_srli_epi16(x0, 8)), mask);
+            let y1 = _mm256_and_si256(_mm256_or_si256(x1, _mm256_srli_epi16(x1, 8)), mask);
+            // packus works within 128-bit lanes: restore the order of the quarters
+            let v = _mm256_permute4x64_epi64(_mm256_packus_epi16(y0, y1), 0b11_01_10_00);
+            ao = _mm256_add_epi8(ao, _mm256_min_epu8(v, one));
+            _mm256_storeu_si256(po.add(32 * k) as *mut __m256i, v);
+            k += 1;
+        }
+        c_out += sum(ao);
+        c_a += sum(aa);
+        c_b += sum(ab);
+    }
+    (c_out, c_a, c_b)
+}
+
+/// One row of the next dyadic level: `out[k] = a[2k] | a[2k+1] | b[2k] | b[2k+1]`
+/// (samples past the end, and the whole of an absent `b`, are background);
+/// `out.len() == ceil(a.len() / 2)`. Returns the nonzero bytes of `out` and,
+/// when `count_in`, those of `a` and of `b`.
+fn level_row(a: &[u8], b: Option<&[u8]>, out: &mut [u8], count_in: bool) -> (u64, u64, u64) {
+    debug_assert_eq!(out.len(), a.len().div_ceil(2));
+    let bb = b.unwrap_or(a); // OR with itself changes nothing
+    debug_assert_eq!(bb.len(), a.len());
+    #[cfg(target_arch = "x86_64")]
+    let (n, mut c_out, mut c_a, mut c_b) = {
+        let (mut done, mut o, mut ca, mut cb) = (0, 0, 0, 0);
+        if std::arch::is_x86_feature_detected!("avx2") {
+            let n64 = a.len() / 64;
+            // SAFETY: AVX2 is present (checked just above).
+            (o, ca, cb) = unsafe { level_row_avx2(a, bb, out, n64, count_in) };
+            done = 64 * n64;
+        }
+        let n32 = (a.len() - done) / 32;
+        let r = level_row_sse2(&a[done..], &bb[done..], &mut out[done / 2..], n32, count_in);
+        (done + 32 * n32, o + r.0, ca + r.1, cb + r.2)
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let (n, mut c_out, mut c_a, mut c_b) = (0usize, 0u64, 0u64, 0u64);
+    for (k, o) in out.iter_mut().enumerate().skip(n / 2) {
+        let i = 2 * k;
+        let (a0, a1) = (a[i], a.get(i + 1).copied().unwrap_or(0));
+        let (b0, b1) = (bb[i], bb.get(i + 1).copied().unwrap_or(0));
+        *o = a0 | a1 | b0 | b1;
+        c_out += (*o != 0) as u64;
+        if count_in {
+            c_a += (a0 != 0) as u64 + (a1 != 0) as u64;
+            c_b += (b0 != 0) as u64 + (b1 != 0) as u64;
+        }
+    }
+    (c_out, c_a, if b.is_some() { c_b } else { 0 })
+}
+
+/// Row buffers of one band of [`dyadic_2d`]: per level, a row waiting for its
+/// pair and a row being built.
+struct Cascade {
+    pending: Vec<Vec<u8>>,
+    has: Vec<bool>,
+    tmp: Vec<Vec<u8>>,
+}
+
+impl Cascade {
+    fn new(n2: usize, k: usize) -> Self {
+        let rows = || {
+            (0..=k)
+                .map(|l| vec![0u8; n_boxes(n2, 1 << l, 0)])
+                .collect::<Vec<_>>()
+        };
+        Cascade {
+            pending: rows(),
+            has: vec![false; k + 1],
+            tmp: rows(),
+        }
+    }
+
+    /// A new row of level `l` is in `tmp[l]` (already counted): pair it with
+    /// the waiting one, or wait; the level-`k` row goes to `out`.
+    fn push(&mut self, mut l: usize, k: usize, counts: &mut [u64], out: &mut [u8]) {
+        loop {
+            if l == k {
+                out.copy_from_slice(&self.tmp[l]);
+                return;
+            }
+            if !self.has[l] {
+                std::mem::swap(&mut self.pending[l], &mut self.tmp[l]);
+                self.has[l] = true;
+                return;
+            }
+            let (lo, hi) = self.tmp.split_at_mut(l + 1);
+            counts[l] += level_row(&self.pending[l], Some(&lo[l]), &mut hi[0], false).0;
+            self.has[l] = false;
+            l += 1;
+        }
+    }
+
+    /// End of a band: rows still waiting pair with background.
+    fn flush(&mut self, k: usize, counts: &mut [u64], out: &mut [u8]) {
+        for l in 1..k {
+            if self.has[l] {
+                self.has[l] = false;
+                let (_, hi) = self.tmp.split_at_mut(l + 1);
+                counts[l] += level_row(&self.pending[l], None, &mut hi[0], false).0;
+                self.push(l + 1, k, counts, out);
+            }
+        }
+    }
+}
+
+/// Result of [`dyadic_2d`].
+struct Dyadic {
+    /// `counts[l - 1]`: occupied boxes of size 2^l, l = 1..=k.
+    counts: Vec<u64>,
+    /// Nonzero source samples.
+    n_fg: u64,
+    /// Occupancy at size 2^k.
+    grid: Grid,
+    /// Bounding box of the foreground in source coordinates, rows then
+    /// columns: (first, one past the last); None when the source is empty.
+    bbox: Option<([usize; 2], [usize; 2])>,
+}
+
+/// Bounding box of a band: rows and columns, (first, one past the last).
+type Bounds = ([usize; 2], [usize; 2]);
+
+fn merge_bounds(a: Option<Bounds>, b: Option<Bounds>) -> Option<Bounds> {
+    match (a, b) {
+        (Some(x), Some(y)) => Some((
+            [x.0[0].min(y.0[0]), x.0[1].min(y.0[1])],
+            [x.1[0].max(y.1[0]), x.1[1].max(y.1[1])],
+        )),
+        (x, None) => x,
+        (None, y) => y,
+    }
+}
+
+/// Columns (first, one past the last) of the foreground of source rows `a`
+/// and `b` that lie outside `known`, found from their level-1 row `l1`
+/// (only its part outside `known` is searched).
+fn row_columns(
+    a: &[u8],
+    b: Option<&[u8]>,
+    l1: &[u8],
+    known: Option<[usize; 2]>,
+) -> Option<[usize; 2]> {
+    let at =
+        |i: usize| a.get(i).copied().unwrap_or(0) | b.and_then(|b| b.get(i).copied()).unwrap_or(0);
+    // level-1 cells before / after the known columns
+    let (lo_end, hi_start) = match known {
+        Some([lo, hi]) => (
+            lo.div_ceil(2).min(l1.len()),
+            (hi.saturating_sub(1) / 2).min(l1.len()),
+        ),
+        None => (l1.len(), 0),
+    };
+    let first =
+        first_nonzero(&l1[..lo_end]).map(|f| if at(2 * f) != 0 { 2 * f } else { 2 * f + 1 });
+    let last = last_nonzero(&l1[hi_start..])
+        .map(|l| hi_start + l)
+        .map(|l| {
+            if at(2 * l + 1) != 0 {
+                2 * l + 2
+            } else {
+                2 * l + 1
+            }
+        });
+    match (known, first, last) {
+        (None, Some(f), Some(l)) => Some([f, l]),
+        (None, _, _) => None,
+        (Some([lo, hi]), f, l) => Some([f.unwrap_or(lo).min(lo), l.unwrap_or(hi).max(hi)]),
+    }
+}
+
+/// The unshifted dyadic lattice of a 2D source (`src.shape[0] == 1`) at box
+/// sizes 2, 4, ..., 2^k in one read of the data: each band of 2^k rows is
+/// reduced level by level through row buffers that stay in cache, and only
+/// its level-k row is stored. The foreground's bounding box is found on the
+/// way (rows from the per-row counts, columns from the level-1 rows).
+fn dyadic_2d(src: &Src, k: usize) -> Dyadic {
+    debug_assert!(k >= 1 && src.shape[0] == 1);
+    let (n1, n2) = (src.shape[1], src.shape[2]);
+    let band = 1usize << k;
+    let shape = [1, n_boxes(n1, band, 0), n_boxes(n2, band, 0)];
+    let mut data = vec![0u8; shape[1] * shape[2]];
+    let row = |i: usize| {
+        let off = src.start + i * src.strides[1];
+        &src.data[off..off + n2]
+    };
+    let (counts, n_fg, bbox) = data
+        .par_chunks_mut(shape[2])
+        .enumerate()
+        .map_init(
+            || Cascade::new(n2, k),
+            |cas, (b, out)| {
+                // counts[l] is level l + 1 (size 2^(l + 1))
+                let mut counts = vec![0u64; k];
+                let mut n_fg = 0u64;
+                let mut rows: Option<[usize; 2]> = None;
+                let mut cols: Option<[usize; 2]> = None;
+                let (r0, r1) = (b * band, ((b + 1) * band).min(n1));
+                for i in (r0..r1).step_by(2) {
+                    let second = (i + 1 < r1).then(|| row(i + 1));
+                    let (c, ca, cb) = level_row(row(i), second, &mut cas.tmp[1], true);
+                    counts[0] += c;
+                    n_fg += ca + cb;
+                    if c > 0 {
+                        let (f, l) = (
+                            if ca > 0 { i } else { i + 1 },
+                            if cb > 0 { i + 2 } else { i + 1 },
+                        );
+                        rows = Some(rows.map_or([f, l], |[a, z]| [a.min(f), z.max(l)]));
+                        cols = row_columns(row(i), second, &cas.tmp[1], cols);
+                    }
+                    cas.push(1, k, &mut counts[..], out);
+                }
+                cas.flush(k, &mut counts[..], out);
+                let bounds = rows.zip(cols).map(|(r, c)| ([r[0], c[0]], [r[1], c[1]]));
+                (counts, n_fg, bounds)
+            },
+        )
+        .reduce(
+            || (vec![0u64; k], 0u64, None),
+            |(mut a, na, ba), (b, nb, bb)| {
+                a.iter_mut().zip(&b).for_each(|(x, y)| *x += y);
+                (a, na + nb, merge_bounds(ba, bb))
+            },
+        );
+    Dyadic {
+        counts,
+        n_fg,
+        grid: Grid { data, shape },
+        bbox,
+    }
+}
+
+/// The `rows x cols` window of a 2D grid that starts at (`r0`, `c0`).
+fn crop_grid(g: &Grid, r0: usize, c0: usize, rows: usize, cols: usize) -> Grid {
+    let w = g.shape[2];
+    let mut data = Vec::with_capacity(rows * cols);
+    for r in r0..r0 + rows {
+        data.extend_from_slice(&g.data[r * w + c0..r * w + c0 + cols]);
+    }
+    Grid {
+        data,
+        shape: [1, rows, cols],
+    }
+}
+
+/// Depth of the fused dyadic pass for these sizes: the longest chain 2, 4,
+/// ..., 2^k among them, shortened until the rows split into enough bands to
+/// keep every thread busy.
+fn dyadic_depth(sizes: &[usize], n_rows: usize) -> usize {
+    let mut k = 0;
+    while sizes.contains(&(1usize << (k + 1))) {
+        k += 1;
+    }
+    let min_bands = 4 * rayon::current_num_threads();
+    while k > 0 && n_boxes(n_rows, 1 << k, 0) < min_bands {
+        k -= 1;
+    }
+    k
+}
+
 /// Default box sizes for a set whose bounding box spans `extent` samples along
 /// its longest axis.
 ///
@@ -383,28 +791,54 @@ pub fn box_count(
         return Err(CoreError::invalid("offsets", "must be a positive integer"));
     }
     let max_len = *vol.shape.iter().max().unwrap_or(&0);
-    if !box_sizes.is_empty() {
-        validate_box_sizes(box_sizes, max_len)?;
-    }
-    let Some((bmin, bmax)) = scan(vol) else {
-        return Err(CoreError::invalid(
-            "data",
-            "the set is empty (no foreground sample)",
-        ));
+    let given = if box_sizes.is_empty() {
+        None
+    } else {
+        Some(validate_box_sizes(box_sizes, max_len)?)
+    };
+    let empty = || CoreError::invalid("data", "the set is empty (no foreground sample)");
+    // A 2D set with given sizes that start a dyadic chain: the unshifted
+    // lattice of the whole array is counted in one fused pass, which finds the
+    // bounding box on the way (no separate scan). Its counts are kept when
+    // that lattice is the one asked for: anchored at the array, or at a
+    // bounding box that starts on it.
+    let mut pre: Option<(usize, Dyadic)> = None;
+    let pre_depth = match &given {
+        Some(sz) if vol.shape[0] == 1 => dyadic_depth(sz, vol.shape[1]),
+        _ => 0,
+    };
+    let (bmin, bmax) = if pre_depth > 0 {
+        let [_, n1, n2] = vol.shape;
+        let full = Src {
+            data: vol.data,
+            start: 0,
+            strides: [n1 * n2, n2],
+            shape: vol.shape,
+        };
+        let d = dyadic_2d(&full, pre_depth);
+        let (lo, hi) = d.bbox.ok_or_else(empty)?;
+        let step = 1 << pre_depth;
+        if anchor == Anchor::Array || (lo[0] % step == 0 && lo[1] % step == 0) {
+            pre = Some((pre_depth, d));
+        }
+        ([0, lo[0], lo[1]], [1, hi[0], hi[1]])
+    } else {
+        scan(vol).ok_or_else(empty)?
     };
     // the number of foreground samples (the count at size 1) comes from the
     // first reduction of the data, which reads every sample once
     let mut n_fg: Option<u64> = None;
-    let sizes = if box_sizes.is_empty() {
-        let extent = (0..3).map(|a| bmax[a] - bmin[a]).max().unwrap_or(1);
-        validate_box_sizes(&default_box_sizes(extent), max_len).map_err(|_| {
-            CoreError::invalid(
-                "data",
-                format!("the set spans only {extent} samples: too small for the default box sizes (give box_sizes)"),
-            )
-        })?
-    } else {
-        validate_box_sizes(box_sizes, max_len)?
+    let sizes = match given {
+        Some(sz) => sz,
+        None => {
+            let extent = (0..3).map(|a| bmax[a] - bmin[a]).max().unwrap_or(1);
+            validate_box_sizes(&default_box_sizes(extent), max_len).map_err(|_| {
+                CoreError::invalid(
+                    "data",
+                    format!("the set spans only {extent} samples: too small for the default box sizes (give box_sizes)"),
+                )
+            })?
+        }
     };
     let (lo, hi) = match anchor {
         Anchor::BoundingBox => (bmin, bmax),
@@ -425,9 +859,45 @@ pub fn box_count(
         // computed grids of this lattice, by size (ascending)
         let mut done: Vec<usize> = Vec::new();
         let mut grids: Vec<Grid> = Vec::new();
+        // 2D, unshifted lattice: sizes 2, 4, ..., 2^k in one fused pass
+        let fused = if *g != [0; 3] || vol.shape[0] != 1 {
+            None
+        } else if let Some((k, d)) = pre.take() {
+            // counted on the whole array: crop the grid to the lattice's origin
+            let cropped = if lo == [0; 3] {
+                d.grid
+            } else {
+                crop_grid(
+                    &d.grid,
+                    lo[1] >> k,
+                    lo[2] >> k,
+                    n_boxes(shape[1], 1 << k, 0),
+                    n_boxes(shape[2], 1 << k, 0),
+                )
+            };
+            Some((k, Dyadic { grid: cropped, ..d }))
+        } else {
+            let k = dyadic_depth(&sizes, shape[1]);
+            (k > 0).then(|| (k, dyadic_2d(&base, k)))
+        };
+        let fused = match fused {
+            Some((k, d)) => {
+                for (l, c) in d.counts.into_iter().enumerate() {
+                    let i = sizes.binary_search(&(2 << l)).map_err(|_| {
+                        CoreError::Internal("dyadic size missing from the size list".into())
+                    })?;
+                    counts[i][j] = c;
+                }
+                n_fg.get_or_insert(d.n_fg);
+                done.push(1 << k);
+                grids.push(d.grid);
+                k
+            }
+            None => 0,
+        };
         for (i, &s) in sizes.iter().enumerate() {
-            if s == 1 {
-                continue; // filled in below from n_fg
+            if s == 1 || (s.is_power_of_two() && s <= 1 << fused) {
+                continue; // size 1 is filled in below from n_fg
             }
             let t = best_source(s, &done);
             let m_ = s / t;
@@ -454,8 +924,10 @@ pub fn box_count(
                 (g, cnt)
             };
             counts[i][j] = cnt;
-            done.push(s);
-            grids.push(grid);
+            // keep `done` ascending (best_source takes the largest divisor)
+            let pos = done.partition_point(|&d| d < s);
+            done.insert(pos, s);
+            grids.insert(pos, grid);
         }
     }
     let n_fg =
@@ -609,6 +1081,193 @@ mod tests {
                     let mut out = prev[..nout].to_vec();
                     pair_or_into(&row, c, &mut out, first);
                     assert_eq!(out, expect(first), "len={len} c={c} first={first}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn first_and_last_nonzero_match_scalar() {
+        let mut seed = 31u64;
+        for len in 0..400usize {
+            for _ in 0..4 {
+                let mut row = vec![0u8; len];
+                let nnz = lcg(&mut seed) % 4;
+                for _ in 0..nnz.min(len as u64) {
+                    let i = (lcg(&mut seed) as usize) % len;
+                    row[i] = 1 + (lcg(&mut seed) % 255) as u8;
+                }
+                assert_eq!(
+                    first_nonzero(&row),
+                    row.iter().position(|&v| v != 0),
+                    "len={len}"
+                );
+                assert_eq!(
+                    last_nonzero(&row),
+                    row.iter().rposition(|&v| v != 0),
+                    "len={len}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn level_row_matches_scalar_for_all_lengths() {
+        let mut seed = 23u64;
+        for len in 0..300usize {
+            // any nonzero byte is foreground, not only 1
+            let mut byte = |p: u64| -> u8 {
+                if lcg(&mut seed) % p == 0 {
+                    1 + (lcg(&mut seed) % 255) as u8
+                } else {
+                    0
+                }
+            };
+            let a: Vec<u8> = (0..len).map(|_| byte(3)).collect();
+            let b: Vec<u8> = (0..len).map(|_| byte(4)).collect();
+            for with_b in [false, true] {
+                let nout = len.div_ceil(2);
+                let expect: Vec<bool> = (0..nout)
+                    .map(|k| {
+                        let hi = (2 * k + 2).min(len);
+                        a[2 * k..hi].iter().any(|&v| v != 0)
+                            || (with_b && b[2 * k..hi].iter().any(|&v| v != 0))
+                    })
+                    .collect();
+                let n_in = a.iter().filter(|&&v| v != 0).count()
+                    + if with_b {
+                        b.iter().filter(|&&v| v != 0).count()
+                    } else {
+                        0
+                    };
+                let mut out = vec![7u8; nout];
+                let bb = with_b.then_some(&b[..]);
+                let (c_out, c_a, c_b) = level_row(&a, bb, &mut out, true);
+                let c_in = c_a + c_b;
+                let got: Vec<bool> = out.iter().map(|&v| v != 0).collect();
+                assert_eq!(got, expect, "len={len} with_b={with_b}");
+                assert_eq!(c_out as usize, expect.iter().filter(|&&v| v).count());
+                assert_eq!(c_in as usize, n_in, "len={len} with_b={with_b}");
+                assert_eq!(c_a as usize, a.iter().filter(|&&v| v != 0).count());
+                let r = level_row(&a, bb, &mut out, false);
+                assert_eq!((r.1, r.2), (0, 0));
+                // the SSE2 body alone (the AVX2 one takes the long rows above
+                // when the CPU has it)
+                #[cfg(target_arch = "x86_64")]
+                if with_b {
+                    let n32 = len / 32;
+                    let mut o = vec![0u8; 16 * n32];
+                    let (co, ca, cb) = level_row_sse2(&a, &b, &mut o, n32, true);
+                    let nz = |v: &[u8]| v.iter().filter(|&&x| x != 0).count() as u64;
+                    assert_eq!(
+                        o.iter().map(|&v| v != 0).collect::<Vec<_>>(),
+                        expect[..16 * n32]
+                    );
+                    assert_eq!(
+                        (co, ca, cb),
+                        (nz(&o), nz(&a[..32 * n32]), nz(&b[..32 * n32]))
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn fused_dyadic_pass_matches_naive_counts_and_grid() {
+        let mut seed = 41u64;
+        for trial in 0..60 {
+            let dims = [
+                1 + (lcg(&mut seed) % 90) as usize,
+                1 + (lcg(&mut seed) % 140) as usize,
+            ];
+            let n = dims[0] * dims[1];
+            // from a few points (a small bounding box) to dense sets
+            let permille = [1, 3, 10, 100, 300][trial % 5];
+            let mut data: Vec<u8> = (0..n)
+                .map(|_| (lcg(&mut seed) % 1000 < permille) as u8)
+                .collect();
+            data[n / 2] = 1;
+            let vol = ByteVolume::new(&data, &dims).unwrap();
+            let src = Src {
+                data: &data,
+                start: 0,
+                strides: [n, dims[1]],
+                shape: vol.shape,
+            };
+            for k in 1..=6usize {
+                let Dyadic {
+                    counts,
+                    n_fg,
+                    grid,
+                    bbox,
+                } = dyadic_2d(&src, k);
+                let (lo, hi) = scan(&vol).unwrap();
+                assert_eq!(
+                    bbox,
+                    Some(([lo[1], lo[2]], [hi[1], hi[2]])),
+                    "dims={dims:?} k={k}"
+                );
+                assert_eq!(n_fg, naive(&data, &dims, 1, [0; 3], Anchor::Array));
+                for l in 1..=k {
+                    let s = 1 << l;
+                    let want = naive(&data, &dims, s, [0; 3], Anchor::Array);
+                    assert_eq!(
+                        counts[l - 1],
+                        want,
+                        "trial {trial} dims={dims:?} k={k} s={s}"
+                    );
+                }
+                let (want, _, _) = reduce_or(&src, [1, 1 << k, 1 << k], [0; 3]);
+                assert_eq!(grid.shape, want.shape);
+                let nz = |g: &Grid| g.data.iter().map(|&v| v != 0).collect::<Vec<_>>();
+                assert_eq!(nz(&grid), nz(&want), "trial {trial} dims={dims:?} k={k}");
+            }
+        }
+    }
+
+    #[test]
+    fn fused_and_general_paths_agree_through_box_count() {
+        // dyadic sizes take the fused pass on the unshifted lattice; offsets
+        // and odd sizes take the general reduction from its grid
+        let mut seed = 5u64;
+        let dims = [203usize, 171];
+        let data: Vec<u8> = (0..dims[0] * dims[1])
+            .map(|_| (lcg(&mut seed) % 11 == 0) as u8)
+            .collect();
+        // sparse sets whose bounding box starts on the dyadic lattice of the
+        // array (row 32, column 64) or off it (row 37, column 21)
+        let sparse = |r0: usize, c0: usize| -> Vec<u8> {
+            let mut seed = 9u64;
+            let mut d = vec![0u8; dims[0] * dims[1]];
+            d[r0 * dims[1] + c0 + 5] = 1;
+            d[(r0 + 3) * dims[1] + c0] = 1;
+            for _ in 0..40 {
+                let r = r0 + (lcg(&mut seed) as usize) % (dims[0] - r0 - 20);
+                let c = c0 + (lcg(&mut seed) as usize) % (dims[1] - c0 - 10);
+                d[r * dims[1] + c] = 1;
+            }
+            d
+        };
+        for data in [data, sparse(32, 64), sparse(37, 21)] {
+            check_all_lattices(&data, &dims);
+        }
+    }
+
+    fn check_all_lattices(data: &[u8], dims: &[usize]) {
+        let vol = ByteVolume::new(data, dims).unwrap();
+        for anchor in [Anchor::BoundingBox, Anchor::Array] {
+            for offs in [1usize, 2] {
+                let sizes = [1usize, 2, 4, 8, 12, 16, 24, 32, 48];
+                let r = box_count(&vol, 2, &sizes, offs, anchor).unwrap();
+                assert_eq!(Some((r.bbox_min, r.bbox_max)), scan(&vol));
+                for (i, &s) in r.box_sizes.iter().enumerate() {
+                    for (j, g) in r.shifts.iter().enumerate() {
+                        assert_eq!(
+                            r.counts[i][j],
+                            naive(data, dims, s, *g, anchor),
+                            "s={s} g={g:?}"
+                        );
+                    }
                 }
             }
         }
