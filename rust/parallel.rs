@@ -13,13 +13,18 @@ use std::sync::{Arc, Mutex};
 
 use crate::error::{CoreError, CoreResult};
 
-/// Resolve `n_threads`: `None` or `Some(0)` means all available cores.
+/// Resolve `n_threads`: `None` or `Some(0)` means all available cores
+/// (looked up once per process: on Linux the lookup reads cgroup files,
+/// which costs as much as a small kernel).
 pub fn resolve_threads(n_threads: Option<usize>) -> usize {
+    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
     match n_threads {
         Some(n) if n > 0 => n,
-        _ => std::thread::available_parallelism()
-            .map(|n| n.get())
-            .unwrap_or(1),
+        _ => *CORES.get_or_init(|| {
+            std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(1)
+        }),
     }
 }
 
