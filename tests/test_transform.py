@@ -187,7 +187,7 @@ def test_transform_cli_geotiff(tmp_path, capsys):
 
 def test_dask_distributed_two_worker_processes():
     """Two worker processes (started by dask.distributed) run the Rust kernel;
-    each call builds its own thread pool, so no rayon state crosses a fork."""
+    a forked child never uses its parent's kept rayon pools (tests/test_fork.py)."""
     distributed = pytest.importorskip("distributed")
     da = pytest.importorskip("dask.array")
     z = spectral_surface(128, 0.5, 5)
