@@ -15,7 +15,7 @@
 //! point's mass does not depend on where the analysis window sits and the
 //! window sums come from summed-area tables: the cost per pixel is the box
 //! neighbourhood (`L_max^2`), independent of the window.
-use super::sat::{band_rows, check_window, line_fit, log_axis, rect, sat};
+use super::sat::{band_rows, check_window, line_fit, log_axis, rect, sat_into};
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 
@@ -45,14 +45,43 @@ pub fn box_masses(
     ks: &[usize],
     z_scale: f64,
 ) -> Vec<Vec<f64>> {
+    let mut out = Vec::new();
+    box_masses_into(
+        z,
+        rows,
+        cols,
+        r0,
+        r1,
+        ks,
+        z_scale,
+        &mut Vec::new(),
+        &mut out,
+    );
+    out
+}
+
+/// [`box_masses`] into reusable buffers: `out` (resized to one plane per box
+/// size) and `zp` (the NaN-padded band).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn box_masses_into(
+    z: &[f64],
+    rows: usize,
+    cols: usize,
+    r0: usize,
+    r1: usize,
+    ks: &[usize],
+    z_scale: f64,
+    zp: &mut Vec<f64>,
+    out: &mut Vec<Vec<f64>>,
+) {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2 (checked just above).
-            return unsafe { box_masses_avx2(z, rows, cols, r0, r1, ks, z_scale) };
+            return unsafe { box_masses_avx2(z, rows, cols, r0, r1, ks, z_scale, zp, out) };
         }
     }
-    box_masses_impl::<false>(z, rows, cols, r0, r1, ks, z_scale)
+    box_masses_impl::<false>(z, rows, cols, r0, r1, ks, z_scale, zp, out)
 }
 
 /// [`box_masses`] compiled for AVX2 (4 doubles per compare). The arithmetic
@@ -60,6 +89,7 @@ pub fn box_masses(
 /// operations in either build, so the counts are identical.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
+#[allow(clippy::too_many_arguments)]
 unsafe fn box_masses_avx2(
     z: &[f64],
     rows: usize,
@@ -68,8 +98,10 @@ unsafe fn box_masses_avx2(
     r1: usize,
     ks: &[usize],
     z_scale: f64,
-) -> Vec<Vec<f64>> {
-    box_masses_impl::<true>(z, rows, cols, r0, r1, ks, z_scale)
+    zp: &mut Vec<f64>,
+    out: &mut Vec<Vec<f64>>,
+) {
+    box_masses_impl::<true>(z, rows, cols, r0, r1, ks, z_scale, zp, out)
 }
 
 /// Pixels per block of [`box_masses_impl`]: the block's counters stay in
@@ -81,6 +113,7 @@ const MAX_THR: usize = 2;
 /// `AVX2`: count with the AVX2 intrinsics of [`avx2::ring`] (only
 /// instantiated by [`box_masses_avx2`], which runs once AVX2 is detected).
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn box_masses_impl<const AVX2: bool>(
     z: &[f64],
     rows: usize,
@@ -89,13 +122,20 @@ fn box_masses_impl<const AVX2: bool>(
     r1: usize,
     ks: &[usize],
     z_scale: f64,
-) -> Vec<Vec<f64>> {
+    zp: &mut Vec<f64>,
+    out: &mut Vec<Vec<f64>>,
+) {
     let kmax = *ks.last().unwrap_or(&0);
     let nr = r1 - r0;
     let thr: Vec<f64> = ks.iter().map(|&k| (k as f64 + 0.5) * z_scale).collect();
-    let mut out = vec![vec![0.0f64; nr * cols]; ks.len()];
+    // every value of every plane is written below (blocks cover the columns)
+    out.resize_with(ks.len(), Vec::new);
+    for o in out.iter_mut() {
+        o.clear();
+        o.resize(nr * cols, 0.0);
+    }
     if nr == 0 || cols == 0 || ks.is_empty() {
-        return out;
+        return;
     }
     // The band's rows with a NaN margin of `kmax` on every side (and the
     // columns rounded up to whole blocks): NaN never counts, so the offsets
@@ -103,7 +143,8 @@ fn box_masses_impl<const AVX2: bool>(
     let ncb = cols.div_ceil(BLOCK);
     let pw = ncb * BLOCK + 2 * kmax;
     let ph = nr + 2 * kmax;
-    let mut zp = vec![f64::NAN; ph * pw];
+    zp.clear();
+    zp.resize(ph * pw, f64::NAN);
     for (pr, prow) in zp.chunks_exact_mut(pw).enumerate() {
         let r = (r0 + pr).wrapping_sub(kmax);
         if r < rows {
@@ -140,15 +181,15 @@ fn box_masses_impl<const AVX2: bool>(
                     // SAFETY: AVX2 is available (see the const parameter).
                     unsafe {
                         match n {
-                            1 => avx2::ring::<1>(&zp, pw, centre, lo, hi, t, c),
-                            _ => avx2::ring::<2>(&zp, pw, centre, lo, hi, t, c),
+                            1 => avx2::ring::<1>(zp, pw, centre, lo, hi, t, c),
+                            _ => avx2::ring::<2>(zp, pw, centre, lo, hi, t, c),
                         }
                     }
                     continue;
                 }
                 match n {
-                    1 => ring::<1>(&zp, pw, centre, lo, hi, t, c),
-                    _ => ring::<2>(&zp, pw, centre, lo, hi, t, c),
+                    1 => ring::<1>(zp, pw, centre, lo, hi, t, c),
+                    _ => ring::<2>(zp, pw, centre, lo, hi, t, c),
                 }
             }
             let m = BLOCK.min(cols - c);
@@ -160,7 +201,6 @@ fn box_masses_impl<const AVX2: bool>(
             }
         }
     }
-    out
 }
 
 /// Adds to `cnt[t][l]` the pairs (pixel `centre + l`, pixel at offset
@@ -368,31 +408,48 @@ pub fn mass_transform(
     let band_rows = band_rows(w);
     let mut dim = vec![f32::NAN; rows * cols];
     let mut r2 = vec![f32::NAN; rows * cols];
+    // per-thread buffers, reused from band to band (fresh ones would be
+    // page-faulted and zeroed by the OS for every band)
+    #[derive(Default)]
+    struct Scratch {
+        zp: Vec<f64>,
+        masses: Vec<Vec<f64>>,
+        vsat: Vec<f64>,
+        isats: Vec<Vec<f64>>,
+    }
     dim.par_chunks_mut(band_rows * cols)
         .zip(r2.par_chunks_mut(band_rows * cols))
         .enumerate()
-        .for_each(|(band, (dout, rout))| {
+        .for_each_init(Scratch::default, |sc, (band, (dout, rout))| {
             let o0 = band * band_rows;
             let o1 = (o0 + band_rows).min(rows);
             let i0 = o0.saturating_sub(h);
             let i1 = (o1 + h).min(rows);
             let nr = i1 - i0;
             let sw = cols + 1;
-            let masses = box_masses(z, rows, cols, i0, i1, &ks, opt.z_scale);
-            let valid: Vec<f64> = (0..nr * cols)
-                .map(|k| (!z[i0 * cols + k].is_nan()) as u8 as f64)
-                .collect();
-            let vsat = sat(&valid, nr, cols);
-            let isats: Vec<Vec<f64>> = masses
-                .iter()
-                .map(|m| {
-                    let inv: Vec<f64> = m
-                        .iter()
-                        .map(|&v| if v > 0.0 { 1.0 / v } else { 0.0 })
-                        .collect();
-                    sat(&inv, nr, cols)
-                })
-                .collect();
+            let Scratch {
+                zp,
+                masses,
+                vsat,
+                isats,
+            } = sc;
+            box_masses_into(z, rows, cols, i0, i1, &ks, opt.z_scale, zp, masses);
+            let zb = &z[i0 * cols..i1 * cols];
+            sat_into(vsat, nr, cols, |r, c| {
+                (!zb[r * cols + c].is_nan()) as u8 as f64
+            });
+            isats.resize_with(masses.len(), Vec::new);
+            for (s, m) in isats.iter_mut().zip(masses.iter()) {
+                sat_into(s, nr, cols, |r, c| {
+                    let v = m[r * cols + c];
+                    if v > 0.0 {
+                        1.0 / v
+                    } else {
+                        0.0
+                    }
+                });
+            }
+            let (vsat, isats) = (&*vsat, &*isats);
             let mut ys = vec![0.0f64; sizes.len()];
             for i in o0..o1 {
                 let r0 = i.saturating_sub(h) - i0;
@@ -400,7 +457,7 @@ pub fn mass_transform(
                 for j in 0..cols {
                     let c0 = j.saturating_sub(h);
                     let c1 = (j + h + 1).min(cols);
-                    let n = rect(&vsat, sw, r0, r1, c0, c1);
+                    let n = rect(vsat, sw, r0, r1, c0, c1);
                     if n < min_pixels {
                         continue;
                     }
@@ -488,12 +545,12 @@ mod tests {
                 &[3, 5, 6, 7, 9, 10],
                 &[20],
             ];
+            // reused buffers, left dirty by the previous call (as in the band driver)
+            let (mut zp, mut out) = (vec![7.0; 5], vec![vec![3.0; 9]; 8]);
             for ks in lists {
                 for &(r0, r1) in &[(0, rows), (rows / 3, rows), (rows / 2, rows / 2 + 1)] {
-                    for m in [
-                        box_masses(&z, rows, cols, r0, r1, ks, 0.61),
-                        box_masses_impl::<false>(&z, rows, cols, r0, r1, ks, 0.61),
-                    ] {
+                    box_masses_impl::<false>(&z, rows, cols, r0, r1, ks, 0.61, &mut zp, &mut out);
+                    for m in [box_masses(&z, rows, cols, r0, r1, ks, 0.61), out.clone()] {
                         assert_eq!(m.len(), ks.len());
                         for (s, &k) in ks.iter().enumerate() {
                             assert_eq!(m[s].len(), (r1 - r0) * cols);

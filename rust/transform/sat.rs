@@ -16,6 +16,26 @@ pub(crate) fn sat(values: &[f64], rows: usize, cols: usize) -> Vec<f64> {
     s
 }
 
+/// [`sat`] of the values `f(r, c)`, written into `s` (resized and
+/// overwritten: a reused buffer gives the same table).
+pub(crate) fn sat_into(
+    s: &mut Vec<f64>,
+    rows: usize,
+    cols: usize,
+    f: impl Fn(usize, usize) -> f64,
+) {
+    let w = cols + 1;
+    s.clear();
+    s.resize((rows + 1) * w, 0.0);
+    for r in 0..rows {
+        let mut run = 0.0;
+        for c in 0..cols {
+            run += f(r, c);
+            s[(r + 1) * w + c + 1] = s[r * w + c + 1] + run;
+        }
+    }
+}
+
 /// Sum over rows `[r0, r1)` x cols `[c0, c1)` of a table of row width `w`
 /// (`cols + 1`); empty ranges sum to 0.
 #[inline]

@@ -14,7 +14,7 @@
 //! increment powers and counts, built per band of rows at fixed positions,
 //! so the cost per pixel is independent of `w` and the result does not
 //! depend on the thread count.
-use super::sat::{band_rows, check_window, line_fit, log_axis, rect, sat};
+use super::sat::{band_rows, check_window, line_fit, log_axis, rect, sat_into};
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 
@@ -40,7 +40,7 @@ pub struct VariationOptions {
 /// window has too few valid pixels or a lag has no valid increment).
 /// Summed-area tables of one increment component: (power SAT, count SAT,
 /// row offset, column offset).
-type LagTables = (Vec<f64>, Vec<f64>, usize, usize);
+type LagTables<'a> = (&'a [f64], &'a [f64], usize, usize);
 
 pub fn variation_transform(
     z: &[f64],
@@ -84,10 +84,25 @@ pub fn variation_transform(
     };
     let mut dim = vec![f32::NAN; rows * cols];
     let mut r2 = vec![f32::NAN; rows * cols];
+    // the components (row and column offsets) of each lag's increments
+    let comps: Vec<Vec<(usize, usize)>> = lags
+        .iter()
+        .map(|&u| match opt.increments {
+            Increments::First => vec![(0, u), (u, 0)],
+            Increments::Square => vec![(u, u)],
+        })
+        .collect();
+    // per-thread tables, reused from band to band (fresh ones would be
+    // page-faulted and zeroed by the OS for every band)
+    #[derive(Default)]
+    struct Scratch {
+        vsat: Vec<f64>,
+        tables: Vec<Vec<(Vec<f64>, Vec<f64>)>>,
+    }
     dim.par_chunks_mut(band_rows * cols)
         .zip(r2.par_chunks_mut(band_rows * cols))
         .enumerate()
-        .for_each(|(band, (dout, rout))| {
+        .for_each_init(Scratch::default, |sc, (band, (dout, rout))| {
             debug_assert!(band < n_bands);
             let o0 = band * band_rows; // first output row
             let o1 = (o0 + band_rows).min(rows);
@@ -97,42 +112,48 @@ pub fn variation_transform(
             let nr = i1 - i0;
             let sw = cols + 1;
             let get = |r: usize, c: usize| z[(i0 + r) * cols + c];
-            let valid: Vec<f64> = (0..nr * cols)
-                .map(|k| (!get(k / cols, k % cols).is_nan()) as u8 as f64)
-                .collect();
-            let vsat = sat(&valid, nr, cols);
-            // per lag: (power SAT, count SAT) for each component
-            let mut tables: Vec<Vec<LagTables>> = Vec::with_capacity(lags.len());
-            for &u in &lags {
-                let comps: Vec<(usize, usize)> = match opt.increments {
-                    Increments::First => vec![(0, u), (u, 0)],
-                    Increments::Square => vec![(u, u)],
-                };
-                let mut t = Vec::with_capacity(comps.len());
-                for (du_r, du_c) in comps {
-                    let mut pw = vec![0.0f64; nr * cols];
-                    let mut ct = vec![0.0f64; nr * cols];
-                    if nr > du_r {
-                        for r in 0..nr - du_r {
-                            for c in 0..cols.saturating_sub(du_c) {
-                                let d = match opt.increments {
-                                    Increments::First => get(r + du_r, c + du_c) - get(r, c),
-                                    Increments::Square => {
-                                        get(r + u, c + u) - get(r + u, c) - get(r, c + u)
-                                            + get(r, c)
-                                    }
-                                };
-                                if !d.is_nan() {
-                                    pw[r * cols + c] = power(d);
-                                    ct[r * cols + c] = 1.0;
-                                }
+            sat_into(&mut sc.vsat, nr, cols, |r, c| {
+                (!get(r, c).is_nan()) as u8 as f64
+            });
+            // per lag and component: (power SAT, count SAT) of the increments
+            // anchored at (r, c); 0 where the increment leaves the band or is NaN
+            sc.tables.resize_with(lags.len(), Vec::new);
+            for ((t, cs), &u) in sc.tables.iter_mut().zip(&comps).zip(&lags) {
+                t.resize_with(cs.len(), Default::default);
+                for ((ps, ct), &(du_r, du_c)) in t.iter_mut().zip(cs) {
+                    let inc = |r: usize, c: usize| -> f64 {
+                        if r + du_r >= nr || c + du_c >= cols {
+                            return f64::NAN;
+                        }
+                        match opt.increments {
+                            Increments::First => get(r + du_r, c + du_c) - get(r, c),
+                            Increments::Square => {
+                                get(r + u, c + u) - get(r + u, c) - get(r, c + u) + get(r, c)
                             }
                         }
-                    }
-                    t.push((sat(&pw, nr, cols), sat(&ct, nr, cols), du_r, du_c));
+                    };
+                    sat_into(ps, nr, cols, |r, c| {
+                        let d = inc(r, c);
+                        if d.is_nan() {
+                            0.0
+                        } else {
+                            power(d)
+                        }
+                    });
+                    sat_into(ct, nr, cols, |r, c| (!inc(r, c).is_nan()) as u8 as f64);
                 }
-                tables.push(t);
             }
+            let (vsat, tables) = (&sc.vsat, &sc.tables);
+            let tables: Vec<Vec<LagTables>> = tables
+                .iter()
+                .zip(&comps)
+                .map(|(t, cs)| {
+                    t.iter()
+                        .zip(cs)
+                        .map(|((ps, ct), &(du_r, du_c))| (ps.as_slice(), ct.as_slice(), du_r, du_c))
+                        .collect()
+                })
+                .collect();
             let mut ys = vec![0.0f64; lags.len()];
             for i in o0..o1 {
                 let r0 = i.saturating_sub(h) - i0;
@@ -141,7 +162,7 @@ pub fn variation_transform(
                     let c0 = j.saturating_sub(h);
                     let c1 = (j + h + 1).min(cols);
                     let k = (i - o0) * cols + j;
-                    if rect(&vsat, sw, r0, r1, c0, c1) < min_pixels {
+                    if rect(vsat, sw, r0, r1, c0, c1) < min_pixels {
                         continue;
                     }
                     let mut ok = true;

@@ -369,12 +369,13 @@ def fractal_transform(
                                 meta=np.empty((0, 0, 0), np.float32))
         out = (res[0], res[1]) if return_fit else res[0]
     else:
-        zcheck = np.asarray(arr, dtype=np.float64)
-        if np.isnan(zcheck).all() or (nodata is not None and np.all((zcheck == nodata) | np.isnan(zcheck))):
-            raise ValueError("image: no valid value (all NaN or nodata)")
+        # one float64 copy at most (none for a float64 input; never modified)
         z = np.asarray(arr, dtype=np.float64)
         if nodata is not None:
             z = np.where(z == nodata, np.nan, z)
+        # fmax ignores NaN: the reduction is NaN only when every value is
+        if np.isnan(np.fmax.reduce(z, axis=None)):
+            raise ValueError("image: no valid value (all NaN or nodata)")
         d, r2 = _grid(z, w, method, opts, min_valid, step, n_threads)
         out = (d, r2) if return_fit else d
     if xr_obj is not None:
