@@ -68,6 +68,27 @@ def test_dask_equals_in_memory_for_any_chunking():
         assert np.allclose(out, ref, atol=1e-6, equal_nan=True), chunks
 
 
+@pytest.mark.parametrize("method", ["mass", "variogram", "madogram", "square"])
+def test_step_grid_is_the_full_map_subsampled(method):
+    """The Rust kernels compute only the step grid (every step-th pixel of
+    every step-th row); it must be the full map's values there, NaN holes and
+    edges included, in memory and through Dask."""
+    z = spectral_surface(128, 0.6, 4)[:101, :87] * 3
+    z[40:44, 10:70] = np.nan
+    z[:6, :9] = np.nan
+    ref = fg.fractal_transform(z, 11, method=method, return_fit=True)
+    for step in (2, 3, 5, 11, 40):
+        out = fg.fractal_transform(z, 11, method=method, step=step, return_fit=True)
+        for a, b in zip(out, ref):
+            assert a.dtype == np.float32 and a.shape == b[::step, ::step].shape
+            assert np.array_equal(np.isnan(a), np.isnan(b[::step, ::step])), step
+            assert np.allclose(a, b[::step, ::step], atol=1e-6, equal_nan=True), step
+    da = pytest.importorskip("dask.array")
+    for chunks in [(50, 45), (30, 87)]:
+        got = fg.fractal_transform(da.from_array(z, chunks=chunks), 11, method=method, step=3).compute()
+        assert np.allclose(got, ref[0][::3, ::3], atol=1e-6, equal_nan=True), chunks
+
+
 def test_xarray_keeps_coords_and_attrs():
     xr = pytest.importorskip("xarray")
     z = spectral_surface(64, 0.5, 2)

@@ -247,6 +247,7 @@ def variation_transform_map(
     p: float,
     square: bool,
     min_valid: float,
+    step: int = 1,
     n_threads: Optional[int] = None,
 ) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
 def mass_transform_map(
@@ -255,6 +256,7 @@ def mass_transform_map(
     box_sizes: Sequence[int],
     z_scale: float,
     min_valid: float,
+    step: int = 1,
     n_threads: Optional[int] = None,
 ) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
 def dbc_transform_map(

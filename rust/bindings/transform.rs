@@ -14,7 +14,7 @@ use pyo3::prelude::*;
 
 /// Moving-window increment estimator. Returns (dimension, r_squared) float32 maps.
 #[pyfunction]
-#[pyo3(signature = (image, window_size, lags, p, square, min_valid, n_threads=None))]
+#[pyo3(signature = (image, window_size, lags, p, square, min_valid, step=1, n_threads=None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn variation_transform_map<'py>(
     py: Python<'py>,
@@ -24,6 +24,7 @@ fn variation_transform_map<'py>(
     p: f64,
     square: bool,
     min_valid: f64,
+    step: usize,
     n_threads: Option<usize>,
 ) -> PyResult<(Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>)> {
     let (rows, cols) = (image.shape()[0], image.shape()[1]);
@@ -40,10 +41,11 @@ fn variation_transform_map<'py>(
             Increments::First
         },
         min_valid,
+        step,
     };
     let (d, r2) =
         py.detach(|| run_in_pool(n_threads, || variation_transform(z, rows, cols, &opt)))?;
-    let shape = (rows, cols);
+    let shape = (rows.div_ceil(step.max(1)), cols.div_ceil(step.max(1)));
     let bad = |_| PyValueError::new_err("internal: map size");
     Ok((
         Array2::from_shape_vec(shape, d)
@@ -57,8 +59,8 @@ fn variation_transform_map<'py>(
 
 /// Moving-window P(m, L) mass dimension. Returns (dimension, r_squared) float32 maps.
 #[pyfunction]
-#[pyo3(signature = (image, window_size, box_sizes, z_scale, min_valid, n_threads=None))]
-#[allow(clippy::type_complexity)]
+#[pyo3(signature = (image, window_size, box_sizes, z_scale, min_valid, step=1, n_threads=None))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn mass_transform_map<'py>(
     py: Python<'py>,
     image: PyReadonlyArray2<'py, f64>,
@@ -66,6 +68,7 @@ fn mass_transform_map<'py>(
     box_sizes: Vec<usize>,
     z_scale: f64,
     min_valid: f64,
+    step: usize,
     n_threads: Option<usize>,
 ) -> PyResult<(Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>)> {
     let (rows, cols) = (image.shape()[0], image.shape()[1]);
@@ -77,14 +80,16 @@ fn mass_transform_map<'py>(
         box_sizes,
         z_scale,
         min_valid,
+        step,
     };
     let (d, r2) = py.detach(|| run_in_pool(n_threads, || mass_transform(z, rows, cols, &opt)))?;
     let bad = |_| PyValueError::new_err("internal: map size");
+    let shape = (rows.div_ceil(step.max(1)), cols.div_ceil(step.max(1)));
     Ok((
-        Array2::from_shape_vec((rows, cols), d)
+        Array2::from_shape_vec(shape, d)
             .map_err(bad)?
             .into_pyarray(py),
-        Array2::from_shape_vec((rows, cols), r2)
+        Array2::from_shape_vec(shape, r2)
             .map_err(bad)?
             .into_pyarray(py),
     ))

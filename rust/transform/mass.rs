@@ -15,7 +15,7 @@
 //! point's mass does not depend on where the analysis window sits and the
 //! window sums come from summed-area tables: the cost per pixel is the box
 //! neighbourhood (`L_max^2`), independent of the window.
-use super::sat::{band_rows, check_window, line_fit, log_axis, rect, sat_into};
+use super::sat::{band_rows, check_step, check_window, line_fit, log_axis, rect, sat_into};
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 
@@ -27,6 +27,8 @@ pub struct MassOptions {
     pub box_sizes: Vec<usize>,
     pub z_scale: f64,
     pub min_valid: f64,
+    /// Output every `step`-th pixel of every `step`-th row (1: all).
+    pub step: usize,
 }
 
 /// `m_p(L)` for every pixel of rows `[r0, r1)` and every box size; invalid
@@ -375,7 +377,8 @@ pub fn mass_curve(
 }
 
 /// Local P(m, L) dimension and r² maps (row-major; NaN where the window has
-/// fewer valid pixels than `min_valid * w * w`).
+/// fewer valid pixels than `min_valid * w * w`), on the grid of every
+/// `step`-th pixel: `ceil(rows / step) x ceil(cols / step)`.
 pub fn mass_transform(
     z: &[f64],
     rows: usize,
@@ -402,12 +405,15 @@ pub fn mass_transform(
             format!("expected a positive number, got {}", opt.z_scale),
         ));
     }
+    let step = check_step(opt.step)?;
     let ks: Vec<usize> = sizes.iter().map(|l| l / 2).collect();
     let (xs, xm, sxx) = log_axis(&sizes);
     let h = w / 2;
-    let band_rows = band_rows(w);
-    let mut dim = vec![f32::NAN; rows * cols];
-    let mut r2 = vec![f32::NAN; rows * cols];
+    // output grid (pixels 0, step, 2 step, ...) and its rows per band
+    let (orows, ocols) = (rows.div_ceil(step), cols.div_ceil(step));
+    let ob = (band_rows(w) / step).max(1);
+    let mut dim = vec![f32::NAN; orows * ocols];
+    let mut r2 = vec![f32::NAN; orows * ocols];
     // per-thread buffers, reused from band to band (fresh ones would be
     // page-faulted and zeroed by the OS for every band)
     #[derive(Default)]
@@ -417,14 +423,15 @@ pub fn mass_transform(
         vsat: Vec<f64>,
         isats: Vec<Vec<f64>>,
     }
-    dim.par_chunks_mut(band_rows * cols)
-        .zip(r2.par_chunks_mut(band_rows * cols))
+    dim.par_chunks_mut(ob * ocols)
+        .zip(r2.par_chunks_mut(ob * ocols))
         .enumerate()
         .for_each_init(Scratch::default, |sc, (band, (dout, rout))| {
-            let o0 = band * band_rows;
-            let o1 = (o0 + band_rows).min(rows);
-            let i0 = o0.saturating_sub(h);
-            let i1 = (o1 + h).min(rows);
+            // output rows g0 .. g1 of the grid: image rows g0 step .. (g1 - 1) step
+            let g0 = band * ob;
+            let g1 = (g0 + ob).min(orows);
+            let i0 = (g0 * step).saturating_sub(h);
+            let i1 = ((g1 - 1) * step + h + 1).min(rows);
             let nr = i1 - i0;
             let sw = cols + 1;
             let Scratch {
@@ -451,10 +458,12 @@ pub fn mass_transform(
             }
             let (vsat, isats) = (&*vsat, &*isats);
             let mut ys = vec![0.0f64; sizes.len()];
-            for i in o0..o1 {
+            for g in g0..g1 {
+                let i = g * step;
                 let r0 = i.saturating_sub(h) - i0;
                 let r1 = (i + h + 1).min(rows) - i0;
-                for j in 0..cols {
+                for q in 0..ocols {
+                    let j = q * step;
                     let c0 = j.saturating_sub(h);
                     let c1 = (j + h + 1).min(cols);
                     let n = rect(vsat, sw, r0, r1, c0, c1);
@@ -465,7 +474,7 @@ pub fn mass_transform(
                         ys[l] = (rect(s, sw, r0, r1, c0, c1) / n).ln();
                     }
                     let (slope, fit_r2) = line_fit(&xs, xm, sxx, &ys);
-                    let k = (i - o0) * cols + j;
+                    let k = (g - g0) * ocols + q;
                     dout[k] = (-slope) as f32;
                     rout[k] = fit_r2 as f32;
                 }
@@ -488,6 +497,7 @@ mod tests {
             box_sizes: vec![3, 5, 7],
             z_scale: 1.0,
             min_valid: 0.5,
+            step: 1,
         };
         let (d, _) = mass_transform(&z, rows, cols, &opt).unwrap();
         // windows whose boxes stay inside the image

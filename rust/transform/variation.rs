@@ -14,7 +14,7 @@
 //! increment powers and counts, built per band of rows at fixed positions,
 //! so the cost per pixel is independent of `w` and the result does not
 //! depend on the thread count.
-use super::sat::{band_rows, check_window, line_fit, log_axis, rect, sat_into};
+use super::sat::{band_rows, check_step, check_window, line_fit, log_axis, rect, sat_into};
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 
@@ -34,10 +34,13 @@ pub struct VariationOptions {
     pub increments: Increments,
     /// Fewest valid pixels in a window, as a fraction of `w * w`.
     pub min_valid: f64,
+    /// Output every `step`-th pixel of every `step`-th row (1: all).
+    pub step: usize,
 }
 
-/// Local dimension and r² maps (row-major, `rows x cols`, NaN where the
-/// window has too few valid pixels or a lag has no valid increment).
+/// Local dimension and r² maps (row-major, NaN where the window has too few
+/// valid pixels or a lag has no valid increment) on the grid of every
+/// `step`-th pixel: `ceil(rows / step) x ceil(cols / step)`.
 /// Summed-area tables of one increment component: (power SAT, count SAT,
 /// row offset, column offset).
 type LagTables<'a> = (&'a [f64], &'a [f64], usize, usize);
@@ -68,10 +71,12 @@ pub fn variation_transform(
             format!("expected a positive number, got {}", opt.p),
         ));
     }
+    let step = check_step(opt.step)?;
     let h = w / 2;
     let (xs, xm, sxx) = log_axis(&lags);
-    let band_rows = band_rows(w);
-    let n_bands = rows.div_ceil(band_rows);
+    // output grid (pixels 0, step, 2 step, ...) and its rows per band
+    let (orows, ocols) = (rows.div_ceil(step), cols.div_ceil(step));
+    let ob = (band_rows(w) / step).max(1);
     let p = opt.p;
     let power = move |d: f64| -> f64 {
         if p == 2.0 {
@@ -82,8 +87,8 @@ pub fn variation_transform(
             d.abs().powf(p)
         }
     };
-    let mut dim = vec![f32::NAN; rows * cols];
-    let mut r2 = vec![f32::NAN; rows * cols];
+    let mut dim = vec![f32::NAN; orows * ocols];
+    let mut r2 = vec![f32::NAN; orows * ocols];
     // the components (row and column offsets) of each lag's increments
     let comps: Vec<Vec<(usize, usize)>> = lags
         .iter()
@@ -99,16 +104,16 @@ pub fn variation_transform(
         vsat: Vec<f64>,
         tables: Vec<Vec<(Vec<f64>, Vec<f64>)>>,
     }
-    dim.par_chunks_mut(band_rows * cols)
-        .zip(r2.par_chunks_mut(band_rows * cols))
+    dim.par_chunks_mut(ob * ocols)
+        .zip(r2.par_chunks_mut(ob * ocols))
         .enumerate()
         .for_each_init(Scratch::default, |sc, (band, (dout, rout))| {
-            debug_assert!(band < n_bands);
-            let o0 = band * band_rows; // first output row
-            let o1 = (o0 + band_rows).min(rows);
+            // output rows g0 .. g1 of the grid: image rows g0 step .. (g1 - 1) step
+            let g0 = band * ob;
+            let g1 = (g0 + ob).min(orows);
             // input rows a window of the band can touch
-            let i0 = o0.saturating_sub(h);
-            let i1 = (o1 + h).min(rows);
+            let i0 = (g0 * step).saturating_sub(h);
+            let i1 = ((g1 - 1) * step + h + 1).min(rows);
             let nr = i1 - i0;
             let sw = cols + 1;
             let get = |r: usize, c: usize| z[(i0 + r) * cols + c];
@@ -155,13 +160,15 @@ pub fn variation_transform(
                 })
                 .collect();
             let mut ys = vec![0.0f64; lags.len()];
-            for i in o0..o1 {
+            for g in g0..g1 {
+                let i = g * step;
                 let r0 = i.saturating_sub(h) - i0;
                 let r1 = (i + h + 1).min(rows) - i0;
-                for j in 0..cols {
+                for q in 0..ocols {
+                    let j = q * step;
                     let c0 = j.saturating_sub(h);
                     let c1 = (j + h + 1).min(cols);
-                    let k = (i - o0) * cols + j;
+                    let k = (g - g0) * ocols + q;
                     if rect(vsat, sw, r0, r1, c0, c1) < min_pixels {
                         continue;
                     }
@@ -269,6 +276,7 @@ mod tests {
                 p: 2.0,
                 increments: inc,
                 min_valid: 0.0,
+                step: 1,
             };
             let (d, _) = variation_transform(&z, rows, cols, &opt).unwrap();
             for &(i, j) in &[
@@ -301,6 +309,7 @@ mod tests {
             p: 2.0,
             increments: Increments::First,
             min_valid: 0.5,
+            step: 1,
         };
         let run = |t| {
             crate::parallel::run_in_pool(Some(t), || variation_transform(&z, rows, cols, &opt))
@@ -330,6 +339,41 @@ mod tests {
             bits(run(1)) == bits(run(3)),
             "results differ between 1 and 3 threads"
         );
+        // the step grid is the full map's every step-th pixel (sums of the
+        // same tables, from other band origins: equal to rounding)
+        for step in [2usize, 3, 7] {
+            let (g, _) = variation_transform(
+                &z,
+                rows,
+                cols,
+                &VariationOptions {
+                    step,
+                    ..opt.clone()
+                },
+            )
+            .unwrap();
+            let (orows, ocols) = (rows.div_ceil(step), cols.div_ceil(step));
+            assert_eq!(g.len(), orows * ocols);
+            for gi in 0..orows {
+                for gj in 0..ocols {
+                    let (x, y) = (g[gi * ocols + gj], a[gi * step * cols + gj * step]);
+                    assert!(
+                        x == y || (x - y).abs() < 1e-6 || (x.is_nan() && y.is_nan()),
+                        "step {step}"
+                    );
+                }
+            }
+        }
+        assert!(variation_transform(
+            &z,
+            rows,
+            cols,
+            &VariationOptions {
+                step: 0,
+                ..opt.clone()
+            }
+        )
+        .is_err());
         assert!(variation_transform(
             &z,
             rows,

@@ -98,13 +98,9 @@ def _grid(z: np.ndarray, w: int, method: str, opts: dict, min_valid: float, step
 
         return whittle_grid(z, w, min_valid, step, n_threads)
     if method == "mass":
-        d, r2 = _core.mass_transform_map(z, w, opts["sizes"], opts["z_scale"], min_valid, n_threads)
-    else:
-        p, square = TRANSFORM_METHODS[method]
-        d, r2 = _core.variation_transform_map(z, w, opts["lags"], p, square, min_valid, n_threads)
-    if step > 1:
-        d, r2 = np.ascontiguousarray(d[::step, ::step]), np.ascontiguousarray(r2[::step, ::step])
-    return d, r2
+        return _core.mass_transform_map(z, w, opts["sizes"], opts["z_scale"], min_valid, step, n_threads)
+    p, square = TRANSFORM_METHODS[method]
+    return _core.variation_transform_map(z, w, opts["lags"], p, square, min_valid, step, n_threads)
 
 
 def fractal_transform(
@@ -215,8 +211,8 @@ def fractal_transform(
     step : int, default 1
         Compute the map on every ``step``-th row and column only (pixels
         ``(k * step, l * step)``): the output has shape
-        ``(ceil(rows / step), ceil(cols / step))``. The DBC, blanket and
-        Whittle kernels compute only those windows.
+        ``(ceil(rows / step), ceil(cols / step))``, equal to the full map at
+        those pixels. Only those windows are fitted.
     nodata : float, optional
         Value marking missing samples, in addition to NaN.
     min_valid : float, default 0.5
