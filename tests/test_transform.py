@@ -89,6 +89,26 @@ def test_step_grid_is_the_full_map_subsampled(method):
         assert np.allclose(got, ref[0][::3, ::3], atol=1e-6, equal_nan=True), chunks
 
 
+@pytest.mark.parametrize("method", ["mass", "variogram", "square"])
+def test_float32_is_read_in_place_with_float64_results(method):
+    """A float32 scene goes to the kernel without a float64 copy; every
+    float32 is exactly a float64, so the map is bit-identical to the one of
+    its float64 cast. A nodata value is compared as given (in float64)."""
+    z = (spectral_surface(96, 0.5, 6) * 7).astype(np.float32)
+    z[10:14, 20:40] = -9999.0
+    z[50, 50] = np.float32(0.1)
+    before = z.copy()
+    for nodata in (None, -9999.0, 0.1):
+        a = fg.fractal_transform(z, 11, method=method, nodata=nodata, return_fit=True)
+        b = fg.fractal_transform(z.astype(np.float64), 11, method=method, nodata=nodata, return_fit=True)
+        for x, y in zip(a, b):
+            assert np.array_equal(x, y, equal_nan=True), nodata
+    # 0.1 is not a float32: no float32 pixel equals it as given
+    a = fg.fractal_transform(z, 11, method=method, nodata=0.1)
+    assert np.array_equal(a, fg.fractal_transform(z, 11, method=method), equal_nan=True)
+    assert np.array_equal(z, before)
+
+
 def test_xarray_keeps_coords_and_attrs():
     xr = pytest.importorskip("xarray")
     z = spectral_surface(64, 0.5, 2)

@@ -67,6 +67,7 @@ fn box_count_binary<'py>(
 /// Box counts of an (N, d) point set. Returns (box_sizes, counts[n_sizes, n_lattices]).
 #[pyfunction]
 #[pyo3(signature = (points, box_sizes, offsets, n_threads=None))]
+#[allow(clippy::type_complexity)]
 fn box_count_points<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
@@ -93,6 +94,7 @@ fn box_count_points<'py>(
 /// Returns (box_sizes, counts[n_sizes, n_lattices]).
 #[pyfunction]
 #[pyo3(signature = (data, box_sizes, offsets, z0, z_unit, n_threads=None))]
+#[allow(clippy::type_complexity)]
 fn dbc_count<'py>(
     py: Python<'py>,
     data: &Bound<'py, PyAny>,
@@ -138,6 +140,7 @@ fn dbc_count<'py>(
 /// Returns (mean_range, n_columns) per box size.
 #[pyfunction]
 #[pyo3(signature = (data, box_sizes, n_threads=None))]
+#[allow(clippy::type_complexity)]
 fn column_ranges<'py>(
     py: Python<'py>,
     data: PyReadonlyArray2<'py, f64>,

@@ -9,42 +9,49 @@ use numpy::ndarray::Array2;
 use numpy::ndarray::Array3;
 use numpy::PyArray3;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
-/// Moving-window increment estimator. Returns (dimension, r_squared) float32 maps.
-#[pyfunction]
-#[pyo3(signature = (image, window_size, lags, p, square, min_valid, step=1, n_threads=None))]
-#[allow(clippy::too_many_arguments, clippy::type_complexity)]
-fn variation_transform_map<'py>(
-    py: Python<'py>,
-    image: PyReadonlyArray2<'py, f64>,
-    window_size: usize,
-    lags: Vec<usize>,
-    p: f64,
-    square: bool,
-    min_valid: f64,
-    step: usize,
-    n_threads: Option<usize>,
-) -> PyResult<(Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>)> {
-    let (rows, cols) = (image.shape()[0], image.shape()[1]);
-    let z = image
-        .as_slice()
-        .map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
-    let opt = VariationOptions {
-        window: window_size,
-        lags,
-        p,
-        increments: if square {
-            Increments::Square
+/// Run a map kernel on a 2D float32 or float64 image, read in place (no
+/// float64 copy of a float32 scene); evaluates to `(result, rows, cols)`.
+macro_rules! on_float_image {
+    ($py:expr, $image:expr, $n_threads:expr, |$z:ident, $rows:ident, $cols:ident| $body:expr) => {{
+        if let Ok(a) = $image.extract::<PyReadonlyArray2<'_, f32>>() {
+            let ($rows, $cols) = (a.shape()[0], a.shape()[1]);
+            let $z = a
+                .as_slice()
+                .map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
+            (
+                $py.detach(|| run_in_pool($n_threads, || $body))?,
+                $rows,
+                $cols,
+            )
+        } else if let Ok(a) = $image.extract::<PyReadonlyArray2<'_, f64>>() {
+            let ($rows, $cols) = (a.shape()[0], a.shape()[1]);
+            let $z = a
+                .as_slice()
+                .map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
+            (
+                $py.detach(|| run_in_pool($n_threads, || $body))?,
+                $rows,
+                $cols,
+            )
         } else {
-            Increments::First
-        },
-        min_valid,
-        step,
-    };
-    let (d, r2) =
-        py.detach(|| run_in_pool(n_threads, || variation_transform(z, rows, cols, &opt)))?;
+            return Err(PyTypeError::new_err(
+                "image: expected a 2D float32 or float64 array",
+            ));
+        }
+    }};
+}
+
+/// The (dimension, r²) pair of a map on the grid of every `step`-th pixel.
+fn step_maps<'py>(
+    py: Python<'py>,
+    (d, r2): (Vec<f32>, Vec<f32>),
+    rows: usize,
+    cols: usize,
+    step: usize,
+) -> PyResult<MapPair<'py>> {
     let shape = (rows.div_ceil(step.max(1)), cols.div_ceil(step.max(1)));
     let bad = |_| PyValueError::new_err("internal: map size");
     Ok((
@@ -57,24 +64,55 @@ fn variation_transform_map<'py>(
     ))
 }
 
-/// Moving-window P(m, L) mass dimension. Returns (dimension, r_squared) float32 maps.
+/// Moving-window increment estimator on a float32 or float64 image.
+/// Returns (dimension, r_squared) float32 maps on the `step` grid.
+#[pyfunction]
+#[pyo3(signature = (image, window_size, lags, p, square, min_valid, step=1, n_threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn variation_transform_map<'py>(
+    py: Python<'py>,
+    image: &Bound<'py, PyAny>,
+    window_size: usize,
+    lags: Vec<usize>,
+    p: f64,
+    square: bool,
+    min_valid: f64,
+    step: usize,
+    n_threads: Option<usize>,
+) -> PyResult<MapPair<'py>> {
+    let opt = VariationOptions {
+        window: window_size,
+        lags,
+        p,
+        increments: if square {
+            Increments::Square
+        } else {
+            Increments::First
+        },
+        min_valid,
+        step,
+    };
+    let (maps, rows, cols) = on_float_image!(py, image, n_threads, |z, rows, cols| {
+        variation_transform(z, rows, cols, &opt)
+    });
+    step_maps(py, maps, rows, cols, step)
+}
+
+/// Moving-window P(m, L) mass dimension on a float32 or float64 image.
+/// Returns (dimension, r_squared) float32 maps on the `step` grid.
 #[pyfunction]
 #[pyo3(signature = (image, window_size, box_sizes, z_scale, min_valid, step=1, n_threads=None))]
-#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+#[allow(clippy::too_many_arguments)]
 fn mass_transform_map<'py>(
     py: Python<'py>,
-    image: PyReadonlyArray2<'py, f64>,
+    image: &Bound<'py, PyAny>,
     window_size: usize,
     box_sizes: Vec<usize>,
     z_scale: f64,
     min_valid: f64,
     step: usize,
     n_threads: Option<usize>,
-) -> PyResult<(Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>)> {
-    let (rows, cols) = (image.shape()[0], image.shape()[1]);
-    let z = image
-        .as_slice()
-        .map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
+) -> PyResult<MapPair<'py>> {
     let opt = MassOptions {
         window: window_size,
         box_sizes,
@@ -82,17 +120,10 @@ fn mass_transform_map<'py>(
         min_valid,
         step,
     };
-    let (d, r2) = py.detach(|| run_in_pool(n_threads, || mass_transform(z, rows, cols, &opt)))?;
-    let bad = |_| PyValueError::new_err("internal: map size");
-    let shape = (rows.div_ceil(step.max(1)), cols.div_ceil(step.max(1)));
-    Ok((
-        Array2::from_shape_vec(shape, d)
-            .map_err(bad)?
-            .into_pyarray(py),
-        Array2::from_shape_vec(shape, r2)
-            .map_err(bad)?
-            .into_pyarray(py),
-    ))
+    let (maps, rows, cols) = on_float_image!(py, image, n_threads, |z, rows, cols| {
+        mass_transform(z, rows, cols, &opt)
+    });
+    step_maps(py, maps, rows, cols, step)
 }
 
 type MapPair<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>);

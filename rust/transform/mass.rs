@@ -16,6 +16,7 @@
 //! window sums come from summed-area tables: the cost per pixel is the box
 //! neighbourhood (`L_max^2`), independent of the window.
 use super::sat::{band_rows, check_step, check_window, line_fit, log_axis, rect, sat_into};
+use crate::dimension::dbc::Sample;
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 
@@ -38,8 +39,8 @@ pub struct MassOptions {
 /// spatial offset is within `k` and `|z_q - z_p| <= (k + 1/2) z_scale`
 /// (NaN on either side never counts). Pixels go by blocks of [`BLOCK`] along
 /// a row, their counters kept in registers while the offsets are walked.
-pub fn box_masses(
-    z: &[f64],
+pub fn box_masses<T: Sample>(
+    z: &[T],
     rows: usize,
     cols: usize,
     r0: usize,
@@ -65,8 +66,8 @@ pub fn box_masses(
 /// [`box_masses`] into reusable buffers: `out` (resized to one plane per box
 /// size) and `zp` (the NaN-padded band).
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn box_masses_into(
-    z: &[f64],
+pub(crate) fn box_masses_into<T: Sample>(
+    z: &[T],
     rows: usize,
     cols: usize,
     r0: usize,
@@ -83,7 +84,7 @@ pub(crate) fn box_masses_into(
             return unsafe { box_masses_avx2(z, rows, cols, r0, r1, ks, z_scale, zp, out) };
         }
     }
-    box_masses_impl::<false>(z, rows, cols, r0, r1, ks, z_scale, zp, out)
+    box_masses_impl::<false, T>(z, rows, cols, r0, r1, ks, z_scale, zp, out)
 }
 
 /// [`box_masses`] compiled for AVX2 (4 doubles per compare). The arithmetic
@@ -92,8 +93,8 @@ pub(crate) fn box_masses_into(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[allow(clippy::too_many_arguments)]
-unsafe fn box_masses_avx2(
-    z: &[f64],
+unsafe fn box_masses_avx2<T: Sample>(
+    z: &[T],
     rows: usize,
     cols: usize,
     r0: usize,
@@ -103,7 +104,7 @@ unsafe fn box_masses_avx2(
     zp: &mut Vec<f64>,
     out: &mut Vec<Vec<f64>>,
 ) {
-    box_masses_impl::<true>(z, rows, cols, r0, r1, ks, z_scale, zp, out)
+    box_masses_impl::<true, T>(z, rows, cols, r0, r1, ks, z_scale, zp, out)
 }
 
 /// Pixels per block of [`box_masses_impl`]: the block's counters stay in
@@ -116,8 +117,8 @@ const MAX_THR: usize = 2;
 /// instantiated by [`box_masses_avx2`], which runs once AVX2 is detected).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn box_masses_impl<const AVX2: bool>(
-    z: &[f64],
+fn box_masses_impl<const AVX2: bool, T: Sample>(
+    z: &[T],
     rows: usize,
     cols: usize,
     r0: usize,
@@ -150,7 +151,12 @@ fn box_masses_impl<const AVX2: bool>(
     for (pr, prow) in zp.chunks_exact_mut(pw).enumerate() {
         let r = (r0 + pr).wrapping_sub(kmax);
         if r < rows {
-            prow[kmax..kmax + cols].copy_from_slice(&z[r * cols..(r + 1) * cols]);
+            for (d, &v) in prow[kmax..kmax + cols]
+                .iter_mut()
+                .zip(&z[r * cols..(r + 1) * cols])
+            {
+                *d = v.to_f64();
+            }
         }
     }
     // Box k counts the offsets with Chebyshev radius <= k. Ring s holds the
@@ -379,8 +385,8 @@ pub fn mass_curve(
 /// Local P(m, L) dimension and r² maps (row-major; NaN where the window has
 /// fewer valid pixels than `min_valid * w * w`), on the grid of every
 /// `step`-th pixel: `ceil(rows / step) x ceil(cols / step)`.
-pub fn mass_transform(
-    z: &[f64],
+pub fn mass_transform<T: Sample>(
+    z: &[T],
     rows: usize,
     cols: usize,
     opt: &MassOptions,
@@ -443,7 +449,7 @@ pub fn mass_transform(
             box_masses_into(z, rows, cols, i0, i1, &ks, opt.z_scale, zp, masses);
             let zb = &z[i0 * cols..i1 * cols];
             sat_into(vsat, nr, cols, |r, c| {
-                (!zb[r * cols + c].is_nan()) as u8 as f64
+                (!zb[r * cols + c].to_f64().is_nan()) as u8 as f64
             });
             isats.resize_with(masses.len(), Vec::new);
             for (s, m) in isats.iter_mut().zip(masses.iter()) {
@@ -559,7 +565,9 @@ mod tests {
             let (mut zp, mut out) = (vec![7.0; 5], vec![vec![3.0; 9]; 8]);
             for ks in lists {
                 for &(r0, r1) in &[(0, rows), (rows / 3, rows), (rows / 2, rows / 2 + 1)] {
-                    box_masses_impl::<false>(&z, rows, cols, r0, r1, ks, 0.61, &mut zp, &mut out);
+                    box_masses_impl::<false, f64>(
+                        &z, rows, cols, r0, r1, ks, 0.61, &mut zp, &mut out,
+                    );
                     for m in [box_masses(&z, rows, cols, r0, r1, ks, 0.61), out.clone()] {
                         assert_eq!(m.len(), ks.len());
                         for (s, &k) in ks.iter().enumerate() {

@@ -15,6 +15,7 @@
 //! so the cost per pixel is independent of `w` and the result does not
 //! depend on the thread count.
 use super::sat::{band_rows, check_step, check_window, line_fit, log_axis, rect, sat_into};
+use crate::dimension::dbc::Sample;
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 
@@ -45,8 +46,8 @@ pub struct VariationOptions {
 /// row offset, column offset).
 type LagTables<'a> = (&'a [f64], &'a [f64], usize, usize);
 
-pub fn variation_transform(
-    z: &[f64],
+pub fn variation_transform<T: Sample>(
+    z: &[T],
     rows: usize,
     cols: usize,
     opt: &VariationOptions,
@@ -116,7 +117,7 @@ pub fn variation_transform(
             let i1 = ((g1 - 1) * step + h + 1).min(rows);
             let nr = i1 - i0;
             let sw = cols + 1;
-            let get = |r: usize, c: usize| z[(i0 + r) * cols + c];
+            let get = |r: usize, c: usize| z[(i0 + r) * cols + c].to_f64();
             sat_into(&mut sc.vsat, nr, cols, |r, c| {
                 (!get(r, c).is_nan()) as u8 as f64
             });

@@ -85,9 +85,28 @@ def _even_chunks(n: int, size: int, step: int, depth: int) -> tuple:
     return tuple(out)
 
 
+def _float_dtype(dtype) -> type:
+    """float32 stays float32 (the mass and increment kernels read it in
+    place, exactly: every float32 is a float64); anything else is float64."""
+    return np.float32 if dtype == np.float32 else np.float64
+
+
+def _nodata_mask(z: np.ndarray, nodata: float) -> np.ndarray:
+    """``z == nodata`` with the value compared as given (in float64) also
+    for a float32 image, without a float64 copy of it."""
+    if z.dtype != np.float32:
+        return z == nodata
+    with np.errstate(over="ignore"):
+        v = np.float32(nodata)
+    if float(v) != float(nodata):  # no float32 equals it (or it is NaN)
+        return np.zeros(z.shape, dtype=bool)
+    return z == v
+
+
 def _grid(z: np.ndarray, w: int, method: str, opts: dict, min_valid: float, step: int, n_threads):
     """(dimension, r²) on the grid of every ``step``-th pixel of ``z`` (NaN = missing)."""
-    z = np.ascontiguousarray(z, dtype=np.float64)
+    native = method in ("mass", "variogram", "madogram", "square")  # kernels that read float32
+    z = np.ascontiguousarray(z, dtype=_float_dtype(z.dtype) if native else np.float64)
     if method == "dbc":
         return _core.dbc_transform_map(z, w, opts["sizes"], opts["z_scale"], 0.0, opts["partial"], min_valid, step,
                                       n_threads)
@@ -334,9 +353,9 @@ def fractal_transform(
 
     def kernel(block):
         """Stacked (dimension, r²) on the ``step`` grid from the block's origin."""
-        z = np.asarray(block, dtype=np.float64)
+        z = np.asarray(block, dtype=_float_dtype(block.dtype))
         if nodata is not None:
-            z = np.where(z == nodata, np.nan, z)
+            z = np.where(_nodata_mask(z, nodata), np.nan, z)
         d, r2 = _grid(z, w, method, opts, min_valid, step, n_threads)
         return np.stack([d, r2])
 
@@ -352,7 +371,7 @@ def fractal_transform(
             # step every chunk but the last a multiple of it
             arr = arr.rechunk(tuple(_even_chunks(n, max(depth, max(c)), step, depth)
                                     for n, c in zip(arr.shape, chunks)))
-        zf = arr.astype(np.float64)
+        zf = arr.astype(_float_dtype(arr.dtype))
         padded = da.overlap.overlap(zf, depth=depth, boundary=np.nan)
         d0 = depth // step
 
@@ -367,10 +386,11 @@ def fractal_transform(
                                 meta=np.empty((0, 0, 0), np.float32))
         out = (res[0], res[1]) if return_fit else res[0]
     else:
-        # one float64 copy at most (none for a float64 input; never modified)
-        z = np.asarray(arr, dtype=np.float64)
+        # no copy of a float32 or float64 image (never modified), one of
+        # other types
+        z = np.asarray(arr, dtype=_float_dtype(arr.dtype))
         if nodata is not None:
-            z = np.where(z == nodata, np.nan, z)
+            z = np.where(_nodata_mask(z, nodata), np.nan, z)
         # fmax ignores NaN: the reduction is NaN only when every value is
         if np.isnan(np.fmax.reduce(z, axis=None)):
             raise ValueError("image: no valid value (all NaN or nodata)")
