@@ -240,9 +240,7 @@ def fractal_transform(
     band : int, optional
         0-based band index for a 3D (bands, rows, cols) input.
     n_threads : int, optional
-        Threads (default all cores): the Rust kernels' threads, and for
-        ``"whittle"`` the FFT workers and BLAS threads; results are identical
-        for any value.
+        Threads (default all cores); results are identical for any value.
     return_fit : bool, default False
         Also return the map of r² of the log-log fit (1 with two lags); for
         ``"whittle"``, the map of the standard error of ``D``.

@@ -165,21 +165,11 @@ def _fill_contrast(contrast, gram, nf, mv, pos, m, n_ord, tables):
 
 def whittle_grid(z: np.ndarray, w: int, min_valid: float, step: int, n_threads: int):
     """(dimension, standard error) maps on the ``step`` grid of ``z`` (NaN =
-    missing, image read as padded with NaN), with ``n_threads`` FFT workers
-    and BLAS threads."""
-    from threadpoolctl import threadpool_limits
-
-    workers = n_threads or os.cpu_count() or 1
-    # the matrix products below run on BLAS: hold its threads to n_threads
-    # too (results do not depend on the count)
-    with threadpool_limits(limits=workers, user_api="blas"):
-        return _whittle_grid(z, w, min_valid, step, workers)
-
-
-def _whittle_grid(z: np.ndarray, w: int, min_valid: float, step: int, workers: int):
+    missing, image read as padded with NaN)."""
     from numpy.lib.stride_tricks import sliding_window_view
     from scipy import fft, ndimage
 
+    workers = n_threads or os.cpu_count() or 1
     rows, cols = z.shape
     half = w // 2
     m = w - 1
