@@ -1,15 +1,20 @@
 //! Thread pools sized by the caller's `n_threads`.
 //!
 //! Every public kernel runs inside a rayon pool of its own size instead of the
-//! global one. Pools are built once per thread count and kept (starting
-//! threads costs tens of microseconds, as much as a whole small kernel). A
-//! forked child does not have its parent's pool threads, so the cache
-//! remembers the process id and a child never touches the parent's pools: it
-//! builds its own (rayon's global pool has no such guard, and a forked child's
-//! first parallel call on it can hang), which matters for multiprocessing and
-//! Dask workers. If the cache is busy (another thread is looking up a pool, or
-//! a fork happened while it was), the call builds a private pool, as before.
-use std::sync::{Arc, Mutex};
+//! global one. Each calling thread keeps its pools, one per thread count
+//! (starting threads costs tens of microseconds, as much as a whole small
+//! kernel): concurrent calls from several threads (Dask's threaded scheduler,
+//! Python threads with the GIL released) never share or queue on one pool, so
+//! `n_threads` is per call, as before. A forked child does not have its
+//! parent's pool threads, so the pools remember the process id and a child
+//! never touches the parent's: it builds its own (rayon's global pool has no
+//! such guard, and a forked child's first parallel call on it can hang),
+//! which matters for multiprocessing and Dask workers. The kept threads sleep
+//! between calls; they make the process multi-threaded, so Python >= 3.12
+//! warns on `os.fork()` after a kernel call, as it does after any threaded
+//! library call.
+use std::cell::RefCell;
+use std::sync::Arc;
 
 use crate::error::{CoreError, CoreResult};
 
@@ -34,9 +39,12 @@ struct PoolCache {
     pools: Vec<(usize, Arc<rayon::ThreadPool>)>,
 }
 
-static POOLS: Mutex<Option<PoolCache>> = Mutex::new(None);
+thread_local! {
+    /// The calling thread's pools.
+    static POOLS: RefCell<Option<PoolCache>> = const { RefCell::new(None) };
+}
 
-/// At most this many thread counts keep a pool.
+/// At most this many thread counts keep a pool per calling thread.
 const MAX_POOLS: usize = 4;
 
 fn build_pool(n: usize) -> CoreResult<rayon::ThreadPool> {
@@ -46,12 +54,16 @@ fn build_pool(n: usize) -> CoreResult<rayon::ThreadPool> {
         .map_err(|e| CoreError::Internal(format!("cannot start a thread pool of {n}: {e}")))
 }
 
-/// The kept pool of `n` threads of this process, built on first use.
+/// The calling thread's pool of `n` threads, built on first use.
 fn pool_of(n: usize) -> CoreResult<Arc<rayon::ThreadPool>> {
-    match POOLS.try_lock() {
-        Ok(mut guard) => lookup(&mut guard, std::process::id(), n),
-        Err(_) => build_pool(n).map(Arc::new),
-    }
+    POOLS
+        .try_with(|cell| match cell.try_borrow_mut() {
+            Ok(mut cache) => lookup(&mut cache, std::process::id(), n),
+            // re-entered from inside a kernel: a private pool
+            Err(_) => build_pool(n).map(Arc::new),
+        })
+        // the thread is exiting: a private pool
+        .unwrap_or_else(|_| build_pool(n).map(Arc::new))
 }
 
 /// Find or build the pool of `n` threads in `cache`, for process `pid`.

@@ -586,12 +586,13 @@ struct Dyadic {
     n_fg: u64,
     /// Occupancy at size 2^k.
     grid: Grid,
-    /// Bounding box of the foreground in source coordinates, rows then
-    /// columns: (first, one past the last); None when the source is empty.
+    /// Bounding box of the foreground in source coordinates:
+    /// `([first row, first column], [last row + 1, last column + 1])`;
+    /// None when the source is empty.
     bbox: Option<([usize; 2], [usize; 2])>,
 }
 
-/// Bounding box of a band: rows and columns, (first, one past the last).
+/// Bounding box of a band: `([first row, first column], [last row + 1, last column + 1])`.
 type Bounds = ([usize; 2], [usize; 2]);
 
 fn merge_bounds(a: Option<Bounds>, b: Option<Bounds>) -> Option<Bounds> {
@@ -704,26 +705,20 @@ fn dyadic_2d(src: &Src, k: usize) -> Dyadic {
     }
 }
 
-/// The `rows x cols` window of a 2D grid that starts at (`r0`, `c0`).
-fn crop_grid(g: &Grid, r0: usize, c0: usize, rows: usize, cols: usize) -> Grid {
-    let w = g.shape[2];
-    let mut data = Vec::with_capacity(rows * cols);
-    for r in r0..r0 + rows {
-        data.extend_from_slice(&g.data[r * w + c0..r * w + c0 + cols]);
-    }
-    Grid {
-        data,
-        shape: [1, rows, cols],
-    }
-}
-
 /// Depth of the fused dyadic pass for these sizes: the longest chain 2, 4,
-/// ..., 2^k among them, shortened until the rows split into enough bands to
-/// keep every thread busy.
+/// ..., 2^k among them, shortened so that every other even size is a
+/// multiple of 2^k (its count is then reduced from the level-k grid, the
+/// only level the pass keeps, instead of from the data), and until the rows
+/// split into enough bands to keep every thread busy.
 fn dyadic_depth(sizes: &[usize], n_rows: usize) -> usize {
     let mut k = 0;
     while sizes.contains(&(1usize << (k + 1))) {
         k += 1;
+    }
+    for &s in sizes {
+        if s % 2 == 0 && !s.is_power_of_two() {
+            k = k.min(s.trailing_zeros() as usize);
+        }
     }
     let min_bands = 4 * rayon::current_num_threads();
     while k > 0 && n_boxes(n_rows, 1 << k, 0) < min_bands {
@@ -797,14 +792,15 @@ pub fn box_count(
         Some(validate_box_sizes(box_sizes, max_len)?)
     };
     let empty = || CoreError::invalid("data", "the set is empty (no foreground sample)");
-    // A 2D set with given sizes that start a dyadic chain: the unshifted
-    // lattice of the whole array is counted in one fused pass, which finds the
-    // bounding box on the way (no separate scan). Its counts are kept when
-    // that lattice is the one asked for: anchored at the array, or at a
-    // bounding box that starts on it.
+    // A 2D set anchored at the array, with given sizes that start a dyadic
+    // chain: the unshifted lattice of the whole array is counted in one fused
+    // pass, which finds the bounding box on the way (no separate scan). With
+    // the bounding-box anchor the box comes first (`scan` reads dense rows
+    // only up to their first and last foreground sample) and the fused pass
+    // runs on it below.
     let mut pre: Option<(usize, Dyadic)> = None;
     let pre_depth = match &given {
-        Some(sz) if vol.shape[0] == 1 => dyadic_depth(sz, vol.shape[1]),
+        Some(sz) if vol.shape[0] == 1 && anchor == Anchor::Array => dyadic_depth(sz, vol.shape[1]),
         _ => 0,
     };
     let (bmin, bmax) = if pre_depth > 0 {
@@ -817,10 +813,7 @@ pub fn box_count(
         };
         let d = dyadic_2d(&full, pre_depth);
         let (lo, hi) = d.bbox.ok_or_else(empty)?;
-        let step = 1 << pre_depth;
-        if anchor == Anchor::Array || (lo[0] % step == 0 && lo[1] % step == 0) {
-            pre = Some((pre_depth, d));
-        }
+        pre = Some((pre_depth, d));
         ([0, lo[0], lo[1]], [1, hi[0], hi[1]])
     } else {
         scan(vol).ok_or_else(empty)?
@@ -862,20 +855,9 @@ pub fn box_count(
         // 2D, unshifted lattice: sizes 2, 4, ..., 2^k in one fused pass
         let fused = if *g != [0; 3] || vol.shape[0] != 1 {
             None
-        } else if let Some((k, d)) = pre.take() {
-            // counted on the whole array: crop the grid to the lattice's origin
-            let cropped = if lo == [0; 3] {
-                d.grid
-            } else {
-                crop_grid(
-                    &d.grid,
-                    lo[1] >> k,
-                    lo[2] >> k,
-                    n_boxes(shape[1], 1 << k, 0),
-                    n_boxes(shape[2], 1 << k, 0),
-                )
-            };
-            Some((k, Dyadic { grid: cropped, ..d }))
+        } else if let Some(kd) = pre.take() {
+            // counted on the whole array, which is this lattice's origin
+            Some(kd)
         } else {
             let k = dyadic_depth(&sizes, shape[1]);
             (k > 0).then(|| (k, dyadic_2d(&base, k)))
@@ -1226,6 +1208,57 @@ mod tests {
     }
 
     #[test]
+    fn long_rows_flush_the_byte_lane_counters() {
+        // 20,000 bytes: the u8 lane counters of the SIMD bodies are flushed
+        // many times (every 120 steps of 32 or 64 bytes)
+        let n = 20_000usize;
+        let a = vec![255u8; n];
+        let b: Vec<u8> = (0..n).map(|i| (i % 3 == 0) as u8).collect();
+        let mut out = vec![0u8; n / 2];
+        let (c_out, c_a, c_b) = level_row(&a, Some(&b), &mut out, true);
+        assert_eq!(
+            (c_out, c_a, c_b),
+            (n as u64 / 2, n as u64, n.div_ceil(3) as u64)
+        );
+        #[cfg(target_arch = "x86_64")]
+        {
+            let n32 = n / 32;
+            let mut o = vec![0u8; 16 * n32];
+            let r = level_row_sse2(&a, &b, &mut o, n32, true);
+            let nb = b[..32 * n32].iter().filter(|&&v| v != 0).count() as u64;
+            assert_eq!(r, (16 * n32 as u64, 32 * n32 as u64, nb));
+        }
+        let zeros = vec![0u8; n];
+        assert_eq!(level_row(&zeros, Some(&zeros), &mut out, true), (0, 0, 0));
+    }
+
+    #[test]
+    fn fused_depth_keeps_every_even_size_reducible() {
+        crate::parallel::run_in_pool(Some(1), || {
+            assert_eq!(dyadic_depth(&[1, 2, 4, 8, 16], 1024), 4);
+            assert_eq!(dyadic_depth(&[1, 2, 4, 8, 12], 1024), 2); // 12 = 4 * 3
+            assert_eq!(dyadic_depth(&[1, 2, 4, 10, 20, 50, 100], 1024), 1);
+            assert_eq!(dyadic_depth(&[1, 3, 9, 27], 1024), 0);
+            // one thread: at least 4 bands of 2^k rows
+            assert_eq!(dyadic_depth(&[1, 2, 4, 8, 16], 16), 2);
+            Ok(())
+        })
+        .unwrap();
+    }
+
+    #[test]
+    fn empty_set_is_an_error_on_the_fused_path_too() {
+        let data = vec![0u8; 64 * 64];
+        let vol = ByteVolume::new(&data, &[64, 64]).unwrap();
+        for anchor in [Anchor::Array, Anchor::BoundingBox] {
+            assert!(matches!(
+                box_count(&vol, 2, &[1, 2, 4, 8], 1, anchor),
+                Err(CoreError::InvalidArgument { .. })
+            ));
+        }
+    }
+
+    #[test]
     fn fused_and_general_paths_agree_through_box_count() {
         // dyadic sizes take the fused pass on the unshifted lattice; offsets
         // and odd sizes take the general reduction from its grid
@@ -1248,9 +1281,15 @@ mod tests {
             }
             d
         };
-        for data in [data, sparse(32, 64), sparse(37, 21)] {
-            check_all_lattices(&data, &dims);
-        }
+        // two threads: the fused depth (and so the paths taken) depends on
+        // the thread count
+        crate::parallel::run_in_pool(Some(2), || {
+            for data in [&data, &sparse(32, 64), &sparse(37, 21)] {
+                check_all_lattices(data, &dims);
+            }
+            Ok(())
+        })
+        .unwrap();
     }
 
     fn check_all_lattices(data: &[u8], dims: &[usize]) {

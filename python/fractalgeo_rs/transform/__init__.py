@@ -231,7 +231,8 @@ def fractal_transform(
         Compute the map on every ``step``-th row and column only (pixels
         ``(k * step, l * step)``): the output has shape
         ``(ceil(rows / step), ceil(cols / step))``, equal to the full map at
-        those pixels. Only those windows are fitted.
+        those pixels (to rounding, 1e-6: window sums are taken from tables
+        whose origins depend on ``step``). Only those windows are fitted.
     nodata : float, optional
         Value marking missing samples, in addition to NaN.
     min_valid : float, default 0.5
@@ -241,6 +242,10 @@ def fractal_transform(
         0-based band index for a 3D (bands, rows, cols) input.
     n_threads : int, optional
         Threads (default all cores); results are identical for any value.
+        For ``"whittle"`` these are the FFT workers; its matrix products run
+        on numpy's BLAS threads, which this does not limit (set
+        ``OPENBLAS_NUM_THREADS`` before starting Python, e.g. in Dask
+        workers).
     return_fit : bool, default False
         Also return the map of r² of the log-log fit (1 with two lags); for
         ``"whittle"``, the map of the standard error of ``D``.
