@@ -12,30 +12,30 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMet
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
+/// Run `f` on the pixels of a C-contiguous image with the GIL released, in a
+/// pool of `n_threads`; returns `(result, rows, cols)`.
+fn run_on_image<T: numpy::Element + Sync, R: Send>(
+    py: Python<'_>,
+    a: &PyReadonlyArray2<'_, T>,
+    n_threads: Option<usize>,
+    f: impl FnOnce(&[T], usize, usize) -> crate::error::CoreResult<R> + Send,
+) -> PyResult<(R, usize, usize)> {
+    let (rows, cols) = (a.shape()[0], a.shape()[1]);
+    let z = a
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
+    let r = py.detach(|| run_in_pool(n_threads, || f(z, rows, cols)))?;
+    Ok((r, rows, cols))
+}
+
 /// Run a map kernel on a 2D float32 or float64 image, read in place (no
 /// float64 copy of a float32 scene); evaluates to `(result, rows, cols)`.
 macro_rules! on_float_image {
     ($py:expr, $image:expr, $n_threads:expr, |$z:ident, $rows:ident, $cols:ident| $body:expr) => {{
         if let Ok(a) = $image.extract::<PyReadonlyArray2<'_, f32>>() {
-            let ($rows, $cols) = (a.shape()[0], a.shape()[1]);
-            let $z = a
-                .as_slice()
-                .map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
-            (
-                $py.detach(|| run_in_pool($n_threads, || $body))?,
-                $rows,
-                $cols,
-            )
+            run_on_image($py, &a, $n_threads, |$z, $rows, $cols| $body)?
         } else if let Ok(a) = $image.extract::<PyReadonlyArray2<'_, f64>>() {
-            let ($rows, $cols) = (a.shape()[0], a.shape()[1]);
-            let $z = a
-                .as_slice()
-                .map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
-            (
-                $py.detach(|| run_in_pool($n_threads, || $body))?,
-                $rows,
-                $cols,
-            )
+            run_on_image($py, &a, $n_threads, |$z, $rows, $cols| $body)?
         } else {
             return Err(PyTypeError::new_err(
                 "image: expected a 2D float32 or float64 array",
