@@ -1,20 +1,27 @@
 //! Thread pools sized by the caller's `n_threads`.
 //!
 //! Every public kernel runs inside a rayon pool of its own size instead of the
-//! global one. Each calling thread keeps its pools, one per thread count
-//! (starting threads costs tens of microseconds, as much as a whole small
-//! kernel): concurrent calls from several threads (Dask's threaded scheduler,
-//! Python threads with the GIL released) never share or queue on one pool, so
-//! `n_threads` is per call, as before. A forked child does not have its
-//! parent's pool threads, so the pools remember the process id and a child
-//! never touches the parent's: it builds its own (rayon's global pool has no
-//! such guard, and a forked child's first parallel call on it can hang),
-//! which matters for multiprocessing and Dask workers. The kept threads sleep
-//! between calls; they make the process multi-threaded, so Python >= 3.12
-//! warns on `os.fork()` after a kernel call, as it does after any threaded
-//! library call.
+//! global one, and pools are kept between calls (starting threads costs tens
+//! of microseconds, as much as a whole small kernel):
+//!
+//! * a pool of every core (the default) is shared by the whole process:
+//!   concurrent calls (Dask's threaded scheduler, Python threads with the GIL
+//!   released) interleave their work on its threads instead of each starting
+//!   one thread per core;
+//! * a smaller pool (e.g. `n_threads=1` per Dask block) is kept per calling
+//!   thread, so concurrent calls never queue on one another.
+//!
+//! A forked child does not have its parent's pool threads, so the pools
+//! remember the process id and a child never touches the parent's: it builds
+//! its own (rayon's global pool has no such guard, and a forked child's first
+//! parallel call on it can hang), which matters for multiprocessing and Dask
+//! workers. When the shared pools are busy (another thread is looking one up,
+//! or a fork happened while it was), the call builds a private pool. The kept
+//! threads sleep between calls; they make the process multi-threaded, so
+//! Python >= 3.12 warns on `os.fork()` after a kernel call, as it does after
+//! any threaded library call.
 use std::cell::RefCell;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use crate::error::{CoreError, CoreResult};
 
@@ -40,11 +47,14 @@ struct PoolCache {
 }
 
 thread_local! {
-    /// The calling thread's pools.
+    /// The calling thread's pools of fewer threads than cores.
     static POOLS: RefCell<Option<PoolCache>> = const { RefCell::new(None) };
 }
 
-/// At most this many thread counts keep a pool per calling thread.
+/// The process's pools of at least as many threads as cores.
+static SHARED: Mutex<Option<PoolCache>> = Mutex::new(None);
+
+/// At most this many thread counts keep a pool (per calling thread, and shared).
 const MAX_POOLS: usize = 4;
 
 fn build_pool(n: usize) -> CoreResult<rayon::ThreadPool> {
@@ -54,16 +64,23 @@ fn build_pool(n: usize) -> CoreResult<rayon::ThreadPool> {
         .map_err(|e| CoreError::Internal(format!("cannot start a thread pool of {n}: {e}")))
 }
 
-/// The calling thread's pool of `n` threads, built on first use.
+/// A kept pool of `n` threads, built on first use: shared by the process
+/// when `n` is at least the number of cores, else the calling thread's.
 fn pool_of(n: usize) -> CoreResult<Arc<rayon::ThreadPool>> {
+    let pid = std::process::id();
+    let private = || build_pool(n).map(Arc::new);
+    if n >= resolve_threads(None) {
+        return match SHARED.try_lock() {
+            Ok(mut cache) => lookup(&mut cache, pid, n),
+            Err(_) => private(), // busy, or held by another thread at a fork
+        };
+    }
     POOLS
         .try_with(|cell| match cell.try_borrow_mut() {
-            Ok(mut cache) => lookup(&mut cache, std::process::id(), n),
-            // re-entered from inside a kernel: a private pool
-            Err(_) => build_pool(n).map(Arc::new),
+            Ok(mut cache) => lookup(&mut cache, pid, n),
+            Err(_) => private(), // not reached: the borrow ends before a kernel runs
         })
-        // the thread is exiting: a private pool
-        .unwrap_or_else(|_| build_pool(n).map(Arc::new))
+        .unwrap_or_else(|_| private()) // the thread is exiting
 }
 
 /// Find or build the pool of `n` threads in `cache`, for process `pid`.
@@ -80,8 +97,11 @@ fn lookup(cache: &mut Option<PoolCache>, pid: u32, n: usize) -> CoreResult<Arc<r
         }
         cache.pid = pid;
     }
-    if let Some((_, p)) = cache.pools.iter().find(|(k, _)| *k == n) {
-        return Ok(p.clone());
+    if let Some(i) = cache.pools.iter().position(|(k, _)| *k == n) {
+        // most recently used last: the eviction below drops the least recent
+        let entry = cache.pools.remove(i);
+        cache.pools.push(entry);
+        return Ok(cache.pools[cache.pools.len() - 1].1.clone());
     }
     let pool = Arc::new(build_pool(n)?);
     if cache.pools.len() >= MAX_POOLS {
@@ -100,8 +120,14 @@ where
     F: FnOnce() -> CoreResult<T> + Send,
 {
     let n = resolve_threads(n_threads);
-    let pool = pool_of(n)?;
-    let result = pool.install(|| std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)));
+    let run = || std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
+    // already on a worker of a pool of this size (a kernel calling a kernel):
+    // run here rather than keep pools in the worker's thread
+    let result = if rayon::current_thread_index().is_some() && rayon::current_num_threads() == n {
+        run()
+    } else {
+        pool_of(n)?.install(run)
+    };
     match result {
         Ok(r) => r,
         Err(payload) => {
@@ -154,5 +180,25 @@ mod tests {
             lookup(&mut cache, 11, n).unwrap();
         }
         assert_eq!(cache.as_ref().unwrap().pools.len(), MAX_POOLS);
+        // the least recently used count is evicted, not the first built
+        let mut cache = None;
+        let keep = lookup(&mut cache, 12, 1).unwrap();
+        for n in 2..=MAX_POOLS {
+            lookup(&mut cache, 12, n).unwrap();
+        }
+        assert!(Arc::ptr_eq(&keep, &lookup(&mut cache, 12, 1).unwrap()));
+        lookup(&mut cache, 12, MAX_POOLS + 1).unwrap(); // evicts 2
+        assert!(Arc::ptr_eq(&keep, &lookup(&mut cache, 12, 1).unwrap()));
+        assert!(cache.as_ref().unwrap().pools.iter().all(|(k, _)| *k != 2));
+    }
+
+    #[test]
+    fn a_kernel_inside_a_pool_of_its_size_runs_in_place() {
+        let outer = run_in_pool(Some(3), || {
+            let idx = rayon::current_thread_index();
+            run_in_pool(Some(3), move || Ok((idx, rayon::current_thread_index())))
+        })
+        .unwrap();
+        assert_eq!(outer.0, outer.1);
     }
 }
