@@ -154,6 +154,9 @@ def test_plane_is_two_in_the_interior_and_rough_is_higher():
         (dict(window_size=9, method="variogram", lags=(1, 9)), ValueError, "lags"),
         (dict(window_size=9, min_valid=2), ValueError, "min_valid"),
         (dict(window_size=9, n_threads=0), ValueError, "n_threads"),
+        (dict(window_size=9, nodata="x"), TypeError, "nodata"),
+        (dict(window_size=9, nodata=True), TypeError, "nodata"),
+        (dict(window_size=9, z_scale="1"), TypeError, "z_scale"),
     ],
 )
 def test_bad_arguments(kwargs, exc, param):

@@ -69,6 +69,15 @@ def check_positive_float(value, name: str) -> float:
     return value
 
 
+def check_nodata(nodata) -> Optional[float]:
+    """``None`` or a real number (NaN allowed: NaN is always missing)."""
+    if nodata is None:
+        return None
+    if isinstance(nodata, (bool, np.bool_)) or not isinstance(nodata, numbers.Real):
+        raise TypeError(f"nodata: expected a number or None, got {nodata!r}")
+    return float(nodata)
+
+
 def check_choice(value, name: str, choices) -> str:
     if value not in choices:
         opts = ", ".join(repr(c) for c in choices)

@@ -386,13 +386,7 @@ pub fn refine_2d_window(
     } else {
         (2 * r - 1, 2 * c - 1)
     };
-    let (or, oc) = shape.unwrap_or((fr, fc));
-    if or < 1 || oc < 1 || or > fr || oc > fc {
-        return Err(CoreError::invalid(
-            "shape",
-            format!("expected 1 .. {fr} rows and 1 .. {fc} columns, got {or} x {oc}"),
-        ));
-    }
+    let (or, oc) = window_shape(shape, (fr, fc))?;
     // Centres: (nr, nc) of them at fine (2a+1, 2b+1).
     let (nr, nc) = if p.periodic { (r, c) } else { (r - 1, c - 1) };
     let scale = p.sigma * p.coarse_spacing.powf(p.hurst);
@@ -423,6 +417,20 @@ pub fn refine_2d_window(
     Array2::from_shape_vec((or, oc), fine).map_err(|e| CoreError::Internal(e.to_string()))
 }
 
+/// The `shape = (rows, cols)` kept of a grid of `full` samples (`None`:
+/// all of it), checked to be a non-empty corner of it.
+fn window_shape(shape: Option<(usize, usize)>, full: (usize, usize)) -> CoreResult<(usize, usize)> {
+    let (fr, fc) = full;
+    let (or, oc) = shape.unwrap_or(full);
+    if or < 1 || oc < 1 || or > fr || oc > fc {
+        return Err(CoreError::invalid(
+            "shape",
+            format!("expected 1 .. {fr} rows and 1 .. {fc} columns, got {or} x {oc}"),
+        ));
+    }
+    Ok((or, oc))
+}
+
 /// Refine `levels` times (levels numbered from `base.level`), halving the
 /// spacing each time; keys use the final grid of each level (origin 0).
 pub fn refine_2d_levels(
@@ -444,14 +452,10 @@ pub fn refine_2d_levels_window(
 ) -> CoreResult<Array2<f64>> {
     check(base)?;
     if levels == 0 {
-        let (r, c) = coarse.dim();
-        let (or, oc) = shape.unwrap_or((r, c));
-        if or < 1 || oc < 1 || or > r || oc > c {
-            return Err(CoreError::invalid(
-                "shape",
-                format!("expected 1 .. {r} rows and 1 .. {c} columns, got {or} x {oc}"),
-            ));
-        }
+        let Some(shape) = shape else {
+            return Ok(coarse.to_owned());
+        };
+        let (or, oc) = window_shape(Some(shape), coarse.dim())?;
         return Ok(coarse.slice(ndarray::s![..or, ..oc]).to_owned());
     }
     let mut grid = coarse.to_owned();

@@ -48,8 +48,8 @@ pub fn box_masses<T: Sample>(
     ks: &[usize],
     z_scale: f64,
 ) -> Vec<Vec<f64>> {
-    let mut out = Vec::new();
-    box_masses_into(
+    let mut buf = MassBuf::default();
+    let band = Band {
         z,
         rows,
         cols,
@@ -57,34 +57,41 @@ pub fn box_masses<T: Sample>(
         r1,
         ks,
         z_scale,
-        &mut Vec::new(),
-        &mut out,
-    );
-    out
+    };
+    box_masses_into(&band, &mut buf);
+    buf.planes
 }
 
-/// [`box_masses`] into reusable buffers: `out` (resized to one plane per box
-/// size) and `zp` (the NaN-padded band).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn box_masses_into<T: Sample>(
-    z: &[T],
-    rows: usize,
-    cols: usize,
-    r0: usize,
-    r1: usize,
-    ks: &[usize],
-    z_scale: f64,
-    zp: &mut Vec<f64>,
-    out: &mut Vec<Vec<f64>>,
-) {
+/// Rows `[r0, r1)` of a `rows x cols` image, with the box half-sides `ks`
+/// (ascending) and the height unit `z_scale` of [`box_masses`].
+pub(crate) struct Band<'a, T> {
+    pub z: &'a [T],
+    pub rows: usize,
+    pub cols: usize,
+    pub r0: usize,
+    pub r1: usize,
+    pub ks: &'a [usize],
+    pub z_scale: f64,
+}
+
+/// Buffers of [`box_masses_into`], reusable from band to band: the
+/// NaN-padded band and the mass planes (`[size][row - r0][col]`).
+#[derive(Default)]
+pub(crate) struct MassBuf {
+    zp: Vec<f64>,
+    pub planes: Vec<Vec<f64>>,
+}
+
+/// [`box_masses`] into reusable buffers (`buf.planes` holds the result).
+pub(crate) fn box_masses_into<T: Sample>(band: &Band<T>, buf: &mut MassBuf) {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2 (checked just above).
-            return unsafe { box_masses_avx2(z, rows, cols, r0, r1, ks, z_scale, zp, out) };
+            return unsafe { box_masses_avx2(band, buf) };
         }
     }
-    box_masses_impl::<false, T>(z, rows, cols, r0, r1, ks, z_scale, zp, out)
+    box_masses_impl::<false, T>(band, buf)
 }
 
 /// [`box_masses`] compiled for AVX2 (4 doubles per compare). The arithmetic
@@ -92,19 +99,8 @@ pub(crate) fn box_masses_into<T: Sample>(
 /// operations in either build, so the counts are identical.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-#[allow(clippy::too_many_arguments)]
-unsafe fn box_masses_avx2<T: Sample>(
-    z: &[T],
-    rows: usize,
-    cols: usize,
-    r0: usize,
-    r1: usize,
-    ks: &[usize],
-    z_scale: f64,
-    zp: &mut Vec<f64>,
-    out: &mut Vec<Vec<f64>>,
-) {
-    box_masses_impl::<true, T>(z, rows, cols, r0, r1, ks, z_scale, zp, out)
+unsafe fn box_masses_avx2<T: Sample>(band: &Band<T>, buf: &mut MassBuf) {
+    box_masses_impl::<true, T>(band, buf)
 }
 
 /// Pixels per block of [`box_masses_impl`]: the block's counters stay in
@@ -116,25 +112,24 @@ const MAX_THR: usize = 2;
 /// `AVX2`: count with the AVX2 intrinsics of [`avx2::ring`] (only
 /// instantiated by [`box_masses_avx2`], which runs once AVX2 is detected).
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn box_masses_impl<const AVX2: bool, T: Sample>(
-    z: &[T],
-    rows: usize,
-    cols: usize,
-    r0: usize,
-    r1: usize,
-    ks: &[usize],
-    z_scale: f64,
-    zp: &mut Vec<f64>,
-    out: &mut Vec<Vec<f64>>,
-) {
+fn box_masses_impl<const AVX2: bool, T: Sample>(band: &Band<T>, buf: &mut MassBuf) {
+    let &Band {
+        z,
+        rows,
+        cols,
+        r0,
+        r1,
+        ks,
+        z_scale,
+    } = band;
+    let MassBuf { zp, planes: out } = buf;
     let kmax = *ks.last().unwrap_or(&0);
     let nr = r1 - r0;
     let thr: Vec<f64> = ks.iter().map(|&k| (k as f64 + 0.5) * z_scale).collect();
-    // every value of every plane is written below (blocks cover the columns)
+    // every value of every plane is written below (blocks cover the columns):
+    // a reused plane keeps its old values until then, with no zeroing pass
     out.resize_with(ks.len(), Vec::new);
     for o in out.iter_mut() {
-        o.clear();
         o.resize(nr * cols, 0.0);
     }
     if nr == 0 || cols == 0 || ks.is_empty() {
@@ -353,9 +348,19 @@ pub fn mass_curve(
     let band = 64usize;
     let partial: Vec<(Vec<f64>, f64)> = (0..rows.div_ceil(band))
         .into_par_iter()
-        .map(|b| {
+        .map_init(MassBuf::default, |buf, b| {
             let (r0, r1) = (b * band, ((b + 1) * band).min(rows));
-            let m = box_masses(z, rows, cols, r0, r1, &ks, z_scale);
+            let job = Band {
+                z,
+                rows,
+                cols,
+                r0,
+                r1,
+                ks: &ks,
+                z_scale,
+            };
+            box_masses_into(&job, buf);
+            let m = &buf.planes;
             let n = m[0].iter().filter(|&&v| v > 0.0).count() as f64;
             let sums = m
                 .iter()
@@ -424,8 +429,7 @@ pub fn mass_transform<T: Sample>(
     // page-faulted and zeroed by the OS for every band)
     #[derive(Default)]
     struct Scratch {
-        zp: Vec<f64>,
-        masses: Vec<Vec<f64>>,
+        masses: MassBuf,
         vsat: Vec<f64>,
         isats: Vec<Vec<f64>>,
     }
@@ -441,12 +445,21 @@ pub fn mass_transform<T: Sample>(
             let nr = i1 - i0;
             let sw = cols + 1;
             let Scratch {
-                zp,
                 masses,
                 vsat,
                 isats,
             } = sc;
-            box_masses_into(z, rows, cols, i0, i1, &ks, opt.z_scale, zp, masses);
+            let job = Band {
+                z,
+                rows,
+                cols,
+                r0: i0,
+                r1: i1,
+                ks: &ks,
+                z_scale: opt.z_scale,
+            };
+            box_masses_into(&job, masses);
+            let masses = &masses.planes;
             let zb = &z[i0 * cols..i1 * cols];
             sat_into(vsat, nr, cols, |r, c| {
                 (!zb[r * cols + c].to_f64().is_nan()) as u8 as f64
@@ -561,13 +574,25 @@ mod tests {
                 &[3, 5, 6, 7, 9, 10],
                 &[20],
             ];
-            // reused buffers, left dirty by the previous call (as in the band driver)
-            let (mut zp, mut out) = (vec![7.0; 5], vec![vec![3.0; 9]; 8]);
+            // reused buffers, dirty everywhere (3.0, 7.0, then the previous
+            // call's results), as in the band drivers
+            let mut buf = MassBuf {
+                zp: vec![7.0; 100_000],
+                planes: vec![vec![3.0; 100_000]; 8],
+            };
             for ks in lists {
                 for &(r0, r1) in &[(0, rows), (rows / 3, rows), (rows / 2, rows / 2 + 1)] {
-                    box_masses_impl::<false, f64>(
-                        &z, rows, cols, r0, r1, ks, 0.61, &mut zp, &mut out,
-                    );
+                    let job = Band {
+                        z: &z[..],
+                        rows,
+                        cols,
+                        r0,
+                        r1,
+                        ks,
+                        z_scale: 0.61,
+                    };
+                    box_masses_impl::<false, f64>(&job, &mut buf);
+                    let out = buf.planes.clone();
                     for m in [box_masses(&z, rows, cols, r0, r1, ks, 0.61), out.clone()] {
                         assert_eq!(m.len(), ks.len());
                         for (s, &k) in ks.iter().enumerate() {

@@ -16,22 +16,43 @@ pub(crate) fn sat(values: &[f64], rows: usize, cols: usize) -> Vec<f64> {
     s
 }
 
-/// [`sat`] of the values `f(r, c)`, written into `s` (resized and
-/// overwritten: a reused buffer gives the same table).
+/// [`sat`] of the values `f(r, c)`, written into `s` (see [`sats_into`]).
 pub(crate) fn sat_into(
     s: &mut Vec<f64>,
     rows: usize,
     cols: usize,
     f: impl Fn(usize, usize) -> f64,
 ) {
+    sats_into([s], rows, cols, |r, c| [f(r, c)]);
+}
+
+/// [`sat`] of each of the `N` values of `f(r, c)`, in one pass (for values
+/// that share their computation), written into reusable buffers: each is
+/// resized, its row 0 and column 0 zeroed and every other entry written, so
+/// a reused buffer gives the same table without a zeroing pass.
+pub(crate) fn sats_into<const N: usize>(
+    tables: [&mut Vec<f64>; N],
+    rows: usize,
+    cols: usize,
+    f: impl Fn(usize, usize) -> [f64; N],
+) {
     let w = cols + 1;
-    s.clear();
-    s.resize((rows + 1) * w, 0.0);
+    let mut tables = tables;
+    for s in tables.iter_mut() {
+        s.resize((rows + 1) * w, 0.0);
+        s[..w].fill(0.0);
+        for r in 1..=rows {
+            s[r * w] = 0.0;
+        }
+    }
     for r in 0..rows {
-        let mut run = 0.0;
+        let mut run = [0.0f64; N];
         for c in 0..cols {
-            run += f(r, c);
-            s[(r + 1) * w + c + 1] = s[r * w + c + 1] + run;
+            let v = f(r, c);
+            for ((s, acc), x) in tables.iter_mut().zip(run.iter_mut()).zip(v) {
+                *acc += x;
+                s[(r + 1) * w + c + 1] = s[r * w + c + 1] + *acc;
+            }
         }
     }
 }
@@ -118,4 +139,31 @@ pub(crate) fn log_axis(scales: &[usize]) -> (Vec<f64>, f64, f64) {
     let xm = xs.iter().sum::<f64>() / xs.len() as f64;
     let sxx = xs.iter().map(|x| (x - xm) * (x - xm)).sum();
     (xs, xm, sxx)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reused_dirty_buffers_give_the_fresh_tables() {
+        let (rows, cols) = (7usize, 5usize);
+        let v: Vec<f64> = (0..rows * cols)
+            .map(|k| (k * 37 % 11) as f64 - 3.0)
+            .collect();
+        let fresh = sat(&v, rows, cols);
+        let neg: Vec<f64> = v.iter().map(|x| -x).collect();
+        let fresh_neg = sat(&neg, rows, cols);
+        // larger and smaller dirty buffers, and a same-size one of another shape
+        for len in [0usize, 10, 48, 500] {
+            let (mut a, mut b) = (vec![9.5; len], vec![-4.0; len]);
+            sats_into([&mut a, &mut b], rows, cols, |r, c| {
+                [v[r * cols + c], -v[r * cols + c]]
+            });
+            assert_eq!((&a, &b), (&fresh, &fresh_neg), "len {len}");
+            let mut s = vec![1.0; len];
+            sat_into(&mut s, rows, cols, |r, c| v[r * cols + c]);
+            assert_eq!(s, fresh);
+        }
+    }
 }

@@ -14,7 +14,9 @@
 //! increment powers and counts, built per band of rows at fixed positions,
 //! so the cost per pixel is independent of `w` and the result does not
 //! depend on the thread count.
-use super::sat::{band_rows, check_step, check_window, line_fit, log_axis, rect, sat_into};
+use super::sat::{
+    band_rows, check_step, check_window, line_fit, log_axis, rect, sat_into, sats_into,
+};
 use crate::dimension::dbc::Sample;
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
@@ -42,10 +44,6 @@ pub struct VariationOptions {
 /// Local dimension and r² maps (row-major, NaN where the window has too few
 /// valid pixels or a lag has no valid increment) on the grid of every
 /// `step`-th pixel: `ceil(rows / step) x ceil(cols / step)`.
-/// Summed-area tables of one increment component: (power SAT, count SAT,
-/// row offset, column offset).
-type LagTables<'a> = (&'a [f64], &'a [f64], usize, usize);
-
 pub fn variation_transform<T: Sample>(
     z: &[T],
     rows: usize,
@@ -138,28 +136,18 @@ pub fn variation_transform<T: Sample>(
                             }
                         }
                     };
-                    sat_into(ps, nr, cols, |r, c| {
+                    // power and count of each increment, computed once
+                    sats_into([ps, ct], nr, cols, |r, c| {
                         let d = inc(r, c);
                         if d.is_nan() {
-                            0.0
+                            [0.0, 0.0]
                         } else {
-                            power(d)
+                            [power(d), 1.0]
                         }
                     });
-                    sat_into(ct, nr, cols, |r, c| (!inc(r, c).is_nan()) as u8 as f64);
                 }
             }
             let (vsat, tables) = (&sc.vsat, &sc.tables);
-            let tables: Vec<Vec<LagTables>> = tables
-                .iter()
-                .zip(&comps)
-                .map(|(t, cs)| {
-                    t.iter()
-                        .zip(cs)
-                        .map(|((ps, ct), &(du_r, du_c))| (ps.as_slice(), ct.as_slice(), du_r, du_c))
-                        .collect()
-                })
-                .collect();
             let mut ys = vec![0.0f64; lags.len()];
             for g in g0..g1 {
                 let i = g * step;
@@ -174,12 +162,13 @@ pub fn variation_transform<T: Sample>(
                         continue;
                     }
                     let mut ok = true;
-                    for (li, t) in tables.iter().enumerate() {
+                    // per lag, the (power, count) tables of each component
+                    for (li, (t, offs)) in tables.iter().zip(&comps).enumerate() {
                         let (mut sp, mut sc) = (0.0, 0.0);
-                        for (ps, cs, du_r, du_c) in t {
+                        for ((ps, cs), &(du_r, du_c)) in t.iter().zip(offs) {
                             // anchors whose partner lies in the window too
-                            let rr1 = r1.saturating_sub(*du_r);
-                            let cc1 = c1.saturating_sub(*du_c);
+                            let rr1 = r1.saturating_sub(du_r);
+                            let cc1 = c1.saturating_sub(du_c);
                             sp += rect(ps, sw, r0, rr1, c0, cc1);
                             sc += rect(cs, sw, r0, rr1, c0, cc1);
                         }

@@ -6,7 +6,7 @@ import numbers
 import numpy as np
 
 from fractalgeo_rs import _core
-from fractalgeo_rs._validation import as_array, check_n_threads
+from fractalgeo_rs._validation import as_array, check_n_threads, check_nodata
 
 __all__ = ["hillshade", "shade_to_byte", "metres_per_degree"]
 
@@ -124,10 +124,9 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
         z = np.ascontiguousarray(z, dtype=np.float64)  # the kernel only reads it
     else:
         z = np.array(z, dtype=np.float64)  # a copy: the caller's array is never touched
+    nodata = check_nodata(nodata)
     if nodata is not None:
-        if not isinstance(nodata, numbers.Real) or isinstance(nodata, bool):
-            raise TypeError(f"nodata: expected a number or None, got {nodata!r}")
-        z[z == float(nodata)] = np.nan
+        z[z == nodata] = np.nan
     for name, v in (("azimuth", azimuth), ("altitude", altitude), ("z_factor", z_factor)):
         if isinstance(v, bool) or not isinstance(v, numbers.Real) or not np.isfinite(v):
             raise ValueError(f"{name}: expected a finite number, got {v!r}")

@@ -30,6 +30,7 @@ from fractalgeo_rs._validation import (
     as_array,
     check_choice,
     check_n_threads,
+    check_nodata,
     check_positive_float,
     check_positive_int,
 )
@@ -266,9 +267,8 @@ def _surface_float(data, nodata, name: str = "data", ndims=(2,)) -> np.ndarray:
     if arr.dtype.kind not in "iuf":
         raise TypeError(f"{name}: expected a numeric array, got dtype {arr.dtype}")
     out = arr if arr.dtype in (np.float32, np.float64) else arr.astype(np.float64)
+    nodata = check_nodata(nodata)
     if nodata is not None:
-        if isinstance(nodata, bool) or not np.isscalar(nodata):
-            raise TypeError(f"nodata: expected a number, got {nodata!r}")
         if np.isnan(nodata):
             pass  # NaN is always nodata
         else:

@@ -67,6 +67,10 @@ _FILTERS_2D: Dict[str, Dict[Tuple[int, ...], float]] = {
 # pooled filters: the contrasts of several filtered fields are summed
 # (a composite likelihood with a shared sigma^2)
 _POOLED = {"first": ("rows", "columns")}
+# shared with the Whittle map (fractalgeo_rs.transform._whittle):
+_MIN_FILTERED = 16  # fewest valid filtered samples of a fit
+_F_FLOOR = 1e-300  # expected periodogram floor, relative to its largest value
+_VANISH = 1e-24  # a filtered field whose mean power is below this times max |z|^2 vanishes
 
 
 def _apply_filter(z: np.ndarray, offsets: np.ndarray, weights: np.ndarray) -> np.ndarray:
@@ -396,8 +400,8 @@ def _whittle_contrast(z, nd, table, parts, taper, spacing, exclude_zero):
         y = _apply_filter(z, off, w)
         valid = ~np.isnan(y)
         nv = int(np.count_nonzero(valid))
-        if nv < 16:
-            raise ValueError(f"data: only {nv} valid filtered samples (NaN or nodata), need at least 16")
+        if nv < _MIN_FILTERED:
+            raise ValueError(f"data: only {nv} valid filtered samples (NaN or nodata), need at least {_MIN_FILTERED}")
         g = _taper(y.shape, taper) * valid
         g = g / math.sqrt(float(np.sum(g**2)))
         I = _periodogram(y, g)
@@ -410,7 +414,7 @@ def _whittle_contrast(z, nd, table, parts, taper, spacing, exclude_zero):
     # scale-free: divide the periodograms by their mean level
     level = float(np.mean(np.concatenate(grams)))
     zmax = float(np.nanmax(np.abs(z)))
-    if not level > 1e-24 * zmax**2 or zmax == 0:
+    if not level > _VANISH * zmax**2 or zmax == 0:
         raise ValueError("data: the filtered field vanishes (constant or planar data), the dimension is undefined")
     grams = [I / level for I in grams]
     n_ord = sum(I.size for I in grams)
@@ -419,7 +423,7 @@ def _whittle_contrast(z, nd, table, parts, taper, spacing, exclude_zero):
         out = []
         for (m, keep), I in zip(models, grams):
             f = m.expected(h)[keep]
-            out.append(np.maximum(f, 1e-300 * np.max(np.abs(f))))
+            out.append(np.maximum(f, _F_FLOOR * np.max(np.abs(f))))
         return out
 
     def contrast(h):

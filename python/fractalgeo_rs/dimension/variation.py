@@ -24,12 +24,11 @@ dimension for two-dimensional surface data. *Statistica Sinica* 10, 343-376.
 """
 from __future__ import annotations
 
-import numbers
 from typing import Optional, Sequence
 
 import numpy as np
 
-from fractalgeo_rs._validation import as_array, check_choice, check_positive_float
+from fractalgeo_rs._validation import as_array, check_choice, check_nodata, check_positive_float
 from fractalgeo_rs.fit import DimensionFit, ScaleRange, fit_loglog
 
 __all__ = ["power_variation", "variogram", "madogram", "surface_variation"]
@@ -51,10 +50,9 @@ def _real_array(data, ndims, name="data") -> np.ndarray:
 
 
 def _with_nodata(z: np.ndarray, data, nodata) -> np.ndarray:
+    nodata = check_nodata(nodata)
     if nodata is None:
         return z
-    if isinstance(nodata, bool) or not isinstance(nodata, numbers.Real):
-        raise TypeError(f"nodata: expected a number, got {nodata!r}")
     if not np.isnan(nodata):
         z = z.copy()
         z[np.asarray(data) == nodata] = np.nan

@@ -331,18 +331,18 @@ def _surface_midpoint(rows, cols, h, seed, additions, periodic, n_threads):
     ii, jj = np.meshgrid(np.arange(nr), np.arange(nc), indexing="ij")
     pos = np.column_stack([ii.ravel(), jj.ravel()]).astype(np.float64) * step
     coarse = _exact_coarse(pos, h, seed, c.STREAM_COARSE_2D, n_threads).reshape(nr, nc)
-    if additions:  # the kernel computes the (rows, cols) corner only
-        return _refine(coarse, levels, h, float(step), True, False, seed, n_threads, shape=(rows, cols))
-    z = _refine(coarse, levels, h, float(step), additions, False, seed, n_threads)
-    return np.ascontiguousarray(z[:rows, :cols])
+    return _refine(coarse, levels, h, float(step), additions, False, seed, n_threads, shape=(rows, cols))
 
 
 def _refine(coarse, levels, h, spacing, additions, periodic, seed, n_threads, shape=None):
+    """The refined grid, or its ``shape = (rows, cols)`` corner (the
+    additions kernel computes that corner only; midpoint is cropped)."""
     if additions:
         w, var = _additions.schedule(h)
         return _core.additions_refine_2d(coarse, levels, h, 1.0, spacing, w, list(var), periodic, seed, 0,
                                          n_threads, shape)
-    return _core.midpoint_refine_2d(coarse, levels, h, 1.0, spacing, False, periodic, seed, 0, n_threads)
+    z = _core.midpoint_refine_2d(coarse, levels, h, 1.0, spacing, False, periodic, seed, 0, n_threads)
+    return z if shape is None else np.ascontiguousarray(z[:shape[0], :shape[1]])
 
 
 @functools.lru_cache(maxsize=2)

@@ -28,7 +28,14 @@ from typing import Optional, Sequence, Tuple, Union
 import numpy as np
 
 from fractalgeo_rs import _core
-from fractalgeo_rs._validation import as_array, check_choice, check_n_threads, check_positive_int
+from fractalgeo_rs._validation import (
+    as_array,
+    check_choice,
+    check_n_threads,
+    check_nodata,
+    check_positive_float,
+    check_positive_int,
+)
 
 from fractalgeo_rs.transform.segment import segment
 
@@ -286,10 +293,9 @@ def fractal_transform(
     """
     check_choice(method, "method", tuple(TRANSFORM_METHODS))
     check_choice(edge_blocks, "edge_blocks", ("drop", "count"))
+    nodata = check_nodata(nodata)
     if method in ("mass", "dbc", "blanket"):
-        if isinstance(z_scale, bool) or not np.isscalar(z_scale) or not (np.isfinite(z_scale) and z_scale > 0):
-            raise ValueError(f"z_scale: expected a positive number, got {z_scale!r}")
-        z_scale = float(z_scale)
+        z_scale = check_positive_float(z_scale, "z_scale")
     n_threads = check_n_threads(n_threads)
     step = check_positive_int(step, "step")
     if isinstance(min_valid, bool) or not np.isscalar(min_valid) or not (0.0 <= float(min_valid) <= 1.0):
@@ -451,6 +457,7 @@ def lacunarity_map(
     if 0 in arr.shape:
         raise ValueError(f"image: array is empty (shape {arr.shape})")
     w = _check_window(window_size, arr.shape)
+    nodata = check_nodata(nodata)
     z = np.array(arr, dtype=np.float64)
     if nodata is not None:
         z[arr == nodata] = np.nan

@@ -18,16 +18,28 @@ from __future__ import annotations
 import math
 import os
 import threading
+from collections import OrderedDict
 from typing import Dict, Tuple
 
 import numpy as np
 
-from fractalgeo_rs.dimension.likelihood import _FILTERS_2D, _fold_spectrum, _lag_kernel, _LagPowers
+from fractalgeo_rs.dimension.likelihood import (
+    _F_FLOOR,
+    _FILTERS_2D,
+    _MIN_FILTERED,
+    _VANISH,
+    _apply_filter,
+    _fold_spectrum,
+    _lag_kernel,
+    _LagPowers,
+)
+from fractalgeo_rs.dimension.surface import _sat
 
 # grid of H: the bounds of fractalgeo_rs.whittle's search, ~0.02 apart
 _H_GRID = np.linspace(0.001, 0.999, 51)
 _FILTER = _FILTERS_2D["square"]
-_MIN_FILTERED = 16  # fractalgeo_rs.whittle needs at least 16 valid filtered samples
+_OFFSETS = np.array(list(_FILTER.keys()), dtype=np.int64)
+_WEIGHTS = np.array(list(_FILTER.values()), dtype=float)
 
 
 class _Tables:
@@ -37,10 +49,8 @@ class _Tables:
 
     def __init__(self, m: int):
         self.m = m
-        offsets = np.array(list(_FILTER.keys()), dtype=np.int64)
-        weights = np.array(list(_FILTER.values()), dtype=float)
         # sum_d v_d |h + d|^{2H} for every grid H: shared by all masks
-        self.powers = _LagPowers((m, m), offsets, weights, (1.0, 1.0)).sums(_H_GRID)
+        self.powers = _LagPowers((m, m), _OFFSETS, _WEIGHTS, (1.0, 1.0)).sums(_H_GRID)
         nk = m // 2 + 1
         wk = np.full((m, nk), 2.0)
         wk[:, 0] = 1.0
@@ -49,7 +59,7 @@ class _Tables:
         wk[0, 0] = 0.0  # the zero frequency is left out
         self.wk = wk.ravel()
         self.n_ord = m * m - 1
-        self.cache: Dict[bytes, Tuple[np.ndarray, np.ndarray]] = {}
+        self.cache: "OrderedDict[bytes, Tuple[np.ndarray, np.ndarray]]" = OrderedDict()
 
     def model(self, valid: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
         """(``wk / f_H`` of shape (K, n_H), ``sum_k log f_H`` of shape (n_H,))."""
@@ -62,17 +72,19 @@ class _Tables:
         key = np.packbits(valid).tobytes()
         hit = self.cache.get(key)
         if hit is not None:
+            self.cache.move_to_end(key)
             return hit
         m = self.m
         g = valid / math.sqrt(float(np.count_nonzero(valid)))
         c = self.powers * (-0.5 * _lag_kernel(g))[None]
         f = _fold_spectrum(c, (m, m), half=True).reshape(_H_GRID.size, -1)
-        f = np.maximum(f, 1e-300 * np.max(np.abs(f), axis=1, keepdims=True))
+        f = np.maximum(f, _F_FLOOR * np.max(np.abs(f), axis=1, keepdims=True))
         inv = np.ascontiguousarray((self.wk[None, :] / f).T)
         logsum = np.log(f) @ self.wk
         hit = (inv, logsum)
-        if len(self.cache) * inv.nbytes > _CACHE_BYTES:
-            self.cache.clear()
+        # least recently used models go first (edge masks recur along each edge)
+        while self.cache and (len(self.cache) + 1) * inv.nbytes > _CACHE_BYTES:
+            self.cache.popitem(last=False)
         self.cache[key] = hit
         return hit
 
@@ -134,9 +146,8 @@ def _argmin_cubic(c: np.ndarray):
 
 def _window_sums(a: np.ndarray, k: int) -> np.ndarray:
     """Sums of ``a`` over every ``k`` x ``k`` window anchored at its top-left
-    pixel (exact integer counts for boolean ``a``)."""
-    s = np.zeros((a.shape[0] + 1, a.shape[1] + 1), dtype=np.int64)
-    s[1:, 1:] = np.cumsum(np.cumsum(a, axis=0, dtype=np.int64), axis=1)
+    pixel (exact counts for boolean ``a``: float64 holds integers to 2^53)."""
+    s = _sat(a)
     return s[k:, k:] - s[:-k, k:] - s[k:, :-k] + s[:-k, :-k]
 
 
@@ -174,8 +185,9 @@ def whittle_grid(z: np.ndarray, w: int, min_valid: float, step: int, n_threads: 
     half = w // 2
     m = w - 1
     zp = np.pad(z, half, mode="constant", constant_values=np.nan)
-    # square increments of the padded image: window (r, c) <-> y[r:r+m, c:c+m]
-    y = zp[1:, 1:] - zp[1:, :-1] - zp[:-1, 1:] + zp[:-1, :-1]
+    # square increments of the padded image (the filter of fractalgeo_rs.whittle):
+    # window (r, c) <-> y[r:r+m, c:c+m]
+    y = _apply_filter(zp, _OFFSETS, _WEIGHTS)
     yvalid = ~np.isnan(y)
     y0 = np.where(yvalid, y, 0.0)
     # per-window counts from integral images: valid pixels, valid filtered
@@ -187,8 +199,8 @@ def whittle_grid(z: np.ndarray, w: int, min_valid: float, step: int, n_threads: 
                                   cval=0.0)[::step, ::step]
 
     nr, nc = frac.shape
-    dim = np.full((nr, nc), np.nan)
-    se = np.full((nr, nc), np.nan)
+    dim = np.full((nr, nc), np.nan, dtype=np.float32)
+    se = np.full((nr, nc), np.nan, dtype=np.float32)
     tables = _tables(m)
     yv = sliding_window_view(y0, (m, m))[::step, ::step]
     mv = sliding_window_view(yvalid, (m, m))[::step, ::step]
@@ -208,11 +220,11 @@ def whittle_grid(z: np.ndarray, w: int, min_valid: float, step: int, n_threads: 
             _fill_contrast(contrast, gram, nf, mv, (r, c), m, n_ord, tables)
         # a vanishing filtered field (constant or planar window): no dimension
         level = gram @ tables.wk / n_ord / nf
-        alive = level > 1e-24 * zabs[r, c] ** 2
+        alive = level > _VANISH * zabs[r, c] ** 2
         alive &= np.all(np.isfinite(contrast), axis=1)
         h, curv = _argmin_cubic(np.where(alive[:, None], contrast, 0.0))
         with np.errstate(invalid="ignore", divide="ignore"):
             sd = np.where(curv > 0, np.sqrt(2.0 / curv), np.nan)
         dim[r, c] = np.where(alive, 3.0 - h, np.nan)
         se[r, c] = np.where(alive, sd, np.nan)
-    return dim.astype(np.float32), se.astype(np.float32)
+    return dim, se
