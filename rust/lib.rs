@@ -15,6 +15,8 @@
 //! | [`lsystem`] | L-systems, turtle geometry and IFS |
 //! | [`transform`] | moving-window maps of local dimension |
 
+#![warn(clippy::undocumented_unsafe_blocks)]
+
 pub mod buffers;
 pub mod dem;
 pub mod dimension;
