@@ -18,6 +18,7 @@
 #![warn(clippy::undocumented_unsafe_blocks)]
 
 pub mod buffers;
+pub mod checks;
 pub mod dem;
 pub mod dimension;
 pub mod error;

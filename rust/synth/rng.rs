@@ -265,8 +265,16 @@ mod tests {
             z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
             z ^ (z >> 31)
         }
-        for (s, a, b) in [(0u64, 0u64, 0u64), (42, 7, 3), (u64::MAX, 1, 0x1f5), (12345, 99, 4)] {
-            assert_eq!(chain_hash3(s, a, b), old_mix64(old_mix64(old_mix64(s) ^ a) ^ b));
+        for (s, a, b) in [
+            (0u64, 0u64, 0u64),
+            (42, 7, 3),
+            (u64::MAX, 1, 0x1f5),
+            (12345, 99, 4),
+        ] {
+            assert_eq!(
+                chain_hash3(s, a, b),
+                old_mix64(old_mix64(old_mix64(s) ^ a) ^ b)
+            );
         }
     }
 
