@@ -260,6 +260,7 @@ class LSystem:
 
     @property
     def axiom(self) -> str:
+        """The axiom (the word of generation 0)."""
         return self._axiom
 
     @property
@@ -269,6 +270,7 @@ class LSystem:
 
     @property
     def ignore(self) -> str:
+        """Symbols skipped when matching the context of context-sensitive rules."""
         return self._ignore
 
     @property
@@ -278,6 +280,7 @@ class LSystem:
 
     @property
     def is_stochastic(self) -> bool:
+        """True when a predecessor has more than one weighted successor."""
         return self._core.is_stochastic
 
     def __repr__(self) -> str:

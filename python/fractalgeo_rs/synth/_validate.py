@@ -67,6 +67,7 @@ class SurfaceReport:
     lags: tuple = field(default=(8, 16, 32, 64))
 
     def as_dict(self) -> dict:
+        """The report's fields as a plain ``dict`` (field name to value)."""
         return asdict(self)
 
     def __str__(self) -> str:
