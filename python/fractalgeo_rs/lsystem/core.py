@@ -81,6 +81,26 @@ class LString:
     Returned by :meth:`LSystem.derive`; also built from text with
     :meth:`LString.parse`. ``str(s)`` gives the text form (``A(1,2.5)B``),
     ``len(s)`` the number of modules.
+
+    Parameters
+    ----------
+    core : _core.ModuleString
+        The Rust string of modules; build an ``LString`` with
+        :meth:`LString.parse` or :meth:`LSystem.derive` rather than directly.
+
+    References
+    ----------
+    P. Prusinkiewicz and A. Lindenmayer, *The Algorithmic Beauty of Plants*,
+    Springer, 1990, doi:10.1007/978-1-4613-8476-2.
+
+    Examples
+    --------
+    >>> from fractalgeo_rs import LString, LSystem
+    >>> s = LString.parse('A(1,2.5)B')
+    >>> len(s), str(s), s.count('A')
+    (2, 'A(1,2.5)B', 1)
+    >>> str(LSystem('b', {'b': 'a', 'a': 'ab'}).derive(4))  # Fibonacci words, eq. 23 of the paper
+    'abaab'
     """
 
     __slots__ = ("_core",)
