@@ -19,11 +19,11 @@ import sys
 import tempfile
 from pathlib import Path
 
-# (page, text the <title> must contain, images required)
+# (page, text the <title> must contain, images required, formulas rendered)
 PAGES = [
-    ("index.html", "fractalgeo_rs", True),
-    ("generated/fractalgeo_rs.box_counting.html", "box_counting", False),
-    ("auto_examples/plot_fig01_minkowski_sausage.html", "Minkowski sausage", True),
+    ("index.html", "fractalgeo_rs", True, False),
+    ("generated/fractalgeo_rs.box_counting.html", "box_counting", False, True),
+    ("auto_examples/plot_fig01_minkowski_sausage.html", "Minkowski sausage", True, False),
 ]
 ERROR_MARKERS = [
     'class="system-message"',
@@ -57,7 +57,7 @@ def run(browser, args, timeout=120):
     return subprocess.run([browser, *FLAGS, *args], capture_output=True, text=True, timeout=timeout)
 
 
-def check_page(browser, site: Path, page: str, title: str, need_images: bool, out: Path):
+def check_page(browser, site: Path, page: str, title: str, need_images: bool, need_math: bool, out: Path):
     path = site / page
     problems = []
     if not path.exists():
@@ -72,6 +72,8 @@ def check_page(browser, site: Path, page: str, title: str, need_images: bool, ou
     for marker in ERROR_MARKERS:
         if marker in dom:
             problems.append(f"{page}: error text {marker!r} in the page")
+    if need_math and "<mjx-container" not in dom:
+        problems.append(f"{page}: formulas not rendered by MathJax")
     imgs = [html.unescape(s) for s in re.findall(r'<img[^>]*\ssrc="([^"]+)"', dom)]
     local = [s for s in imgs if not s.startswith(("data:", "http:", "https:"))]
     if need_images and not local:
@@ -110,8 +112,8 @@ def main(argv=None) -> int:
     out.mkdir(parents=True, exist_ok=True)
     site = Path(args.site)
     all_problems = []
-    for page, title, need_images in PAGES:
-        problems, shot = check_page(browser, site, page, title, need_images, out)
+    for page, title, need_images, need_math in PAGES:
+        problems, shot = check_page(browser, site, page, title, need_images, need_math, out)
         all_problems += problems
         if shot is not None and shot.exists():
             print(f"screenshot {shot} {shot.stat().st_size} bytes ({page})")

@@ -37,6 +37,7 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
     "sphinx.ext.mathjax",
+    "sphinx-mathjax-offline",  # a local copy of MathJax 3: no CDN, formulas render offline
     "numpydoc",
     "myst_parser",
     "sphinx_gallery.gen_gallery",
@@ -87,5 +88,5 @@ html_theme_options = {
     "header_links_before_dropdown": 7,
 }
 html_show_sourcelink = False
-# Formulas are rendered by MathJax in the reader's browser; the build itself
-# fetches nothing.
+# Formulas are rendered by the copy of MathJax that sphinx-mathjax-offline
+# places in _static: the site loads nothing from the network.
