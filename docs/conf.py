@@ -44,8 +44,7 @@ extensions = [
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
-exclude_patterns = ["_build", "**.ipynb_checkpoints", "_templates"]
-templates_path = ["_templates"]
+exclude_patterns = ["_build", "**.ipynb_checkpoints"]
 
 # -- API reference ------------------------------------------------------------
 autosummary_generate = True
