@@ -10,7 +10,6 @@ package (``_apigen.py``), the gallery from ``examples/plot_*.py``
 """
 from __future__ import annotations
 
-import os
 import sys
 from pathlib import Path
 
