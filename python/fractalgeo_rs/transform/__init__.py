@@ -424,6 +424,13 @@ def lacunarity_map(
     References
     ----------
     Allain, C., Cloitre, M. (1991). *Physical Review A* 44(6), 3552-3558.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> lam = fg.lacunarity_map(np.ones((16, 16)), 5, box_sizes=[1, 2])
+    >>> lam.shape, float(np.nanmax(np.abs(lam - 1.0)))  # a constant image has no gaps: Lambda = 1
+    ((2, 16, 16), 0.0)
     """
     if array_kind(image) == "numpy":
         image = as_array(image, "image")
