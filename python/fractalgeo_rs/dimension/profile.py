@@ -17,7 +17,7 @@ from typing import Optional, Sequence
 import numpy as np
 
 from fractalgeo_rs import _core
-from fractalgeo_rs._validation import check_n_threads, check_positive_float, check_positive_int
+from fractalgeo_rs._validation import check_n_threads, check_positive_int
 from fractalgeo_rs.dimension.variation import _real_array, _with_nodata
 from fractalgeo_rs.fit import DimensionFit, ScaleRange, fit_loglog
 

@@ -10,7 +10,6 @@ import os
 import secrets
 from typing import Any, Mapping, Optional, Sequence, Union
 
-import numpy as np
 
 from fractalgeo_rs import _core
 from fractalgeo_rs._validation import check_n_threads

@@ -23,7 +23,7 @@ Voss, R. F. (1986). Characterization and measurement of random fractals.
 """
 from __future__ import annotations
 
-from typing import Optional, Sequence, Tuple, Union
+from typing import Optional, Sequence
 
 import numpy as np
 
