@@ -126,7 +126,7 @@ def read_raster(path, band: Optional[int] = None) -> Tuple[np.ndarray, Optional[
                 raise OSError(f"path: {p!r} is not a numeric .npy array (it holds Python objects, which are "
                               f"never unpickled)") from None
             raise _unreadable(p, exc) from None
-        except (EOFError, OSError, SyntaxError, TypeError, KeyError, UnicodeError) as exc:
+        except (Exception, MemoryError) as exc:  # numpy's header parser raises many kinds
             raise _unreadable(p, exc) from None
         if not isinstance(a, np.ndarray) or a.dtype.kind not in "biuf":
             raise OSError(f"path: {p!r} does not hold a real numeric array")
@@ -141,13 +141,13 @@ def read_raster(path, band: Optional[int] = None) -> Tuple[np.ndarray, Optional[
             raise ValueError(f"band: EXR files are read as one band (channel \"Y\"), asked for {band}")
         try:
             return _core.read_exr(p), None
-        except (OSError, ValueError, RuntimeError) as exc:
+        except (OSError, ValueError, RuntimeError, MemoryError) as exc:
             raise _unreadable(p, exc) from None
     rio = _rasterio()
     if ext == ".png" or (rio is None and ext in (".tif", ".tiff")):
         try:
             img = _core.read_image(p)
-        except (OSError, ValueError, RuntimeError) as exc:
+        except (OSError, ValueError, RuntimeError, MemoryError) as exc:
             raise _unreadable(p, exc) from None
         return np.ascontiguousarray(img[:, :, pick(img.shape[2]) - 1]), None
     if rio is None:

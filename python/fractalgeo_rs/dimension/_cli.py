@@ -65,6 +65,8 @@ def _run_dimension(args: argparse.Namespace) -> int:
     if method is None:
         is_binary = is_binary_mask(data)
         method = "box" if is_binary or args.threshold is not None else "dbc"
+        if is_binary and args.threshold is None and data.dtype != bool:
+            data = data != 0  # a 0/1 or 0/255 mask: the nonzero value is the foreground
     opts = {"n_threads": args.n_threads, "scale_range": _parse_range(args.scale_range)}
     if args.box_sizes:
         try:
