@@ -146,3 +146,9 @@ def test_nodata_must_be_a_number(name):
 def test_spectral_dimension_of_degenerate_data_is_an_error(data):
     with pytest.raises(ValueError, match="^data: no variation"):
         fg.spectral_dimension(data)
+
+
+def test_lags_are_integers_never_truncated():
+    with pytest.raises(TypeError, match="^lags"):
+        fg.variogram(PROFILE, lags=[1.5, 2, 3])
+    assert fg.variogram(PROFILE, lags=[1, 2.0, 4]).dimension == fg.variogram(PROFILE, lags=[1, 2, 4]).dimension
