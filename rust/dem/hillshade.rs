@@ -404,7 +404,9 @@ pub fn hillshade_gdal_byte(z: ArrayView2<f32>, dx: f64, dy: f64, p: &ShadeParams
     out.par_chunks_mut(cols).enumerate().for_each(|(i, row)| {
         let interior_row = i > 0 && i + 1 < rows;
         for (j, o) in row.iter_mut().enumerate() {
-            let w = if interior_row && j > 0 && j + 1 < cols {
+            if interior_row && j > 0 && j + 1 < cols {
+                // NaN anywhere in the window propagates to the value: only
+                // then is the window rebuilt with the nodata rule
                 let b = (i - 1) * cols + j - 1;
                 let w = [
                     zs[b],
@@ -417,14 +419,13 @@ pub fn hillshade_gdal_byte(z: ArrayView2<f32>, dx: f64, dy: f64, p: &ShadeParams
                     zs[b + 2 * cols + 1],
                     zs[b + 2 * cols + 2],
                 ];
-                if w.iter().any(|v| v.is_nan()) {
-                    gdal_window(zs, rows, cols, i, j)
-                } else {
-                    Some(w)
+                let v = value(&w);
+                if !v.is_nan() {
+                    *o = gdal_to_byte(v);
+                    continue;
                 }
-            } else {
-                gdal_window(zs, rows, cols, i, j)
-            };
+            }
+            let w = gdal_window(zs, rows, cols, i, j);
             *o = match w {
                 Some(w) => gdal_to_byte(value(&w)),
                 None => 0,

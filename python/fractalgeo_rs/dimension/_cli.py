@@ -105,6 +105,5 @@ def _run_dimension(args: argparse.Namespace) -> int:
 def _run_demo(args: argparse.Namespace) -> int:
     from fractalgeo_rs.demo import run_demo
 
-    run_demo(args.out)
-    print(f"demo: figure and fits written to {args.out}")
+    run_demo(args.out)  # prints the fits and the paths it wrote (shown in the README)
     return 0
