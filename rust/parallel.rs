@@ -29,9 +29,14 @@ use crate::error::{CoreError, CoreResult};
 /// the same cap first, see `_validation.check_n_threads`).
 pub const MAX_THREADS_PER_CORE: usize = 4;
 
-/// The largest `n_threads` accepted: [`MAX_THREADS_PER_CORE`] times the cores.
+/// The cap never goes below this many threads (so a thread count chosen on
+/// a larger machine still runs on a small one).
+pub const MIN_THREAD_CAP: usize = 16;
+
+/// The largest `n_threads` accepted: [`MAX_THREADS_PER_CORE`] times the
+/// cores, at least [`MIN_THREAD_CAP`].
 pub fn max_threads() -> usize {
-    MAX_THREADS_PER_CORE * resolve_threads(None)
+    (MAX_THREADS_PER_CORE * resolve_threads(None)).max(MIN_THREAD_CAP)
 }
 
 /// Resolve `n_threads`: `None` or `Some(0)` means all available cores
@@ -138,7 +143,8 @@ where
         return Err(CoreError::invalid(
             "n_threads",
             format!(
-                "expected at most {} ({MAX_THREADS_PER_CORE} per available core), got {n}",
+                "expected at most {} ({MAX_THREADS_PER_CORE} per available core, at least \
+                 {MIN_THREAD_CAP}), got {n}",
                 max_threads()
             ),
         ));

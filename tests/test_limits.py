@@ -95,7 +95,7 @@ def test_no_abort_under_an_address_space_limit():
 
 
 def test_n_threads_is_bounded():
-    cap = v.MAX_THREADS_PER_CORE * v.available_cores()
+    cap = v.max_threads()
     z = np.eye(64, dtype=bool)
     with pytest.raises(ValueError, match="n_threads: expected at most"):
         fg.box_counting(z, n_threads=10**6)

@@ -24,6 +24,7 @@ __all__ = [
     "default_max_memory",
     "MemoryLimitError",
     "MAX_THREADS_PER_CORE",
+    "max_threads",
     "available_cores",
     "check_n_threads",
     "check_z_factor",
@@ -87,8 +88,15 @@ def check_real_array(data, name: str = "data") -> np.ndarray:
     return as_array(data, name)
 
 
-#: ``n_threads`` may be at most this many times the available cores.
+#: ``n_threads`` may be at most this many times the available cores ...
 MAX_THREADS_PER_CORE = 4
+#: ... and the cap is never below this (rust/parallel.rs has the same rule).
+MIN_THREAD_CAP = 16
+
+
+def max_threads() -> int:
+    """The largest accepted ``n_threads``: ``max(4 x cores, 16)``."""
+    return max(MAX_THREADS_PER_CORE * available_cores(), MIN_THREAD_CAP)
 
 
 def available_cores() -> int:
@@ -100,19 +108,20 @@ def available_cores() -> int:
 
 
 def check_n_threads(n_threads) -> Optional[int]:
-    """``None`` (all cores) or a positive int of at most
-    ``MAX_THREADS_PER_CORE`` times the available cores (more threads than
-    that only slow the machine down; the Rust layer enforces the same cap)."""
+    """``None`` (all cores) or a positive int of at most :func:`max_threads`
+    (4 per available core, at least 16: more threads only slow the machine
+    down; the Rust layer enforces the same cap)."""
     if n_threads is None:
         return None
     if isinstance(n_threads, bool) or not isinstance(n_threads, numbers.Integral):
         raise TypeError(f"n_threads: expected a positive int or None, got {n_threads!r}")
     if n_threads < 1:
         raise ValueError(f"n_threads: expected a positive int or None, got {n_threads}")
-    cap = MAX_THREADS_PER_CORE * available_cores()
+    cap = max_threads()
     if n_threads > cap:
         raise ValueError(f"n_threads: expected at most {cap} ({MAX_THREADS_PER_CORE} per available core, "
-                         f"{available_cores()} cores), got {n_threads}; None uses one thread per core")
+                         f"{available_cores()} cores, at least {MIN_THREAD_CAP}), got {n_threads}; "
+                         f"None uses one thread per core")
     return int(n_threads)
 
 
