@@ -91,3 +91,20 @@ def test_old_thread_spellings_still_work(tmp_path, dem_tif):
     m = tmp_path / "m.npy"
     np.save(m, np.eye(64, dtype=np.uint8) * 255)
     assert main(["dimension", str(m), "--threads", "1"]) == 0
+
+
+def test_missing_dask_is_one_line_naming_the_extra(tmp_path, dem_tif, capsys, monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "dask", None)
+    monkeypatch.setitem(sys.modules, "dask.array", None)
+    assert main(["transform", str(dem_tif), str(tmp_path / "o.npy"), "--chunks", "64"]) == 1
+    err = capsys.readouterr().err
+    assert 'pip install "fractalgeo_rs[dask]"' in err and err.count("\n") == 1
+
+
+def test_help_shows_defaults(capsys):
+    with pytest.raises(SystemExit):
+        main(["hillshade", "--help"])
+    out = capsys.readouterr().out
+    assert "(default: 315.0)" in out and "--n-threads" in out and "--threads" not in out

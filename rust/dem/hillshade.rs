@@ -405,8 +405,9 @@ pub fn hillshade_gdal_byte(z: ArrayView2<f32>, dx: f64, dy: f64, p: &ShadeParams
         let interior_row = i > 0 && i + 1 < rows;
         for (j, o) in row.iter_mut().enumerate() {
             if interior_row && j > 0 && j + 1 < cols {
-                // NaN anywhere in the window propagates to the value: only
-                // then is the window rebuilt with the nodata rule
+                // NaN anywhere around the centre propagates to the value
+                // (the centre itself is not in Horn's sums): only then is the
+                // window rebuilt with the nodata rule
                 let b = (i - 1) * cols + j - 1;
                 let w = [
                     zs[b],
@@ -420,7 +421,7 @@ pub fn hillshade_gdal_byte(z: ArrayView2<f32>, dx: f64, dy: f64, p: &ShadeParams
                     zs[b + 2 * cols + 2],
                 ];
                 let v = value(&w);
-                if !v.is_nan() {
+                if !(v.is_nan() || w[4].is_nan()) {
                     *o = gdal_to_byte(v);
                     continue;
                 }
