@@ -3,7 +3,7 @@
 //! kernel (`py.detach`), runs it in a pool of `n_threads` and maps the error.
 //! Nothing else lives here.
 use crate::error::CoreError;
-use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyMemoryError, PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 
 pub mod convert;
@@ -18,7 +18,8 @@ impl From<CoreError> for PyErr {
     fn from(e: CoreError) -> PyErr {
         match e {
             CoreError::InvalidArgument { .. } => PyValueError::new_err(e.to_string()),
-            CoreError::Io(_) => PyOSError::new_err(e.to_string()),
+            CoreError::Io(_) | CoreError::System(_) => PyOSError::new_err(e.to_string()),
+            CoreError::OutOfMemory { .. } => PyMemoryError::new_err(e.to_string()),
             CoreError::Internal(_) => PyRuntimeError::new_err(e.to_string()),
         }
     }
