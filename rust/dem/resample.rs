@@ -39,6 +39,7 @@ use crate::synth::rng::StreamKey;
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
 use std::collections::{BTreeSet, HashMap};
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// Streams of the resampling noise (disjoint from the synthesis streams).
 pub const STREAM_BASE: u64 = 3 << 20;
@@ -315,7 +316,7 @@ impl Table {
 
 /// Full-stencil tables, built once per process.
 fn full_tables() -> &'static [Table; 6] {
-    static T: std::sync::OnceLock<[Table; 6]> = std::sync::OnceLock::new();
+    static T: OnceLock<[Table; 6]> = OnceLock::new();
     T.get_or_init(|| {
         let st = all_stencils();
         let v: Vec<Table> = st
@@ -352,18 +353,42 @@ pub fn table_at(which: usize, h: f64) -> ([f64; NS], f64) {
 
 /// Tables for the stencils cut by an edge or a hole, keyed by mask.
 struct Partial {
-    map: HashMap<u16, Table>,
+    map: HashMap<u16, Arc<Table>>,
+}
+
+/// Process-wide cache of the cut-stencil tables, keyed by (stencil, mask):
+/// a table depends only on the geometry, so tiles and repeated calls share it.
+type Cache = Mutex<HashMap<(usize, u16), Arc<Table>>>;
+
+fn partial_cache() -> &'static Cache {
+    static C: OnceLock<Cache> = OnceLock::new();
+    C.get_or_init(|| Mutex::new(HashMap::new()))
 }
 
 impl Partial {
-    fn build(st: &Stencil, masks: BTreeSet<u16>) -> Partial {
-        let v: Vec<(u16, Table)> = masks
+    fn build(st: &Stencil, which: usize, masks: BTreeSet<u16>) -> Partial {
+        let cache = partial_cache();
+        let missing: Vec<u16> = {
+            let c = cache.lock().unwrap_or_else(|e| e.into_inner());
+            masks
+                .iter()
+                .copied()
+                .filter(|m| !c.contains_key(&(which, *m)))
+                .collect()
+        };
+        let built: Vec<(u16, Arc<Table>)> = missing
             .into_par_iter()
-            .map(|m| (m, Table::build(st, m, N_PARTIAL)))
+            .map(|m| (m, Arc::new(Table::build(st, m, N_PARTIAL))))
             .collect();
-        Partial {
-            map: v.into_iter().collect(),
+        let mut c = cache.lock().unwrap_or_else(|e| e.into_inner());
+        for (m, t) in built {
+            c.entry((which, m)).or_insert(t);
         }
+        let map = masks
+            .into_iter()
+            .filter_map(|m| c.get(&(which, m)).map(|t| (m, Arc::clone(t))))
+            .collect();
+        Partial { map }
     }
 }
 
@@ -553,7 +578,7 @@ fn level_point(coarse: ArrayView2<f64>, maps: &Maps, p: &ResampleParams, l: u32)
                 cols: fc,
                 point: true,
             };
-            Partial::build(st, collect_masks(&g, st, fr, 3, any_nan, targets))
+            Partial::build(st, step, collect_masks(&g, st, fr, 3, any_nan, targets))
         };
         let ptr = Shared(fine.as_mut_ptr());
         let len = fine.len();
@@ -673,6 +698,7 @@ fn level_area(coarse: ArrayView2<f64>, maps: &Maps, p: &ResampleParams, l: u32) 
         let st = &stencils[2 + q];
         partials.push(Partial::build(
             st,
+            2 + q,
             collect_masks(&g, st, r, 2, any_nan, |_| (0..c).collect()),
         ));
     }
