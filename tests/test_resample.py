@@ -217,3 +217,12 @@ def test_bad_dem():
         fg.fractal_resample(np.zeros((8, 8)), 2, hurst=np.zeros((4, 4)), sigma=1.0)
     with pytest.raises(MemoryError, match="^factor"):
         fg.fractal_resample(np.zeros((64, 64)), 4096, hurst=0.5, sigma=1.0)
+
+
+def test_docstring_examples_run():
+    import doctest
+
+    from fractalgeo_rs.dem import _resample
+
+    res = doctest.testmod(_resample, optionflags=doctest.ELLIPSIS)
+    assert res.failed == 0 and res.attempted >= 4
