@@ -29,7 +29,11 @@ fn fractal_resample<'py>(
         seed,
         detail,
         origin,
-        global_cols: if global_cols == 0 { d.dim().1 as u64 } else { global_cols },
+        global_cols: if global_cols == 0 {
+            d.dim().1 as u64
+        } else {
+            global_cols
+        },
     };
     let out = py.detach(|| run_in_pool(n_threads, || resample::resample(d, h, s, &p)))?;
     Ok(out.into_pyarray(py))
@@ -42,7 +46,9 @@ fn fractal_resample<'py>(
 #[allow(clippy::type_complexity)]
 fn resample_stencil(which: usize, hurst: f64) -> PyResult<(Vec<f64>, f64, Vec<(isize, isize)>)> {
     if which > 5 {
-        return Err(pyo3::exceptions::PyValueError::new_err("which: expected 0 to 5"));
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "which: expected 0 to 5",
+        ));
     }
     let (w, sd) = resample::table_at(which, hurst);
     let st = match which {

@@ -307,8 +307,8 @@ impl Table {
         let f = t - k as f64;
         let (a, b) = (&self.entries[k], &self.entries[k + 1]);
         let mut w = [0.0; NS];
-        for q in 0..NS {
-            w[q] = a.w[q] + f * (b.w[q] - a.w[q]);
+        for (q, wq) in w.iter_mut().enumerate() {
+            *wq = a.w[q] + f * (b.w[q] - a.w[q]);
         }
         (w, (a.var + f * (b.var - a.var)).max(0.0).sqrt())
     }
@@ -453,7 +453,14 @@ impl Maps<'_> {
 }
 
 /// Collect the masks of the new samples with a cut stencil.
-fn collect_masks<F>(g: &Grid, st: &Stencil, rows: usize, reach: usize, any_nan: bool, targets: F) -> BTreeSet<u16>
+fn collect_masks<F>(
+    g: &Grid,
+    st: &Stencil,
+    rows: usize,
+    reach: usize,
+    any_nan: bool,
+    targets: F,
+) -> BTreeSet<u16>
 where
     F: Fn(usize) -> Vec<usize> + Sync,
 {
@@ -477,7 +484,12 @@ where
         })
 }
 
-fn check(dem: &ArrayView2<f64>, hurst: &ArrayView2<f64>, sigma: &ArrayView2<f64>, p: &ResampleParams) -> CoreResult<()> {
+fn check(
+    dem: &ArrayView2<f64>,
+    hurst: &ArrayView2<f64>,
+    sigma: &ArrayView2<f64>,
+    p: &ResampleParams,
+) -> CoreResult<()> {
     let (r, c) = dem.dim();
     if r < 2 || c < 2 {
         return Err(CoreError::invalid(
@@ -529,7 +541,12 @@ fn stream(p: &ResampleParams, level: u32, phase: u64) -> StreamKey {
 }
 
 /// One point-support level: `(r, c)` -> `(2r - 1, 2c - 1)`.
-fn level_point(coarse: ArrayView2<f64>, maps: &Maps, p: &ResampleParams, l: u32) -> CoreResult<Array2<f64>> {
+fn level_point(
+    coarse: ArrayView2<f64>,
+    maps: &Maps,
+    p: &ResampleParams,
+    l: u32,
+) -> CoreResult<Array2<f64>> {
     let (r, c) = coarse.dim();
     let (fr, fc) = (2 * r - 1, 2 * c - 1);
     let cs = coarse
@@ -671,7 +688,12 @@ fn noise(
 }
 
 /// One area-support level: `(r, c)` -> `(2r, 2c)`, block means kept.
-fn level_area(coarse: ArrayView2<f64>, maps: &Maps, p: &ResampleParams, l: u32) -> CoreResult<Array2<f64>> {
+fn level_area(
+    coarse: ArrayView2<f64>,
+    maps: &Maps,
+    p: &ResampleParams,
+    l: u32,
+) -> CoreResult<Array2<f64>> {
     let (r, c) = coarse.dim();
     let (fr, fc) = (2 * r, 2 * c);
     let cs = coarse
@@ -704,79 +726,81 @@ fn level_area(coarse: ArrayView2<f64>, maps: &Maps, p: &ResampleParams, l: u32) 
     }
     let mut fine = crate::buffers::zeroed(fr * fc);
     let corr = (4.0f64 / 3.0).sqrt();
-    fine.par_chunks_mut(2 * fc).enumerate().for_each(|(i, rows2)| {
-        let (top, bottom) = rows2.split_at_mut(fc);
-        let mut last_h = f64::NAN;
-        let mut cache: [([f64; NS], f64); 4] = [([0.0; NS], 0.0); 4];
-        for j in 0..c {
-            let z = cs[i * c + j];
-            let (h, s) = maps.at(i >> l, j >> l);
-            if !(z.is_finite() && h.is_finite() && s.is_finite()) {
+    fine.par_chunks_mut(2 * fc)
+        .enumerate()
+        .for_each(|(i, rows2)| {
+            let (top, bottom) = rows2.split_at_mut(fc);
+            let mut last_h = f64::NAN;
+            let mut cache: [([f64; NS], f64); 4] = [([0.0; NS], 0.0); 4];
+            for j in 0..c {
+                let z = cs[i * c + j];
+                let (h, s) = maps.at(i >> l, j >> l);
+                if !(z.is_finite() && h.is_finite() && s.is_finite()) {
+                    for q in 0..4 {
+                        let (di, dj) = (q / 2, q % 2);
+                        let row = if di == 0 { &mut *top } else { &mut *bottom };
+                        row[2 * j + dj] = f64::NAN;
+                    }
+                    continue;
+                }
+                let interior = !any_nan && g.interior(i, j, 2);
+                if interior && h != last_h {
+                    for (q, cq) in cache.iter_mut().enumerate() {
+                        *cq = tables[2 + q].at(h);
+                    }
+                    last_h = h;
+                }
+                let mut v = [0.0; 4];
+                let mut e = [0.0; 4];
                 for q in 0..4 {
                     let (di, dj) = (q / 2, q % 2);
-                    let row = if di == 0 { &mut *top } else { &mut *bottom };
-                    row[2 * j + dj] = f64::NAN;
-                }
-                continue;
-            }
-            let interior = !any_nan && g.interior(i, j, 2);
-            if interior && h != last_h {
-                for (q, cq) in cache.iter_mut().enumerate() {
-                    *cq = tables[2 + q].at(h);
-                }
-                last_h = h;
-            }
-            let mut v = [0.0; 4];
-            let mut e = [0.0; 4];
-            for q in 0..4 {
-                let (di, dj) = (q / 2, q % 2);
-                let st = &stencils[2 + q];
-                let (w, sd, m) = if interior {
-                    (cache[q].0, cache[q].1, u16::MAX)
-                } else {
-                    let (m, _) = g.mask(st, i, j);
-                    let (w, sd) = if m == u16::MAX {
-                        tables[2 + q].at(h)
+                    let st = &stencils[2 + q];
+                    let (w, sd, m) = if interior {
+                        (cache[q].0, cache[q].1, u16::MAX)
                     } else {
-                        match partials[q].map.get(&m) {
-                            Some(t) => t.at(h),
-                            None => ([0.0; NS], f64::NAN),
-                        }
+                        let (m, _) = g.mask(st, i, j);
+                        let (w, sd) = if m == u16::MAX {
+                            tables[2 + q].at(h)
+                        } else {
+                            match partials[q].map.get(&m) {
+                                Some(t) => t.at(h),
+                                None => ([0.0; NS], f64::NAN),
+                            }
+                        };
+                        (w, sd, m)
                     };
-                    (w, sd, m)
-                };
-                let mut acc = 0.0;
-                for (k, &(dr, dc)) in st.offsets.iter().enumerate() {
-                    if m & (1 << k) != 0 {
-                        let (ii, jj) = ((i as isize + dr) as usize, (j as isize + dc) as usize);
-                        acc += w[k] * cs[ii * c + jj];
+                    let mut acc = 0.0;
+                    for (k, &(dr, dc)) in st.offsets.iter().enumerate() {
+                        if m & (1 << k) != 0 {
+                            let (ii, jj) = ((i as isize + dr) as usize, (j as isize + dc) as usize);
+                            acc += w[k] * cs[ii * c + jj];
+                        }
                     }
+                    v[q] = acc;
+                    e[q] = noise(
+                        detail,
+                        &key,
+                        &sd,
+                        s,
+                        h,
+                        scale,
+                        g0,
+                        g1,
+                        gcols,
+                        2 * i + di,
+                        2 * j + dj,
+                    );
                 }
-                v[q] = acc;
-                e[q] = noise(
-                    detail,
-                    &key,
-                    &sd,
-                    s,
-                    h,
-                    scale,
-                    g0,
-                    g1,
-                    gcols,
-                    2 * i + di,
-                    2 * j + dj,
-                );
+                let em = 0.25 * (e[0] + e[1] + e[2] + e[3]);
+                let vm = 0.25 * (v[0] + v[1] + v[2] + v[3]);
+                for q in 0..4 {
+                    let (di, dj) = (q / 2, q % 2);
+                    let x = v[q] - vm + z + corr * (e[q] - em);
+                    let row = if di == 0 { &mut *top } else { &mut *bottom };
+                    row[2 * j + dj] = x;
+                }
             }
-            let em = 0.25 * (e[0] + e[1] + e[2] + e[3]);
-            let vm = 0.25 * (v[0] + v[1] + v[2] + v[3]);
-            for q in 0..4 {
-                let (di, dj) = (q / 2, q % 2);
-                let x = v[q] - vm + z + corr * (e[q] - em);
-                let row = if di == 0 { &mut *top } else { &mut *bottom };
-                row[2 * j + dj] = x;
-            }
-        }
-    });
+        });
     Array2::from_shape_vec((fr, fc), fine).map_err(|e| CoreError::Internal(e.to_string()))
 }
 
@@ -797,7 +821,9 @@ mod tests {
     }
 
     fn field(r: usize, c: usize) -> Array2<f64> {
-        Array2::from_shape_fn((r, c), |(i, j)| ((i * 7 + j * 3) as f64).sin() * 5.0 + i as f64)
+        Array2::from_shape_fn((r, c), |(i, j)| {
+            ((i * 7 + j * 3) as f64).sin() * 5.0 + i as f64
+        })
     }
 
     #[test]
@@ -854,7 +880,13 @@ mod tests {
         let z = field(9, 11);
         let h = Array2::from_elem((9, 11), 0.6);
         let s = Array2::from_elem((9, 11), 1.0);
-        let out = resample(z.view(), h.view(), s.view(), &params(2, Support::Point, true)).unwrap();
+        let out = resample(
+            z.view(),
+            h.view(),
+            s.view(),
+            &params(2, Support::Point, true),
+        )
+        .unwrap();
         assert_eq!(out.dim(), (33, 41));
         for i in 0..9 {
             for j in 0..11 {
@@ -866,9 +898,21 @@ mod tests {
         // stencils at the edges (and the diamond samples they feed, up to 6
         // fine cells in) reproduce constants only (no drift in fBm).
         let plane = Array2::from_shape_fn((9, 11), |(i, j)| 2.0 * i as f64 - 0.5 * j as f64 + 3.0);
-        let out = resample(plane.view(), h.view(), s.view(), &params(1, Support::Point, false)).unwrap();
+        let out = resample(
+            plane.view(),
+            h.view(),
+            s.view(),
+            &params(1, Support::Point, false),
+        )
+        .unwrap();
         let flat = Array2::from_elem((9, 11), 4.5);
-        let outf = resample(flat.view(), h.view(), s.view(), &params(1, Support::Point, false)).unwrap();
+        let outf = resample(
+            flat.view(),
+            h.view(),
+            s.view(),
+            &params(1, Support::Point, false),
+        )
+        .unwrap();
         assert!(outf.iter().all(|v| (v - 4.5).abs() < 1e-12));
         for ((i, j), v) in out.indexed_iter() {
             if i < 6 || j < 6 || i + 6 >= 17 || j + 6 >= 21 {
@@ -884,7 +928,13 @@ mod tests {
         let z = field(8, 10);
         let h = Array2::from_elem((8, 10), 0.4);
         let s = Array2::from_elem((8, 10), 2.0);
-        let out = resample(z.view(), h.view(), s.view(), &params(2, Support::Area, true)).unwrap();
+        let out = resample(
+            z.view(),
+            h.view(),
+            s.view(),
+            &params(2, Support::Area, true),
+        )
+        .unwrap();
         assert_eq!(out.dim(), (32, 40));
         for i in 0..8 {
             for j in 0..10 {
@@ -936,13 +986,25 @@ mod tests {
         z[(5, 5)] = f64::NAN;
         let h = Array2::from_elem((12, 12), 0.5);
         let s = Array2::from_elem((12, 12), 1.0);
-        let out = resample(z.view(), h.view(), s.view(), &params(1, Support::Point, true)).unwrap();
+        let out = resample(
+            z.view(),
+            h.view(),
+            s.view(),
+            &params(1, Support::Point, true),
+        )
+        .unwrap();
         assert!(out[(10, 10)].is_nan());
         assert!(out[(9, 9)].is_nan() && out[(11, 10)].is_nan());
         assert!(out[(8, 9)].is_finite() && out[(10, 7)].is_finite());
         let n_nan = out.iter().filter(|x| x.is_nan()).count();
         assert_eq!(n_nan, 1 + 4 + 4);
-        let out = resample(z.view(), h.view(), s.view(), &params(1, Support::Area, true)).unwrap();
+        let out = resample(
+            z.view(),
+            h.view(),
+            s.view(),
+            &params(1, Support::Area, true),
+        )
+        .unwrap();
         let n_nan = out.iter().filter(|x| x.is_nan()).count();
         assert_eq!(n_nan, 4);
         assert!(out[(10, 10)].is_nan() && out[(11, 11)].is_nan());
