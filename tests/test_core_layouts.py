@@ -81,6 +81,8 @@ CASES = {
     "davies_harte_fbm": (np.sqrt(np.linspace(1.0, 2.0, 65)), lambda a: _core.davies_harte_fbm(a, 64, 1, 0)),
     "hillshade_f64": (IMG, lambda a: _core.hillshade_f64(a, [1.0] * a.shape[0], 1.0, 315.0, 45.0, 1.0, False)),
     "hillshade_gdal_byte": (IMG.astype(np.float32), lambda a: _core.hillshade_gdal_byte(a, 1.0, 1.0, 315.0, 45.0, 1.0, False)),
+    "fractal_resample": (IMG[:16, :12], lambda a: _core.fractal_resample(
+        a, np.full(a.shape, 0.6) + 0.01 * a / a.max(), np.full(a.shape, 1.0), 1, False, 5, [True])),
     "shade_to_byte": (np.abs(np.sin(IMG)).astype(np.float32), lambda a: _core.shade_to_byte(a)),
     "write_exr": (IMG.astype(np.float32), lambda a: _file_bytes(_core.write_exr, a, ".exr")),
     "write_mesh": (rng.random((3, 3)).astype(np.float32), _mesh),

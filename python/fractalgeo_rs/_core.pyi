@@ -22,6 +22,7 @@ __all__ = [
     "dbc_count",
     "dbc_transform_map",
     "fgn_sqrt_eigenvalues",
+    "fractal_resample",
     "higuchi_lengths",
     "hillshade_f64",
     "hillshade_gdal_byte",
@@ -50,6 +51,7 @@ __all__ = [
     "write_exr",
     "write_mesh",
     "write_png",
+    "resample_stencil",
 ]
 
 # ---- dimension ----
@@ -309,3 +311,23 @@ def mass_curve_image(
     z_scale: float,
     n_threads: Optional[int] = None,
 ) -> npt.NDArray[np.float64]: ...
+
+
+# --- dem: fractal resampling ---
+RESAMPLE_HALO: int
+
+def fractal_resample(
+    dem: npt.NDArray[np.float64],
+    hurst: npt.NDArray[np.float64],
+    sigma: npt.NDArray[np.float64],
+    levels: int,
+    area: bool,
+    seed: int,
+    detail: Sequence[bool],
+    origin: Tuple[int, int] = (0, 0),
+    global_cols: int = 0,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...
+def resample_stencil(
+    which: int, hurst: float
+) -> Tuple[list[float], float, list[Tuple[int, int]]]: ...

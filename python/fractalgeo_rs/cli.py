@@ -18,6 +18,7 @@ import sys
 from typing import Optional, Sequence
 
 _DOMAIN_CLIS = (
+    "fractalgeo_rs.dem._cli",
     "fractalgeo_rs.dimension._cli",
     "fractalgeo_rs.lsystem._cli",
     "fractalgeo_rs.synth._cli",
