@@ -56,6 +56,7 @@ const NONE: u32 = u32::MAX;
 
 #[derive(Clone, Copy)]
 struct FaceInfo {
+    handle: Option<FixedFaceHandle<InnerTag>>,
     version: u32,
     err: f64,
     cand: u32,
@@ -65,6 +66,7 @@ struct FaceInfo {
 impl Default for FaceInfo {
     fn default() -> Self {
         FaceInfo {
+            handle: None,
             version: 0,
             err: 0.0,
             cand: NONE,
@@ -73,31 +75,13 @@ impl Default for FaceInfo {
     }
 }
 
+/// A queue entry: the priority's bits (non-negative floats order like their
+/// bit patterns), then the lower face index first, then the version.
+#[derive(PartialEq, Eq, PartialOrd, Ord)]
 struct Entry {
-    prio: f64,
-    face: usize,
-    handle: FixedFaceHandle<InnerTag>,
+    key: u64,
+    face_rev: u32,
     version: u32,
-}
-
-impl PartialEq for Entry {
-    fn eq(&self, o: &Self) -> bool {
-        self.cmp(o) == Ordering::Equal
-    }
-}
-impl Eq for Entry {}
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Entry {
-    fn cmp(&self, o: &Self) -> Ordering {
-        self.prio
-            .total_cmp(&o.prio)
-            .then_with(|| o.face.cmp(&self.face))
-            .then_with(|| self.version.cmp(&o.version))
-    }
 }
 
 struct Grid<'a> {
@@ -206,6 +190,7 @@ struct Refiner<'a> {
     excluded: Vec<bool>,
     faces: Vec<FaceInfo>,
     heap: BinaryHeap<Entry>,
+    max_error: f64,
 }
 
 impl Refiner<'_> {
@@ -264,13 +249,15 @@ impl Refiner<'_> {
             self.faces.resize(i + 1, FaceInfo::default());
         }
         info.version = self.faces[i].version.wrapping_add(1);
+        info.handle = Some(f);
         self.faces[i] = info;
-        if info.cand != NONE {
-            let prio = if info.mixed { f64::INFINITY } else { info.err };
+        let prio = if info.mixed { f64::INFINITY } else { info.err };
+        // A face within the bound never needs a split: keep it out of the
+        // queue (most faces end there; a smaller heap pops faster).
+        if info.cand != NONE && prio > self.max_error {
             self.heap.push(Entry {
-                prio,
-                face: i,
-                handle: f,
+                key: prio.to_bits(),
+                face_rev: !(i as u32),
                 version: info.version,
             });
         }
@@ -357,6 +344,7 @@ pub fn greedy_tin(
         excluded,
         faces: Vec::new(),
         heap: BinaryHeap::new(),
+        max_error,
     };
     for &s in &initial {
         rf.insert(s, None)?;
@@ -368,15 +356,17 @@ pub fn greedy_tin(
     let budget = max_triangles.unwrap_or(usize::MAX);
     let mut star: Vec<FixedFaceHandle<InnerTag>> = Vec::new();
     while let Some(top) = rf.heap.pop() {
-        let info = rf.faces[top.face];
+        let info = rf.faces[!top.face_rev as usize];
         if info.version != top.version {
             continue;
         }
-        if top.prio <= max_error || rf.tri.num_inner_faces() >= budget {
-            rf.heap.push(top);
+        if rf.tri.num_inner_faces() >= budget {
             break;
         }
-        let face = rf.tri.face(top.handle);
+        let Some(handle) = info.handle else {
+            return Err(CoreError::Internal("queued face without a handle".into()));
+        };
+        let face = rf.tri.face(handle);
         let hint = face.vertices()[0].fix();
         let v = rf.insert(info.cand as usize, Some(hint))?;
         star.clear();
@@ -455,4 +445,66 @@ mod tests {
             assert_eq!(t.max_error, 0.0);
         }
     }
+}
+
+/// Rasterise the triangle mesh (`xy` in grid coordinates `(col, row)`,
+/// heights `z`) onto a `rows x cols` grid by barycentric interpolation;
+/// samples covered by no triangle are NaN. A sample on a shared edge takes
+/// the value of the first triangle that covers it.
+pub fn rasterize(
+    xy: &[[f64; 2]],
+    z: &[f64],
+    triangles: &[[i64; 3]],
+    rows: usize,
+    cols: usize,
+) -> CoreResult<Vec<f64>> {
+    let n = xy.len();
+    if z.len() != n {
+        return Err(CoreError::invalid("z", "needs one height per vertex"));
+    }
+    let cells = rows
+        .checked_mul(cols)
+        .filter(|&c| c <= (1usize << 40))
+        .ok_or_else(|| CoreError::invalid("shape", "is too large"))?;
+    let mut out = Vec::new();
+    out.try_reserve_exact(cells)
+        .map_err(|_| CoreError::invalid("shape", format!("cannot allocate {rows} x {cols} values")))?;
+    out.resize(cells, f64::NAN);
+    for (k, t) in triangles.iter().enumerate() {
+        if t.iter().any(|&i| i < 0 || i as u64 >= n as u64) {
+            return Err(CoreError::invalid(
+                "triangles",
+                format!("row {k} has a vertex index outside [0, {n})"),
+            ));
+        }
+        let [a, b, c] = t.map(|i| xy[i as usize]);
+        let [za, zb, zc] = t.map(|i| z[i as usize]);
+        let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+        if area == 0.0 || !area.is_finite() {
+            continue;
+        }
+        let tol = -1e-9 * area.abs();
+        let lo = |u: f64, v: f64, w: f64| u.min(v).min(w).ceil().max(0.0);
+        let hi = |u: f64, v: f64, w: f64, m: usize| u.max(v).max(w).floor().min(m as f64 - 1.0);
+        let (x0, x1) = (lo(a[0], b[0], c[0]), hi(a[0], b[0], c[0], cols));
+        let (y0, y1) = (lo(a[1], b[1], c[1]), hi(a[1], b[1], c[1], rows));
+        if x0 > x1 || y0 > y1 {
+            continue;
+        }
+        for y in y0 as usize..=y1 as usize {
+            for x in x0 as usize..=x1 as usize {
+                let (px, py) = (x as f64, y as f64);
+                let w0 = ((c[0] - b[0]) * (py - b[1]) - (c[1] - b[1]) * (px - b[0])) / area.signum();
+                let w1 = ((a[0] - c[0]) * (py - c[1]) - (a[1] - c[1]) * (px - c[0])) / area.signum();
+                let w2 = ((b[0] - a[0]) * (py - a[1]) - (b[1] - a[1]) * (px - a[0])) / area.signum();
+                if w0 >= tol && w1 >= tol && w2 >= tol {
+                    let o = &mut out[y * cols + x];
+                    if o.is_nan() {
+                        *o = (w0 * za + w1 * zb + w2 * zc) / area.abs();
+                    }
+                }
+            }
+        }
+    }
+    Ok(out)
 }
