@@ -88,6 +88,9 @@ struct Grid<'a> {
     z: &'a [f64],
     rows: usize,
     cols: usize,
+    /// Rounding allowance of an interpolated height: errors up to
+    /// `max_error + slack` count as within the bound.
+    slack: f64,
 }
 
 impl Grid<'_> {
@@ -170,7 +173,7 @@ fn simplify_edge(g: &Grid, samples: &[usize], max_error: f64, keep: &mut Vec<usi
                     best = (e, k);
                 }
             }
-            if best.0 > max_error {
+            if best.0 > max_error + g.slack {
                 keep.push(samples[best.1]);
                 stack.push((a, best.1));
                 stack.push((best.1, b));
@@ -254,7 +257,7 @@ impl Refiner<'_> {
         let prio = if info.mixed { f64::INFINITY } else { info.err };
         // A face within the bound never needs a split: keep it out of the
         // queue (most faces end there; a smaller heap pops faster).
-        if info.cand != NONE && prio > self.max_error {
+        if info.cand != NONE && prio > self.max_error + self.g.slack {
             self.heap.push(Entry {
                 key: prio.to_bits(),
                 face_rev: !(i as u32),
@@ -282,7 +285,8 @@ impl Refiner<'_> {
 /// NaN = nodata).
 ///
 /// * `max_error`: stop when every valid sample is within this vertical
-///   distance of the mesh (same unit as `z`; >= 0).
+///   distance of the mesh (same unit as `z`; >= 0), allowing for the
+///   rounding of the interpolation (`16 eps max|z|`).
 /// * `max_triangles`: stop when the mesh has this many triangles (the
 ///   initial mesh may already have more).
 /// * `shared_edges`: the vertices on the four raster edges are chosen by a
@@ -310,7 +314,13 @@ pub fn greedy_tin(
     if let Some(bad) = z.iter().find(|v| v.is_infinite()) {
         return Err(CoreError::invalid("dem", format!("contains an infinite value ({bad})")));
     }
-    let g = Grid { z, rows, cols };
+    let zmax = z.iter().filter(|v| !v.is_nan()).fold(0.0f64, |m, v| m.max(v.abs()));
+    let g = Grid {
+        z,
+        rows,
+        cols,
+        slack: 16.0 * f64::EPSILON * zmax,
+    };
     let mut initial: Vec<usize> = valid_hull(&g)
         .into_iter()
         .map(|(c, r)| r as usize * cols + c as usize)
