@@ -21,7 +21,6 @@
 use crate::error::{CoreError, CoreResult};
 use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
 use spade::{DelaunayTriangulation, HasPosition, Point2, Triangulation};
-use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 /// The result of [`greedy_tin`].
@@ -219,30 +218,39 @@ impl Refiner<'_> {
             for y in y0..=y1 {
                 let row = y as usize * self.g.cols;
                 // Edge functions are linear in x: step them along the row.
-                let mut w0 = edge(p[1], p[2], x0, y);
-                let mut w1 = edge(p[2], p[0], x0, y);
-                let mut w2 = edge(p[0], p[1], x0, y);
-                let (d0, d1, d2) = (-(p[2].1 - p[1].1), -(p[0].1 - p[2].1), -(p[1].1 - p[0].1));
-                for x in x0..=x1 {
-                    if w0 >= 0 && w1 >= 0 && w2 >= 0 {
-                        let s = row + x as usize;
-                        if !self.is_vertex[s] && !self.excluded[s] {
-                            let z = self.g.z[s];
-                            if z.is_nan() {
-                                info.mixed = true;
-                            } else {
-                                let plane = (w0 as f64 * zs[0] + w1 as f64 * zs[1] + w2 as f64 * zs[2]) * inv;
-                                let e = (z - plane).abs();
-                                if e > best {
-                                    best = e;
-                                    info.cand = s as u32;
-                                }
+                let w = [edge(p[1], p[2], x0, y), edge(p[2], p[0], x0, y), edge(p[0], p[1], x0, y)];
+                let d = [-(p[2].1 - p[1].1), -(p[0].1 - p[2].1), -(p[1].1 - p[0].1)];
+                // The columns where all three edge functions are >= 0, exactly:
+                // w + d k >= 0 for k = x - x0.
+                let (mut k0, mut k1) = (0i64, x1 - x0);
+                for i in 0..3 {
+                    if d[i] > 0 {
+                        if w[i] < 0 {
+                            k0 = k0.max((-w[i] + d[i] - 1).div_euclid(d[i]));
+                        }
+                    } else if d[i] < 0 {
+                        k1 = k1.min(w[i].div_euclid(-d[i]));
+                    } else if w[i] < 0 {
+                        k1 = -1;
+                    }
+                }
+                for k in k0..=k1 {
+                    let x = x0 + k;
+                    let s = row + x as usize;
+                    if !self.is_vertex[s] && !self.excluded[s] {
+                        let z = self.g.z[s];
+                        if z.is_nan() {
+                            info.mixed = true;
+                        } else {
+                            let (w0, w1, w2) = (w[0] + d[0] * k, w[1] + d[1] * k, w[2] + d[2] * k);
+                            let plane = (w0 as f64 * zs[0] + w1 as f64 * zs[1] + w2 as f64 * zs[2]) * inv;
+                            let e = (z - plane).abs();
+                            if e > best {
+                                best = e;
+                                info.cand = s as u32;
                             }
                         }
                     }
-                    w0 += d0;
-                    w1 += d1;
-                    w2 += d2;
                 }
             }
             info.err = best.max(0.0);
