@@ -2,7 +2,9 @@
 use crate::parallel::run_in_pool;
 use crate::tin::{delaunay, greedy, interpolate};
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods,
+};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -21,9 +23,13 @@ fn tin_delaunay<'py>(
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray2<i64>>> {
     let view = points.as_array();
-    let edges: Option<Vec<[i64; 2]>> = constraints
-        .as_ref()
-        .map(|c| c.as_array().rows().into_iter().map(|r| [r[0], r[1]]).collect());
+    let edges: Option<Vec<[i64; 2]>> = constraints.as_ref().map(|c| {
+        c.as_array()
+            .rows()
+            .into_iter()
+            .map(|r| [r[0], r[1]])
+            .collect()
+    });
     let t = py.detach(|| run_in_pool(n_threads, || delaunay::delaunay(&view, edges.as_deref())))?;
     Ok(triangles_array(t).into_pyarray(py))
 }
@@ -58,7 +64,10 @@ fn tin_greedy<'py>(
     let n = r.grid.len();
     let grid = Array2::from_shape_vec(
         (n, 2),
-        r.grid.iter().flat_map(|g| [g[0] as i64, g[1] as i64]).collect(),
+        r.grid
+            .iter()
+            .flat_map(|g| [g[0] as i64, g[1] as i64])
+            .collect(),
     )
     .expect("n x 2 grid positions");
     Ok((
@@ -118,7 +127,12 @@ fn tin_rasterize<'py>(
     cols: usize,
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let p: Vec<[f64; 2]> = xy.as_array().rows().into_iter().map(|r| [r[0], r[1]]).collect();
+    let p: Vec<[f64; 2]> = xy
+        .as_array()
+        .rows()
+        .into_iter()
+        .map(|r| [r[0], r[1]])
+        .collect();
     let zs: Vec<f64> = z.as_array().iter().copied().collect();
     let t: Vec<[i64; 3]> = triangles
         .as_array()

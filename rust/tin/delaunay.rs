@@ -8,8 +8,7 @@ use super::{indexed_points, insertion_error, Indexed};
 use crate::error::{CoreError, CoreResult};
 use spade::handles::FixedVertexHandle;
 use spade::{
-    ConstrainedDelaunayTriangulation, DelaunayTriangulation, PositionInTriangulation,
-    Triangulation,
+    ConstrainedDelaunayTriangulation, DelaunayTriangulation, PositionInTriangulation, Triangulation,
 };
 
 /// Point `i` of the caller's array as `(x, y)`.
@@ -91,7 +90,11 @@ fn triangles_of<T: Triangulation<Vertex = Indexed>>(tri: &T) -> Vec<[i64; 3]> {
     tri.inner_faces()
         .map(|f| {
             let [a, b, c] = f.vertices();
-            [a.data().idx as i64, b.data().idx as i64, c.data().idx as i64]
+            [
+                a.data().idx as i64,
+                b.data().idx as i64,
+                c.data().idx as i64,
+            ]
         })
         .collect()
 }
@@ -171,11 +174,8 @@ mod tests {
 
     #[test]
     fn square_with_duplicate_keeps_first() {
-        let p = Array2::from_shape_vec(
-            (5, 2),
-            vec![0., 0., 1., 0., 1., 1., 0., 1., 1., 0.],
-        )
-        .unwrap();
+        let p =
+            Array2::from_shape_vec((5, 2), vec![0., 0., 1., 0., 1., 1., 0., 1., 1., 0.]).unwrap();
         let t = delaunay(&p.view(), None).unwrap();
         assert_eq!(t.len(), 2);
         for &tr in &t {

@@ -129,7 +129,8 @@ fn valid_hull(g: &Grid) -> Vec<(i64, i64)> {
             Box::new(pts.iter().rev())
         };
         for &p in iter {
-            while hull.len() >= start + 2 && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0
+            while hull.len() >= start + 2
+                && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0
             {
                 hull.pop();
             }
@@ -218,7 +219,11 @@ impl Refiner<'_> {
             for y in y0..=y1 {
                 let row = y as usize * self.g.cols;
                 // Edge functions are linear in x: step them along the row.
-                let w = [edge(p[1], p[2], x0, y), edge(p[2], p[0], x0, y), edge(p[0], p[1], x0, y)];
+                let w = [
+                    edge(p[1], p[2], x0, y),
+                    edge(p[2], p[0], x0, y),
+                    edge(p[0], p[1], x0, y),
+                ];
                 let d = [-(p[2].1 - p[1].1), -(p[0].1 - p[2].1), -(p[1].1 - p[0].1)];
                 // The columns where all three edge functions are >= 0, exactly:
                 // w + d k >= 0 for k = x - x0.
@@ -243,7 +248,8 @@ impl Refiner<'_> {
                             info.mixed = true;
                         } else {
                             let (w0, w1, w2) = (w[0] + d[0] * k, w[1] + d[1] * k, w[2] + d[2] * k);
-                            let plane = (w0 as f64 * zs[0] + w1 as f64 * zs[1] + w2 as f64 * zs[2]) * inv;
+                            let plane =
+                                (w0 as f64 * zs[0] + w1 as f64 * zs[1] + w2 as f64 * zs[2]) * inv;
                             let e = (z - plane).abs();
                             if e > best {
                                 best = e;
@@ -274,7 +280,11 @@ impl Refiner<'_> {
         }
     }
 
-    fn insert(&mut self, s: usize, hint: Option<FixedVertexHandle>) -> CoreResult<FixedVertexHandle> {
+    fn insert(
+        &mut self,
+        s: usize,
+        hint: Option<FixedVertexHandle>,
+    ) -> CoreResult<FixedVertexHandle> {
         let (r, c) = (s / self.g.cols, s % self.g.cols);
         let v = GridVertex {
             pos: Point2::new(c as f64, r as f64),
@@ -318,11 +328,22 @@ pub fn greedy_tin(
     let n = rows
         .checked_mul(cols)
         .filter(|&n| n == z.len() && n < u32::MAX as usize)
-        .ok_or_else(|| CoreError::invalid("dem", "shape does not match the data or has 2^32 samples or more"))?;
+        .ok_or_else(|| {
+            CoreError::invalid(
+                "dem",
+                "shape does not match the data or has 2^32 samples or more",
+            )
+        })?;
     if let Some(bad) = z.iter().find(|v| v.is_infinite()) {
-        return Err(CoreError::invalid("dem", format!("contains an infinite value ({bad})")));
+        return Err(CoreError::invalid(
+            "dem",
+            format!("contains an infinite value ({bad})"),
+        ));
     }
-    let zmax = z.iter().filter(|v| !v.is_nan()).fold(0.0f64, |m, v| m.max(v.abs()));
+    let zmax = z
+        .iter()
+        .filter(|v| !v.is_nan())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
     let g = Grid {
         z,
         rows,
@@ -453,7 +474,9 @@ mod tests {
         let mut x = 12345u64;
         let z: Vec<f64> = (0..rows * cols)
             .map(|_| {
-                x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                x = x
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
                 (x >> 11) as f64 / (1u64 << 53) as f64
             })
             .collect();
@@ -485,8 +508,9 @@ pub fn rasterize(
         .filter(|&c| c <= (1usize << 40))
         .ok_or_else(|| CoreError::invalid("shape", "is too large"))?;
     let mut out = Vec::new();
-    out.try_reserve_exact(cells)
-        .map_err(|_| CoreError::invalid("shape", format!("cannot allocate {rows} x {cols} values")))?;
+    out.try_reserve_exact(cells).map_err(|_| {
+        CoreError::invalid("shape", format!("cannot allocate {rows} x {cols} values"))
+    })?;
     out.resize(cells, f64::NAN);
     for (k, t) in triangles.iter().enumerate() {
         if t.iter().any(|&i| i < 0 || i as u64 >= n as u64) {
@@ -512,9 +536,12 @@ pub fn rasterize(
         for y in y0 as usize..=y1 as usize {
             for x in x0 as usize..=x1 as usize {
                 let (px, py) = (x as f64, y as f64);
-                let w0 = ((c[0] - b[0]) * (py - b[1]) - (c[1] - b[1]) * (px - b[0])) / area.signum();
-                let w1 = ((a[0] - c[0]) * (py - c[1]) - (a[1] - c[1]) * (px - c[0])) / area.signum();
-                let w2 = ((b[0] - a[0]) * (py - a[1]) - (b[1] - a[1]) * (px - a[0])) / area.signum();
+                let w0 =
+                    ((c[0] - b[0]) * (py - b[1]) - (c[1] - b[1]) * (px - b[0])) / area.signum();
+                let w1 =
+                    ((a[0] - c[0]) * (py - c[1]) - (a[1] - c[1]) * (px - c[0])) / area.signum();
+                let w2 =
+                    ((b[0] - a[0]) * (py - a[1]) - (b[1] - a[1]) * (px - a[0])) / area.signum();
                 if w0 >= tol && w1 >= tol && w2 >= tol {
                     let o = &mut out[y * cols + x];
                     if o.is_nan() {

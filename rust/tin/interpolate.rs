@@ -7,7 +7,8 @@ use super::{indexed_points, insertion_error, Indexed};
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 use spade::{
-    DelaunayTriangulation, FloatTriangulation, HierarchyHintGenerator, Point2, PositionInTriangulation, Triangulation,
+    DelaunayTriangulation, FloatTriangulation, HierarchyHintGenerator, Point2,
+    PositionInTriangulation, Triangulation,
 };
 
 /// Interpolation method of [`grid_from_points`].
@@ -75,7 +76,8 @@ pub fn grid_from_points<P: PointSource>(
         .filter(|&c| c <= (1usize << 40))
         .ok_or_else(|| CoreError::invalid("shape", format!("{rows} x {cols} is too large")))?;
     let vertices = indexed_points("points", n, |i| points.xy(i))?;
-    let mut tri: Tri = Tri::bulk_load(vertices.clone()).map_err(|e| insertion_error("points", e))?;
+    let mut tri: Tri =
+        Tri::bulk_load(vertices.clone()).map_err(|e| insertion_error("points", e))?;
     // Duplicates: the kept vertex takes the first occurrence's index.
     if tri.num_vertices() < n {
         let mut seen = vec![false; n];
@@ -98,37 +100,42 @@ pub fn grid_from_points<P: PointSource>(
         ));
     }
     let mut out = Vec::new();
-    out.try_reserve_exact(cells)
-        .map_err(|_| CoreError::invalid("shape", format!("cannot allocate {rows} x {cols} values")))?;
+    out.try_reserve_exact(cells).map_err(|_| {
+        CoreError::invalid("shape", format!("cannot allocate {rows} x {cols} values"))
+    })?;
     out.resize(cells, f64::NAN);
     let value = |v: spade::handles::VertexHandle<Indexed, (), (), ()>| values[v.data().idx];
     let grads: Vec<[f64; 2]> = if method == Method::NaturalC1 {
         let nn = tri.natural_neighbor();
-        tri.vertices().map(|v| nn.estimate_gradient(v, value)).collect()
+        tri.vertices()
+            .map(|v| nn.estimate_gradient(v, value))
+            .collect()
     } else {
         Vec::new()
     };
-    out.par_chunks_mut(cols.max(1)).enumerate().for_each(|(r, row)| {
-        let nn = tri.natural_neighbor();
-        let bary = tri.barycentric();
-        for (c, o) in row.iter_mut().enumerate() {
-            let (cf, rf) = (c as f64, r as f64);
-            let p = Point2::new(t[0] + t[1] * cf + t[2] * rf, t[3] + t[4] * cf + t[5] * rf);
-            let v = match method {
-                Method::Natural => nn.interpolate(value, p),
-                Method::NaturalC1 => {
-                    nn.interpolate_gradient(value, |v| grads[v.fix().index()], 1.0, p)
-                }
-                Method::Linear => bary.interpolate(value, p),
-                Method::Nearest => match tri.locate(p) {
-                    PositionInTriangulation::OutsideOfConvexHull(_)
-                    | PositionInTriangulation::NoTriangulation => None,
-                    _ => tri.nearest_neighbor(p).map(value),
-                },
-            };
-            *o = v.unwrap_or(f64::NAN);
-        }
-    });
+    out.par_chunks_mut(cols.max(1))
+        .enumerate()
+        .for_each(|(r, row)| {
+            let nn = tri.natural_neighbor();
+            let bary = tri.barycentric();
+            for (c, o) in row.iter_mut().enumerate() {
+                let (cf, rf) = (c as f64, r as f64);
+                let p = Point2::new(t[0] + t[1] * cf + t[2] * rf, t[3] + t[4] * cf + t[5] * rf);
+                let v = match method {
+                    Method::Natural => nn.interpolate(value, p),
+                    Method::NaturalC1 => {
+                        nn.interpolate_gradient(value, |v| grads[v.fix().index()], 1.0, p)
+                    }
+                    Method::Linear => bary.interpolate(value, p),
+                    Method::Nearest => match tri.locate(p) {
+                        PositionInTriangulation::OutsideOfConvexHull(_)
+                        | PositionInTriangulation::NoTriangulation => None,
+                        _ => tri.nearest_neighbor(p).map(value),
+                    },
+                };
+                *o = v.unwrap_or(f64::NAN);
+            }
+        });
     Ok(out)
 }
 
@@ -141,7 +148,9 @@ mod tests {
     fn linear_function_is_reproduced() {
         let mut x = 7u64;
         let mut rnd = || {
-            x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (x >> 11) as f64 / (1u64 << 53) as f64
         };
         let mut pts = vec![0., 0., 10., 0., 10., 10., 0., 10.];
@@ -150,9 +159,14 @@ mod tests {
             pts.push(10.0 * rnd());
         }
         let p = Array2::from_shape_vec((pts.len() / 2, 2), pts).unwrap();
-        let vals: Vec<f64> = p.rows().into_iter().map(|r| 1.0 + 2.0 * r[0] - 3.0 * r[1]).collect();
+        let vals: Vec<f64> = p
+            .rows()
+            .into_iter()
+            .map(|r| 1.0 + 2.0 * r[0] - 3.0 * r[1])
+            .collect();
         for m in [Method::Natural, Method::Linear, Method::NaturalC1] {
-            let g = grid_from_points(&p.view(), &vals, 11, 11, [0., 1., 0., 0., 0., 1.], m).unwrap();
+            let g =
+                grid_from_points(&p.view(), &vals, 11, 11, [0., 1., 0., 0., 0., 1.], m).unwrap();
             for r in 0..11 {
                 for c in 0..11 {
                     let want = 1.0 + 2.0 * c as f64 - 3.0 * r as f64;
@@ -160,7 +174,15 @@ mod tests {
                 }
             }
         }
-        let g = grid_from_points(&p.view(), &vals, 1, 1, [20., 1., 0., 0., 0., 1.], Method::Nearest).unwrap();
+        let g = grid_from_points(
+            &p.view(),
+            &vals,
+            1,
+            1,
+            [20., 1., 0., 0., 0., 1.],
+            Method::Nearest,
+        )
+        .unwrap();
         assert!(g[0].is_nan());
     }
 }
