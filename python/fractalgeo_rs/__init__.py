@@ -41,6 +41,8 @@ from fractalgeo_rs.transform import fractal_transform, lacunarity_map, segment
 from fractalgeo_rs.synth import fbm, fbm_surface, validate_surface, SurfaceReport, synthetic_dem  # noqa: E402
 from fractalgeo_rs.dem import fractal_resample, hillshade, lakes  # noqa: E402
 from fractalgeo_rs.io import read_raster, write_raster  # noqa: E402
+from fractalgeo_rs import tin  # noqa: E402
+from fractalgeo_rs.tin import TIN, delaunay, grid_from_points, tin_from_dem  # noqa: E402
 
 __all__ = [
     "__version__",
@@ -84,4 +86,10 @@ __all__ = [
     "fractal_resample",
     "read_raster",
     "write_raster",
+    # tin
+    "tin",
+    "TIN",
+    "delaunay",
+    "grid_from_points",
+    "tin_from_dem",
 ]

@@ -331,3 +331,32 @@ def fractal_resample(
 def resample_stencil(
     which: int, hurst: float
 ) -> Tuple[list[float], float, list[Tuple[int, int]]]: ...
+def tin_delaunay(
+    points: npt.NDArray[np.float64],
+    constraints: Optional[npt.NDArray[np.int64]] = None,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.int64]: ...
+def tin_greedy(
+    dem: npt.NDArray[np.float64],
+    max_error: float,
+    max_triangles: Optional[int] = None,
+    shared_edges: bool = True,
+    n_threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.int64], npt.NDArray[np.float64], npt.NDArray[np.int64], float]: ...
+def tin_grid(
+    points: npt.NDArray[np.float64],
+    values: npt.NDArray[np.float64],
+    rows: int,
+    cols: int,
+    transform: Sequence[float],
+    method: str,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...
+def tin_rasterize(
+    xy: npt.NDArray[np.float64],
+    z: npt.NDArray[np.float64],
+    triangles: npt.NDArray[np.int64],
+    rows: int,
+    cols: int,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...

@@ -23,6 +23,7 @@ _DOMAIN_CLIS = (
     "fractalgeo_rs.lsystem._cli",
     "fractalgeo_rs.synth._cli",
     "fractalgeo_rs.transform._cli",
+    "fractalgeo_rs.tin._cli",
     # each issue adds its domain's _cli module here
 )
 

@@ -12,6 +12,7 @@ mod dimension;
 mod io;
 mod lsystem;
 mod synth;
+mod tin;
 mod transform;
 
 impl From<CoreError> for PyErr {
@@ -34,5 +35,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     synth::register(m)?;
     lsystem::register(m)?;
     transform::register(m)?;
+    tin::register(m)?;
     Ok(())
 }
