@@ -4,6 +4,7 @@ use crate::transform::blanket::{blanket_areas, blanket_transform, BlanketMapOpti
 use crate::transform::dbc::{dbc_transform, DbcMapOptions, LocalMap};
 use crate::transform::lacunarity::lacunarity_transform;
 use crate::transform::mass::{mass_curve, mass_transform, MassOptions};
+use crate::transform::gls::{gls_transform, GlsOptions, GlsTables};
 use crate::transform::variation::{variation_transform, Increments, VariationOptions};
 use numpy::ndarray::Array2;
 use numpy::ndarray::Array3;
@@ -124,6 +125,68 @@ fn mass_transform_map<'py>(
         mass_transform(z, rows, cols, &opt)
     });
     step_maps(py, maps, rows, cols, step)
+}
+
+/// Moving-window GLS Hurst exponent on a float32 or float64 image, with the
+/// tables of `fractalgeo_rs.dimension.gls.tables` (`a`, `da`, `g`: (nH, K);
+/// `se`: (nH,); grid `h0 + i dh`). Returns [hurst, se] float32 maps on the
+/// `step` grid, and [angle, ratio] after them with `anisotropy`.
+#[pyfunction]
+#[pyo3(signature = (image, window_size, dilations, h0, dh, a, da, g, se, steps, min_valid, step=1, anisotropy=false, n_threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn gls_transform_map<'py>(
+    py: Python<'py>,
+    image: &Bound<'py, PyAny>,
+    window_size: usize,
+    dilations: usize,
+    h0: f64,
+    dh: f64,
+    a: PyReadonlyArray2<'py, f64>,
+    da: PyReadonlyArray2<'py, f64>,
+    g: PyReadonlyArray2<'py, f64>,
+    se: Vec<f64>,
+    steps: usize,
+    min_valid: f64,
+    step: usize,
+    anisotropy: bool,
+    n_threads: Option<usize>,
+) -> PyResult<Vec<Bound<'py, PyArray2<f32>>>> {
+    let n_h = a.shape()[0];
+    let flat = |t: &PyReadonlyArray2<'py, f64>| -> PyResult<Vec<f64>> {
+        if t.shape()[0] != n_h {
+            return Err(PyValueError::new_err("tables: a, da and g need the same shape"));
+        }
+        Ok(t.as_array().iter().copied().collect())
+    };
+    let tab = GlsTables {
+        h0,
+        dh,
+        n_h,
+        a: flat(&a)?,
+        da: flat(&da)?,
+        g: flat(&g)?,
+        se,
+    };
+    let opt = GlsOptions {
+        window: window_size,
+        dilations,
+        steps,
+        min_valid,
+        step,
+        anisotropy,
+    };
+    let (maps, rows, cols) = on_float_image!(py, image, n_threads, |z, rows, cols| {
+        gls_transform(z, rows, cols, &opt, &tab)
+    });
+    let shape = (rows.div_ceil(step.max(1)), cols.div_ceil(step.max(1)));
+    let bad = |_| PyValueError::new_err("internal: map size");
+    let mut out = vec![];
+    for v in [maps.hurst, maps.se, maps.angle, maps.ratio] {
+        if !v.is_empty() {
+            out.push(Array2::from_shape_vec(shape, v).map_err(bad)?.into_pyarray(py));
+        }
+    }
+    Ok(out)
 }
 
 type MapPair<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>);
@@ -273,6 +336,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mass_curve_image, m)?)?;
     m.add_function(wrap_pyfunction!(lacunarity_transform_map, m)?)?;
     m.add_function(wrap_pyfunction!(variation_transform_map, m)?)?;
+    m.add_function(wrap_pyfunction!(gls_transform_map, m)?)?;
     m.add_function(wrap_pyfunction!(mass_transform_map, m)?)?;
     m.add_function(wrap_pyfunction!(dbc_transform_map, m)?)?;
     m.add_function(wrap_pyfunction!(blanket_transform_map, m)?)?;

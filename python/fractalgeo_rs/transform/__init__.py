@@ -47,6 +47,7 @@ TRANSFORM_METHODS = {
     "dbc": (None, None),
     "blanket": (None, None),
     "whittle": (None, None),
+    "gls": (None, None),
     "variogram": (2.0, False),
     "madogram": (1.0, False),
     "square": (2.0, True),
@@ -112,7 +113,7 @@ def _nodata_mask(z: np.ndarray, nodata: float) -> np.ndarray:
 
 def _grid(z: np.ndarray, w: int, method: str, opts: dict, min_valid: float, step: int, n_threads):
     """(dimension, r²) on the grid of every ``step``-th pixel of ``z`` (NaN = missing)."""
-    native = method in ("mass", "variogram", "madogram", "square")  # kernels that read float32
+    native = method in ("mass", "variogram", "madogram", "square", "gls")  # kernels that read float32
     z = np.ascontiguousarray(z, dtype=_float_dtype(z.dtype) if native else np.float64)
     if method == "dbc":
         return _core.dbc_transform_map(z, w, opts["sizes"], opts["z_scale"], 0.0, opts["partial"], min_valid, step,
@@ -123,6 +124,10 @@ def _grid(z: np.ndarray, w: int, method: str, opts: dict, min_valid: float, step
         from fractalgeo_rs.transform._whittle import whittle_grid
 
         return whittle_grid(z, w, min_valid, step, n_threads)
+    if method == "gls":
+        from fractalgeo_rs.dimension.gls import gls_grid
+
+        return gls_grid(z, w, opts["dilations"], min_valid, step, n_threads, opts["anisotropy"])
     if method == "mass":
         return _core.mass_transform_map(z, w, opts["sizes"], opts["z_scale"], min_valid, step, n_threads)
     p, square = TRANSFORM_METHODS[method]
@@ -145,6 +150,8 @@ def fractal_transform(
     band: Optional[int] = None,
     n_threads: Optional[int] = None,
     return_fit: bool = False,
+    dilations: int = 2,
+    anisotropy: bool = False,
 ):
     """Map of local fractal dimension over a moving window.
 
@@ -332,7 +339,7 @@ def fractal_transform(
     if 0 in arr.shape:
         raise ValueError(f"image: array is empty (shape {arr.shape})")
     w = _check_window(window_size, arr.shape)
-    opts = {"lags": lags, "z_scale": z_scale}
+    opts = {"lags": lags, "z_scale": z_scale, "dilations": dilations, "anisotropy": bool(anisotropy)}
     half = w // 2
     if method == "mass":
         if box_sizes is None:
@@ -354,6 +361,15 @@ def fractal_transform(
         if len(eps) < 3 or eps[0] < 1:
             raise ValueError(f"epsilons: need at least 3 distinct positive thicknesses, got {eps}")
         opts["epsilons"] = eps
+    elif method == "gls":
+        from fractalgeo_rs.dimension.gls import _check_dilations
+
+        opts["dilations"] = _check_dilations(dilations)
+        if 4 * opts["dilations"] >= w:
+            raise ValueError(f"dilations: {opts['dilations']} needs a window of at least "
+                             f"{4 * opts['dilations'] + 1} pixels, got {w}")
+        if not isinstance(anisotropy, (bool, np.bool_)):
+            raise TypeError(f"anisotropy: expected a bool, got {anisotropy!r}")
     elif method == "whittle":
         if w < 7:
             raise ValueError(f"window_size: method 'whittle' needs a window of at least 7 pixels, got {w}")
@@ -365,8 +381,7 @@ def fractal_transform(
         z = np.asarray(block, dtype=_float_dtype(block.dtype))
         if nodata is not None:
             z = np.where(_nodata_mask(z, nodata), np.nan, z)
-        d, r2 = _grid(z, w, method, opts, min_valid, step, n_threads)
-        return np.stack([d, r2])
+        return np.stack(_grid(z, w, method, opts, min_valid, step, n_threads))
 
     if is_dask:
         import dask.array as da
@@ -390,10 +405,11 @@ def fractal_transform(
             n1 = -(-(b.shape[1] - 2 * depth) // step)
             return res[:, d0:d0 + n0, d0:d0 + n1].astype(np.float32)
 
-        out_chunks = ((2,),) + tuple(tuple(-(-(c - 2 * depth) // step) for c in cs) for cs in padded.chunks)
+        n_maps = 4 if method == "gls" and opts["anisotropy"] else 2
+        out_chunks = ((n_maps,),) + tuple(tuple(-(-(c - 2 * depth) // step) for c in cs) for cs in padded.chunks)
         res = padded.map_blocks(block_fn, new_axis=0, chunks=out_chunks, dtype=np.float32,
                                 meta=np.empty((0, 0, 0), np.float32))
-        out = (res[0], res[1]) if return_fit else res[0]
+        maps = [res[i] for i in range(n_maps)]
     else:
         # no copy of a float32 or float64 image (never modified), one of
         # other types
@@ -403,12 +419,14 @@ def fractal_transform(
         # fmax ignores NaN: the reduction is NaN only when every value is
         if np.isnan(np.fmax.reduce(z, axis=None)):
             raise ValueError("image: no valid value (all NaN or nodata)")
-        d, r2 = _grid(z, w, method, opts, min_valid, step, n_threads)
-        out = (d, r2) if return_fit else d
+        maps = list(_grid(z, w, method, opts, min_valid, step, n_threads))
+    # gls with anisotropy: (D[, se], angle, ratio)
+    out = tuple(maps[:2] if return_fit else maps[:1]) + tuple(maps[2:])
+    out = out if len(out) > 1 else out[0]
     if xr_obj is not None:
         grid = xr_obj.isel({xr_obj.dims[0]: slice(None, None, step), xr_obj.dims[1]: slice(None, None, step)})
         wrap = lambda a: grid.copy(data=a).astype(np.float32).rename("fractal_dimension")  # noqa: E731
-        out = tuple(wrap(a) for a in out) if return_fit else wrap(out)
+        out = tuple(wrap(a) for a in out) if isinstance(out, tuple) else wrap(out)
     return out
 
 
