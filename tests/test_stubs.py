@@ -21,7 +21,7 @@ def test_docstring_examples_run():
     import doctest
     import importlib
 
-    for name in ["fractalgeo_rs.dimension", "fractalgeo_rs.dimension.boxcount", "fractalgeo_rs.fit",
+    for name in ["fractalgeo_rs.dimension", "fractalgeo_rs.dimension.boxcount", "fractalgeo_rs.dimension.gls", "fractalgeo_rs.fit",
                  "fractalgeo_rs.io", "fractalgeo_rs.synth._validate", "fractalgeo_rs.transform"]:
         mod = importlib.import_module(name)
         res = doctest.testmod(mod, optionflags=doctest.ELLIPSIS)

@@ -291,7 +291,7 @@ def gls_dimension(
     Examples
     --------
     >>> import fractalgeo_rs as fg
-    >>> z = fg.fbm_surface((128, 128), 0.5, method="exact", seed=1)
+    >>> z = fg.fbm_surface((32, 32), 0.5, method="exact", seed=1)
     >>> fit = fg.dimension(z, method="gls")
     >>> abs(fit.dimension - 2.5) < 4 * fit.stderr
     True
