@@ -109,6 +109,53 @@ impl GlsTables {
         (i, x - i as f64)
     }
 
+    /// Per interval `i` of the grid, the coefficients in `s` of
+    /// `sum_f g_f(s) a_f(s)` (`g` linear, `a` cubic Hermite: a quartic), so
+    /// that a Gauss-Newton step needs two dot products with `y` only.
+    pub fn step_polys(&self, k: usize) -> Vec<[f64; 5]> {
+        let dh = self.dh;
+        (0..self.n_h - 1)
+            .map(|i| {
+                let (r0, r1) = (i * k, (i + 1) * k);
+                let mut c = [0.0f64; 5];
+                for f in 0..k {
+                    let (a0, a1) = (self.a[r0 + f], self.a[r1 + f]);
+                    let (d0, d1) = (dh * self.da[r0 + f], dh * self.da[r1 + f]);
+                    let aa = [a0, d0, -3.0 * a0 - 2.0 * d0 + 3.0 * a1 - d1, 2.0 * a0 + d0 - 2.0 * a1 + d1];
+                    let (b0, b1) = (self.g[r0 + f], self.g[r1 + f] - self.g[r0 + f]);
+                    c[0] += b0 * aa[0];
+                    c[1] += b0 * aa[1] + b1 * aa[0];
+                    c[2] += b0 * aa[2] + b1 * aa[1];
+                    c[3] += b0 * aa[3] + b1 * aa[2];
+                    c[4] += b1 * aa[3];
+                }
+                c
+            })
+            .collect()
+    }
+
+    /// [`GlsTables::solve`] with the polynomials of [`GlsTables::step_polys`]
+    /// (equal to rounding).
+    pub fn solve_with(&self, polys: &[[f64; 5]], ys: &[f64], steps: usize) -> (f64, f64) {
+        let k = ys.len();
+        let hi = self.h0 + self.dh * (self.n_h - 1) as f64;
+        let mut h = 0.5f64;
+        for _ in 0..steps {
+            let (i, s) = self.locate(h);
+            let (g0, g1) = (&self.g[i * k..(i + 1) * k], &self.g[(i + 1) * k..(i + 2) * k]);
+            let (mut y0, mut y1) = (0.0, 0.0);
+            for f in 0..k {
+                y0 += g0[f] * ys[f];
+                y1 += g1[f] * ys[f];
+            }
+            let c = &polys[i];
+            let ga = c[0] + s * (c[1] + s * (c[2] + s * (c[3] + s * c[4])));
+            h = (h + (1.0 - s) * y0 + s * y1 - ga).clamp(self.h0, hi);
+        }
+        let (i, s) = self.locate(h);
+        (h, (1.0 - s) * self.se[i] + s * self.se[i + 1])
+    }
+
     /// Gauss-Newton steps from `H = 0.5`; returns `(H, se of H)`.
     pub fn solve(&self, ys: &[f64], steps: usize) -> (f64, f64) {
         let k = ys.len();
@@ -280,6 +327,7 @@ pub fn gls_transform<T: Sample>(
         ratio: if opt.anisotropy { vec![f32::NAN; n_out] } else { vec![] },
     };
     let full = (w * w) as f64;
+    let polys = tab.step_polys(nf);
     #[derive(Default)]
     struct Scratch {
         vsat: Vec<f64>,
@@ -383,7 +431,7 @@ pub fn gls_transform<T: Sample>(
                         continue;
                     }
                     ln_in_place(ys);
-                    let (hh, se) = tab.solve(ys, opt.steps);
+                    let (hh, se) = tab.solve_with(&polys, ys, opt.steps);
                     hout[kk] = hh as f32;
                     sout[kk] = (se * (full / valid).sqrt()) as f32;
                     if !aout.is_empty() {
@@ -435,6 +483,17 @@ mod tests {
             }
         }
         t
+    }
+
+    #[test]
+    fn fast_steps_equal_the_interpolated_steps() {
+        let tab = toy_tables(2);
+        let polys = tab.step_polys(16);
+        for t in 0..50 {
+            let ys: Vec<f64> = (0..16).map(|f| ((f * 7 + t * 3) % 11) as f64 * 0.1 - 0.4).collect();
+            let (a, b) = (tab.solve(&ys, 4), tab.solve_with(&polys, &ys, 4));
+            assert!((a.0 - b.0).abs() < 1e-12 && (a.1 - b.1).abs() < 1e-12, "{a:?} {b:?}");
+        }
     }
 
     #[test]
