@@ -2,9 +2,9 @@
 use crate::parallel::run_in_pool;
 use crate::transform::blanket::{blanket_areas, blanket_transform, BlanketMapOptions};
 use crate::transform::dbc::{dbc_transform, DbcMapOptions, LocalMap};
+use crate::transform::gls::{gls_transform, GlsOptions, GlsTables};
 use crate::transform::lacunarity::lacunarity_transform;
 use crate::transform::mass::{mass_curve, mass_transform, MassOptions};
-use crate::transform::gls::{gls_transform, GlsOptions, GlsTables};
 use crate::transform::variation::{variation_transform, Increments, VariationOptions};
 use numpy::ndarray::Array2;
 use numpy::ndarray::Array3;
@@ -154,7 +154,9 @@ fn gls_transform_map<'py>(
     let n_h = a.shape()[0];
     let flat = |t: &PyReadonlyArray2<'py, f64>| -> PyResult<Vec<f64>> {
         if t.shape()[0] != n_h {
-            return Err(PyValueError::new_err("tables: a, da and g need the same shape"));
+            return Err(PyValueError::new_err(
+                "tables: a, da and g need the same shape",
+            ));
         }
         Ok(t.as_array().iter().copied().collect())
     };
@@ -183,7 +185,11 @@ fn gls_transform_map<'py>(
     let mut out = vec![];
     for v in [maps.hurst, maps.se, maps.angle, maps.ratio] {
         if !v.is_empty() {
-            out.push(Array2::from_shape_vec(shape, v).map_err(bad)?.into_pyarray(py));
+            out.push(
+                Array2::from_shape_vec(shape, v)
+                    .map_err(bad)?
+                    .into_pyarray(py),
+            );
         }
     }
     Ok(out)

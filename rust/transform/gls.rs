@@ -38,7 +38,11 @@ pub struct Filter {
 pub fn filters(k: usize) -> Vec<Filter> {
     let mut out = Vec::with_capacity(8 * k);
     for order in [1usize, 2] {
-        let w: &[f64] = if order == 1 { &[-1.0, 1.0] } else { &[1.0, -2.0, 1.0] };
+        let w: &[f64] = if order == 1 {
+            &[-1.0, 1.0]
+        } else {
+            &[1.0, -2.0, 1.0]
+        };
         for (dir, &(er, ec)) in DIRS.iter().enumerate() {
             for u in 1..=k {
                 let offs: Vec<(isize, isize)> = (0..=order as isize)
@@ -121,7 +125,12 @@ impl GlsTables {
                 for f in 0..k {
                     let (a0, a1) = (self.a[r0 + f], self.a[r1 + f]);
                     let (d0, d1) = (dh * self.da[r0 + f], dh * self.da[r1 + f]);
-                    let aa = [a0, d0, -3.0 * a0 - 2.0 * d0 + 3.0 * a1 - d1, 2.0 * a0 + d0 - 2.0 * a1 + d1];
+                    let aa = [
+                        a0,
+                        d0,
+                        -3.0 * a0 - 2.0 * d0 + 3.0 * a1 - d1,
+                        2.0 * a0 + d0 - 2.0 * a1 + d1,
+                    ];
                     let (b0, b1) = (self.g[r0 + f], self.g[r1 + f] - self.g[r0 + f]);
                     c[0] += b0 * aa[0];
                     c[1] += b0 * aa[1] + b1 * aa[0];
@@ -142,7 +151,10 @@ impl GlsTables {
         let mut h = 0.5f64;
         for _ in 0..steps {
             let (i, s) = self.locate(h);
-            let (g0, g1) = (&self.g[i * k..(i + 1) * k], &self.g[(i + 1) * k..(i + 2) * k]);
+            let (g0, g1) = (
+                &self.g[i * k..(i + 1) * k],
+                &self.g[(i + 1) * k..(i + 2) * k],
+            );
             let (mut y0, mut y1) = (0.0, 0.0);
             for f in 0..k {
                 y0 += g0[f] * ys[f];
@@ -273,7 +285,9 @@ fn ln_in_place(v: &mut [f64]) {
 
 #[test]
 fn fast_ln_matches_the_library() {
-    let mut xs: Vec<f64> = (0..2000).map(|k| 1.37f64.powf(k as f64 / 7.0 - 140.0)).collect();
+    let mut xs: Vec<f64> = (0..2000)
+        .map(|k| 1.37f64.powf(k as f64 / 7.0 - 140.0))
+        .collect();
     xs.push(1e-310);
     let want: Vec<f64> = xs.iter().map(|x| x.ln()).collect();
     ln_in_place(&mut xs[..2000]);
@@ -309,7 +323,10 @@ pub fn gls_transform<T: Sample>(
     if k == 0 || 4 * k >= w {
         return Err(CoreError::invalid(
             "dilations",
-            format!("expected an int in [1, {}) for window {w}, got {k}", w.div_ceil(4)),
+            format!(
+                "expected an int in [1, {}) for window {w}, got {k}",
+                w.div_ceil(4)
+            ),
         ));
     }
     let fl = filters(k);
@@ -323,8 +340,16 @@ pub fn gls_transform<T: Sample>(
     let mut maps = GlsMaps {
         hurst: vec![f32::NAN; n_out],
         se: vec![f32::NAN; n_out],
-        angle: if opt.anisotropy { vec![f32::NAN; n_out] } else { vec![] },
-        ratio: if opt.anisotropy { vec![f32::NAN; n_out] } else { vec![] },
+        angle: if opt.anisotropy {
+            vec![f32::NAN; n_out]
+        } else {
+            vec![]
+        },
+        ratio: if opt.anisotropy {
+            vec![f32::NAN; n_out]
+        } else {
+            vec![]
+        },
     };
     let full = (w * w) as f64;
     let polys = tab.step_polys(nf);
@@ -337,7 +362,10 @@ pub fn gls_transform<T: Sample>(
     let chunk = ob * ocols;
     let n_bands = orows.div_ceil(ob);
     // the anisotropy maps split like the others (empty slices when not asked)
-    let (mut angle, mut ratio) = (std::mem::take(&mut maps.angle), std::mem::take(&mut maps.ratio));
+    let (mut angle, mut ratio) = (
+        std::mem::take(&mut maps.angle),
+        std::mem::take(&mut maps.ratio),
+    );
     let mut aparts = split_bands(&mut angle, chunk, n_bands);
     let mut rparts = split_bands(&mut ratio, chunk, n_bands);
     maps.hurst
@@ -346,102 +374,107 @@ pub fn gls_transform<T: Sample>(
         .zip(aparts.par_iter_mut())
         .zip(rparts.par_iter_mut())
         .enumerate()
-        .for_each_init(Scratch::default, |sc, (band, (((hout, sout), aout), rout))| {
-            let g0 = band * ob;
-            let g1 = (g0 + ob).min(orows);
-            let i0 = (g0 * step).saturating_sub(h);
-            let i1 = ((g1 - 1) * step + h + 1).min(rows);
-            let nr = i1 - i0;
-            let sw = cols + 1;
-            let get = |r: usize, c: usize| z[(i0 + r) * cols + c].to_f64();
-            sat_into(&mut sc.vsat, nr, cols, |r, c| (!get(r, c).is_nan()) as u8 as f64);
-            // a band without missing samples needs no count tables
-            let complete = sc.vsat[nr * sw + cols] == (nr * cols) as f64;
-            sc.power.resize_with(nf, Vec::new);
-            sc.count.resize_with(nf, Vec::new);
-            for (fi, f) in fl.iter().enumerate() {
-                let inc = |r: usize, c: usize| -> f64 {
-                    if r + f.span.0 >= nr || c + f.span.1 >= cols {
-                        return f64::NAN;
-                    }
-                    let mut d = 0.0;
-                    for &(dr, dc, wt) in &f.taps[..f.n_taps] {
-                        d += wt * get(r + dr, c + dc);
-                    }
-                    d
-                };
-                if complete {
-                    sat_into(&mut sc.power[fi], nr, cols, |r, c| {
-                        let d = inc(r, c);
-                        if d.is_nan() {
-                            0.0
-                        } else {
-                            d * d
-                        }
-                    });
-                } else {
-                    let (p, n) = (&mut sc.power[fi], &mut sc.count[fi]);
-                    sats_into([p, n], nr, cols, |r, c| {
-                        let d = inc(r, c);
-                        if d.is_nan() {
-                            [0.0, 0.0]
-                        } else {
-                            [d * d, 1.0]
-                        }
-                    });
-                }
-            }
-            // one output row at a time, filter by filter (sequential reads of
-            // each table), then the fit per pixel: vrow[q * nf + fi] = V_f,
-            // 0 where the window is skipped or the filter has no valid increment
-            let mut vrow = vec![0.0f64; ocols * nf];
-            let mut validrow = vec![0.0f64; ocols];
-            for g in g0..g1 {
-                let i = g * step;
-                let r0 = i.saturating_sub(h) - i0;
-                let r1 = (i + h + 1).min(rows) - i0;
-                let win = |q: usize| {
-                    let j = q * step;
-                    (j.saturating_sub(h), (j + h + 1).min(cols))
-                };
-                for (q, v) in validrow.iter_mut().enumerate() {
-                    let (c0, c1) = win(q);
-                    *v = rect(&sc.vsat, sw, r0, r1, c0, c1);
-                }
+        .for_each_init(
+            Scratch::default,
+            |sc, (band, (((hout, sout), aout), rout))| {
+                let g0 = band * ob;
+                let g1 = (g0 + ob).min(orows);
+                let i0 = (g0 * step).saturating_sub(h);
+                let i1 = ((g1 - 1) * step + h + 1).min(rows);
+                let nr = i1 - i0;
+                let sw = cols + 1;
+                let get = |r: usize, c: usize| z[(i0 + r) * cols + c].to_f64();
+                sat_into(&mut sc.vsat, nr, cols, |r, c| {
+                    (!get(r, c).is_nan()) as u8 as f64
+                });
+                // a band without missing samples needs no count tables
+                let complete = sc.vsat[nr * sw + cols] == (nr * cols) as f64;
+                sc.power.resize_with(nf, Vec::new);
+                sc.count.resize_with(nf, Vec::new);
                 for (fi, f) in fl.iter().enumerate() {
-                    let rr1 = r1.saturating_sub(f.span.0);
-                    let (ps, cs) = (&sc.power[fi], &sc.count[fi]);
-                    for q in 0..ocols {
+                    let inc = |r: usize, c: usize| -> f64 {
+                        if r + f.span.0 >= nr || c + f.span.1 >= cols {
+                            return f64::NAN;
+                        }
+                        let mut d = 0.0;
+                        for &(dr, dc, wt) in &f.taps[..f.n_taps] {
+                            d += wt * get(r + dr, c + dc);
+                        }
+                        d
+                    };
+                    if complete {
+                        sat_into(&mut sc.power[fi], nr, cols, |r, c| {
+                            let d = inc(r, c);
+                            if d.is_nan() {
+                                0.0
+                            } else {
+                                d * d
+                            }
+                        });
+                    } else {
+                        let (p, n) = (&mut sc.power[fi], &mut sc.count[fi]);
+                        sats_into([p, n], nr, cols, |r, c| {
+                            let d = inc(r, c);
+                            if d.is_nan() {
+                                [0.0, 0.0]
+                            } else {
+                                [d * d, 1.0]
+                            }
+                        });
+                    }
+                }
+                // one output row at a time, filter by filter (sequential reads of
+                // each table), then the fit per pixel: vrow[q * nf + fi] = V_f,
+                // 0 where the window is skipped or the filter has no valid increment
+                let mut vrow = vec![0.0f64; ocols * nf];
+                let mut validrow = vec![0.0f64; ocols];
+                for g in g0..g1 {
+                    let i = g * step;
+                    let r0 = i.saturating_sub(h) - i0;
+                    let r1 = (i + h + 1).min(rows) - i0;
+                    let win = |q: usize| {
+                        let j = q * step;
+                        (j.saturating_sub(h), (j + h + 1).min(cols))
+                    };
+                    for (q, v) in validrow.iter_mut().enumerate() {
                         let (c0, c1) = win(q);
-                        let cc1 = c1.saturating_sub(f.span.1);
-                        let sp = rect(ps, sw, r0, rr1, c0, cc1);
-                        let n = if complete {
-                            (rr1.saturating_sub(r0) * cc1.saturating_sub(c0)) as f64
-                        } else {
-                            rect(cs, sw, r0, rr1, c0, cc1)
-                        };
-                        vrow[q * nf + fi] = if n < 0.5 || sp <= 0.0 { 0.0 } else { sp / n };
+                        *v = rect(&sc.vsat, sw, r0, r1, c0, c1);
+                    }
+                    for (fi, f) in fl.iter().enumerate() {
+                        let rr1 = r1.saturating_sub(f.span.0);
+                        let (ps, cs) = (&sc.power[fi], &sc.count[fi]);
+                        for q in 0..ocols {
+                            let (c0, c1) = win(q);
+                            let cc1 = c1.saturating_sub(f.span.1);
+                            let sp = rect(ps, sw, r0, rr1, c0, cc1);
+                            let n = if complete {
+                                (rr1.saturating_sub(r0) * cc1.saturating_sub(c0)) as f64
+                            } else {
+                                rect(cs, sw, r0, rr1, c0, cc1)
+                            };
+                            vrow[q * nf + fi] = if n < 0.5 || sp <= 0.0 { 0.0 } else { sp / n };
+                        }
+                    }
+                    for q in 0..ocols {
+                        let kk = (g - g0) * ocols + q;
+                        let valid = validrow[q];
+                        let ys = &mut vrow[q * nf..(q + 1) * nf];
+                        if valid < min_pixels || ys.iter().any(|&v| v == 0.0) {
+                            continue;
+                        }
+                        ln_in_place(ys);
+                        let (hh, se) = tab.solve_with(&polys, ys, opt.steps);
+                        hout[kk] = hh as f32;
+                        sout[kk] = (se * (full / valid).sqrt()) as f32;
+                        if !aout.is_empty() {
+                            let (ang, rat) = anisotropy(&ys[..4 * k], k, hh);
+                            aout[kk] = ang as f32;
+                            rout[kk] = rat as f32;
+                        }
                     }
                 }
-                for q in 0..ocols {
-                    let kk = (g - g0) * ocols + q;
-                    let valid = validrow[q];
-                    let ys = &mut vrow[q * nf..(q + 1) * nf];
-                    if valid < min_pixels || ys.iter().any(|&v| v == 0.0) {
-                        continue;
-                    }
-                    ln_in_place(ys);
-                    let (hh, se) = tab.solve_with(&polys, ys, opt.steps);
-                    hout[kk] = hh as f32;
-                    sout[kk] = (se * (full / valid).sqrt()) as f32;
-                    if !aout.is_empty() {
-                        let (ang, rat) = anisotropy(&ys[..4 * k], k, hh);
-                        aout[kk] = ang as f32;
-                        rout[kk] = rat as f32;
-                    }
-                }
-            }
-        });
+            },
+        );
     drop((aparts, rparts));
     maps.angle = angle;
     maps.ratio = ratio;
@@ -459,7 +492,10 @@ mod tests {
         let n_h = 5;
         let nf = fl.len();
         let len = |f: &Filter| {
-            let (r, c) = (f.taps[1].0 as f64 - f.taps[0].0 as f64, f.taps[1].1 as f64 - f.taps[0].1 as f64);
+            let (r, c) = (
+                f.taps[1].0 as f64 - f.taps[0].0 as f64,
+                f.taps[1].1 as f64 - f.taps[0].1 as f64,
+            );
             (r * r + c * c).sqrt().ln()
         };
         let x: Vec<f64> = fl.iter().map(len).collect();
@@ -490,9 +526,14 @@ mod tests {
         let tab = toy_tables(2);
         let polys = tab.step_polys(16);
         for t in 0..50 {
-            let ys: Vec<f64> = (0..16).map(|f| ((f * 7 + t * 3) % 11) as f64 * 0.1 - 0.4).collect();
+            let ys: Vec<f64> = (0..16)
+                .map(|f| ((f * 7 + t * 3) % 11) as f64 * 0.1 - 0.4)
+                .collect();
             let (a, b) = (tab.solve(&ys, 4), tab.solve_with(&polys, &ys, 4));
-            assert!((a.0 - b.0).abs() < 1e-12 && (a.1 - b.1).abs() < 1e-12, "{a:?} {b:?}");
+            assert!(
+                (a.0 - b.0).abs() < 1e-12 && (a.1 - b.1).abs() < 1e-12,
+                "{a:?} {b:?}"
+            );
         }
     }
 
@@ -532,17 +573,40 @@ mod tests {
         );
         assert!(a.hurst[40 * cols + 30].is_finite() && a.angle[40 * cols + 30].is_finite());
         for step in [2usize, 5] {
-            let g = run(2, &GlsOptions { step, anisotropy: false, ..opt.clone() });
+            let g = run(
+                2,
+                &GlsOptions {
+                    step,
+                    anisotropy: false,
+                    ..opt.clone()
+                },
+            );
             assert!(g.angle.is_empty());
             let ocols = cols.div_ceil(step);
             for gi in 0..rows.div_ceil(step) {
                 for gj in 0..ocols {
-                    let (x, y) = (g.hurst[gi * ocols + gj], a.hurst[gi * step * cols + gj * step]);
-                    assert!((x.is_nan() && y.is_nan()) || (x - y).abs() < 1e-6, "step {step}");
+                    let (x, y) = (
+                        g.hurst[gi * ocols + gj],
+                        a.hurst[gi * step * cols + gj * step],
+                    );
+                    assert!(
+                        (x.is_nan() && y.is_nan()) || (x - y).abs() < 1e-6,
+                        "step {step}"
+                    );
                 }
             }
         }
-        assert!(gls_transform(&z, rows, cols, &GlsOptions { dilations: 4, ..opt.clone() }, &tab).is_err());
+        assert!(gls_transform(
+            &z,
+            rows,
+            cols,
+            &GlsOptions {
+                dilations: 4,
+                ..opt.clone()
+            },
+            &tab
+        )
+        .is_err());
     }
 
     #[test]
@@ -561,6 +625,9 @@ mod tests {
             }
         }
         let (ang, ratio) = anisotropy(&ys, k, h);
-        assert!((ratio - 2.0).abs() < 1e-9 && (ang - 90.0).abs() < 1e-9, "{ang} {ratio}");
+        assert!(
+            (ratio - 2.0).abs() < 1e-9 && (ang - 90.0).abs() < 1e-9,
+            "{ang} {ratio}"
+        );
     }
 }
