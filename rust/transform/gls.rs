@@ -452,7 +452,14 @@ pub fn gls_transform<T: Sample>(
                             } else {
                                 rect(cs, sw, r0, rr1, c0, cc1)
                             };
-                            vrow[q * nf + fi] = if n < 0.5 || sp <= 0.0 { 0.0 } else { sp / n };
+                            // no valid increment, a zero variation, or one
+                            // that overflowed (inf samples): not fitted
+                            let v = sp / n;
+                            vrow[q * nf + fi] = if n >= 0.5 && v > 0.0 && v.is_finite() {
+                                v
+                            } else {
+                                0.0
+                            };
                         }
                     }
                     for q in 0..ocols {
