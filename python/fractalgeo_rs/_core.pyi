@@ -25,6 +25,7 @@ __all__ = [
     "gls_transform_map",
     "higuchi_lengths",
     "hillshade_f64",
+    "hillshade_gdal_byte",
     "ifs_chaos_game",
     "ifs_check",
     "ifs_iterate",
@@ -145,6 +146,16 @@ def hillshade_f64(
     multidirectional: bool,
     n_threads: Optional[int] = None,
 ) -> npt.NDArray[np.float32]: ...
+def hillshade_gdal_byte(
+    dem: npt.NDArray[np.float32],
+    dx: float,
+    dy: float,
+    azimuth: float,
+    altitude: float,
+    z_factor: float,
+    multidirectional: bool,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.uint8]: ...
 def shade_to_byte(shade: npt.NDArray[np.float32], n_threads: Optional[int] = None) -> npt.NDArray[np.uint8]: ...
 def read_exr(path: str | PathLike[str]) -> npt.NDArray[np.float32]: ...
 def write_exr(path: str | PathLike[str], image: npt.NDArray[np.float32]) -> None: ...

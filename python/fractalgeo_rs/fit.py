@@ -66,6 +66,26 @@ class DimensionFit:
         :meth:`from_model`, e.g. the Whittle likelihood): the fitted model's
         value of the measure at each scale, drawn by :meth:`plot` instead of
         a line. ``None`` for log-log regressions.
+
+    References
+    ----------
+    K. Falconer, *Fractal Geometry: Mathematical Foundations and
+    Applications*, Wiley, 1990.
+
+    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
+    dimension: assessing the roughness of time series and spatial data,
+    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> fit = fg.box_counting(np.ones((64, 64), dtype=bool))  # a filled square: D = 2
+    >>> round(fit.dimension, 6), round(fit.r_squared, 6)
+    (2.0, 1.0)
+    >>> fit.scales.tolist()
+    [1.0, 2.0, 4.0, 8.0, 16.0]
+    >>> fit.measures.tolist()
+    [4096.0, 1024.0, 256.0, 64.0, 16.0]
     """
 
     dimension: float

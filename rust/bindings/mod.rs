@@ -3,9 +3,11 @@
 //! kernel (`py.detach`), runs it in a pool of `n_threads` and maps the error.
 //! Nothing else lives here.
 use crate::error::CoreError;
-use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyMemoryError, PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 
+pub mod convert;
+mod dem;
 mod dimension;
 mod io;
 mod lsystem;
@@ -16,7 +18,8 @@ impl From<CoreError> for PyErr {
     fn from(e: CoreError) -> PyErr {
         match e {
             CoreError::InvalidArgument { .. } => PyValueError::new_err(e.to_string()),
-            CoreError::Io(_) => PyOSError::new_err(e.to_string()),
+            CoreError::Io(_) | CoreError::System(_) => PyOSError::new_err(e.to_string()),
+            CoreError::OutOfMemory { .. } => PyMemoryError::new_err(e.to_string()),
             CoreError::Internal(_) => PyRuntimeError::new_err(e.to_string()),
         }
     }
@@ -25,6 +28,7 @@ impl From<CoreError> for PyErr {
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    dem::register(m)?;
     dimension::register(m)?;
     io::register(m)?;
     synth::register(m)?;

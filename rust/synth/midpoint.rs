@@ -113,7 +113,7 @@ pub fn refine_1d(coarse: &[f64], p: &RefineParams) -> CoreResult<Vec<f64>> {
     let kd = key(p, PHASE_DISPLACE);
     let ka = key(p, PHASE_ADD);
     let o = p.origin.1;
-    let mut out = vec![0.0; m];
+    let mut out = crate::buffers::try_zeroed(m, "n")?;
     out.par_chunks_mut(1 << 12)
         .enumerate()
         .for_each(|(ci, chunk)| {
@@ -188,7 +188,8 @@ pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2
     let add = p.additions;
 
     // Pass A (diamond step): old samples and cell centres, row by row.
-    let mut fine = crate::buffers::zeroed(fr * fc);
+    let mut fine =
+        crate::buffers::try_zeroed(crate::buffers::checked_len(fr, fc, "shape")?, "shape")?;
     fine.par_chunks_mut(fc).enumerate().for_each(|(i, row)| {
         let gbase = (o0 + i as u64) * gc + o1;
         let a = i / 2;
@@ -225,7 +226,13 @@ pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2
     // odd and reads only samples with i + j even (written by pass A), so the
     // rows can be processed in parallel through a shared pointer.
     struct Shared(*mut f64);
+    // SAFETY: the pointer is shared by the rows of pass B only, and they
+    // never touch the same cell mutably: row i writes its own odd-parity
+    // cells and reads only even-parity cells, which no row writes in this
+    // pass; `fine` outlives the parallel loop and is not otherwise borrowed.
     unsafe impl Sync for Shared {}
+    // SAFETY: as for Sync: the raw pointer is only dereferenced inside the
+    // loop below, under the parity rule stated there.
     unsafe impl Send for Shared {}
     impl Shared {
         fn get(&self) -> *mut f64 {
@@ -294,6 +301,9 @@ pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2
             } else {
                 mean + delta_s * ks.normal(gbase + j as u64)
             };
+            debug_assert!(i * fc + j < fr * fc);
+            // SAFETY: (i, j) has i + j odd, a cell only row i writes in this
+            // pass, and i < fr, j < fc keep it inside the fr * fc buffer.
             unsafe { *base.add(i * fc + j) = v };
             j += 2;
         }

@@ -15,7 +15,8 @@
 //! tables built per band of rows at fixed positions (as in
 //! [`super::variation`]), so the cost per pixel does not grow with the window
 //! and the result does not depend on the thread count.
-use super::sat::{band_rows, check_step, check_window, rect, sat_into, sats_into};
+use super::sat::{band_rows, check_window, rect, sat_into, sats_into};
+use crate::checks::step_grid;
 use crate::dimension::dbc::Sample;
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
@@ -332,9 +333,9 @@ pub fn gls_transform<T: Sample>(
     let fl = filters(k);
     let nf = fl.len();
     tab.check(nf)?;
-    let step = check_step(opt.step)?;
+    let step = opt.step;
+    let (orows, ocols) = step_grid(step, rows, cols)?;
     let h = w / 2;
-    let (orows, ocols) = (rows.div_ceil(step), cols.div_ceil(step));
     let ob = (band_rows(w) / step).max(1);
     let n_out = orows * ocols;
     let mut maps = GlsMaps {

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fractalgeo_rs._validation import as_array
+from fractalgeo_rs._validation import as_array, check_nodata
 
 __all__ = ["Lakes", "lakes"]
 
@@ -61,6 +61,17 @@ def lakes(dem, level, *, closed_only=False, nodata=None, coastlines=True):
     -------
     Lakes
 
+    References
+    ----------
+    B. B. Mandelbrot, How long is the coast of Britain? Statistical self-
+    similarity and fractional dimension, *Science* 156 (1967) 636-638,
+    doi:10.1126/science.156.3775.636.
+
+    M. Datcu and K. Seidel, Fractal and multiresolution techniques for the
+    understanding of geo-information, in *Fractals in Geoscience and Remote
+    Sensing*, Proceedings of a Joint JRC/EARSeL Expert Meeting, Ispra, 1994
+    (published 1995).
+
     Examples
     --------
     >>> import numpy as np, fractalgeo_rs as fg
@@ -77,6 +88,7 @@ def lakes(dem, level, *, closed_only=False, nodata=None, coastlines=True):
     if isinstance(level, bool) or not isinstance(level, numbers.Real) or not np.isfinite(level):
         raise ValueError(f"level: expected a finite number, got {level!r}")
     level = float(level)
+    nodata = check_nodata(nodata)
     valid = np.isfinite(z) if np.issubdtype(z.dtype, np.floating) else np.ones(z.shape, dtype=bool)
     if nodata is not None:
         valid &= z != nodata

@@ -28,7 +28,7 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from fractalgeo_rs._validation import as_array, check_choice, check_nodata, check_positive_float
+from fractalgeo_rs._validation import as_array, check_choice, check_integer_lags, check_nodata, check_positive_float
 from fractalgeo_rs.fit import DimensionFit, ScaleRange, fit_loglog
 
 __all__ = ["power_variation", "variogram", "madogram", "surface_variation"]
@@ -61,9 +61,10 @@ def _with_nodata(z: np.ndarray, data, nodata) -> np.ndarray:
 
 def _check_lags(lags, n_max: int, name="lags") -> np.ndarray:
     try:
-        lg = np.asarray(sorted(set(int(v) for v in lags)), dtype=np.int64)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name}: expected a sequence of positive ints, got {lags!r}") from None
+        lg = np.asarray(check_integer_lags(lags, name, minimum=-(2**62)), dtype=np.int64)
+    except (TypeError, ValueError) as exc:
+        raise TypeError(f"{name}: expected a sequence of positive integer lags (1.5 is not a lag), "
+                        f"got {lags!r}") from exc
     if lg.size < 2:
         raise ValueError(f"{name}: need at least 2 distinct lags, got {lg.size}")
     if lg[0] < 1:
@@ -162,6 +163,26 @@ def power_variation(
         ``scales`` are the lags, ``measures`` ``V_p(l)``; ``extra["hurst"]``
         is ``slope / p``. With two lags the fit is exact: ``stderr`` and
         ``ci95`` are NaN.
+
+    References
+    ----------
+    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
+    dimension: assessing the roughness of time series and spatial data,
+    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+
+    J. T. Kent and A. T. A. Wood, Estimating the fractal dimension of a
+    locally self-similar Gaussian process by using increments, *Journal of
+    the Royal Statistical Society B* 59(3) (1997) 679-699,
+    doi:10.1111/1467-9868.00091.
+
+    Examples
+    --------
+    >>> import fractalgeo_rs as fg
+    >>> x = fg.fbm(4096, 0.5, method='exact', seed=0)  # D = 2 - H = 1.5
+    >>> round(fg.power_variation(x).dimension, 1)  # p = 1, second-order increments
+    1.5
+    >>> round(fg.power_variation(x, p=2.0, order=1).dimension, 1)  # the variogram
+    1.5
     """
     z = _with_nodata(_real_array(data, (1,)), data, nodata)
     p = check_positive_float(p, "p")
@@ -182,14 +203,85 @@ def power_variation(
 def variogram(data, *, lags: Sequence[int] = (1, 2), nodata: Optional[float] = None,
               scale_range: ScaleRange = None) -> DimensionFit:
     """Variogram estimator of a profile's dimension: :func:`power_variation`
-    with ``p=2, order=1`` (Gneiting et al. 2012). ``D = 2 - slope / 2``."""
+    with ``p=2, order=1`` (Gneiting et al. 2012). ``D = 2 - slope / 2``.
+
+    Parameters
+    ----------
+    data : array_like, shape (n,)
+        The profile, on a regular grid. NaN and ``nodata`` are skipped.
+    lags : sequence of int, default (1, 2)
+        Lags in samples; the default pair is the recommendation of Gneiting et
+        al. (2012).
+    nodata : float, optional
+        Value meaning "no data".
+    scale_range : None, "auto" or (low, high)
+        Lags used in the fit; see :func:`fractalgeo_rs.fit.fit_loglog`.
+
+    Returns
+    -------
+    DimensionFit
+        ``measures`` are half the mean squared increments at ``lags`` (the
+        semivariogram);
+        ``extra["hurst"]`` is ``2 - D``. With two lags the fit is exact and its
+        interval is NaN.
+
+    References
+    ----------
+    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
+    dimension: assessing the roughness of time series and spatial data,
+    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> round(fg.variogram(np.arange(100.0)).dimension, 6)  # a line: gamma(k) = k^2, D = 1
+    1.0
+    >>> x = fg.fbm(4096, 0.3, method='exact', seed=0)  # D = 2 - H = 1.7
+    >>> round(fg.variogram(x).dimension, 1)
+    1.7
+    """
     return power_variation(data, p=2.0, order=1, lags=lags, nodata=nodata, scale_range=scale_range)
 
 
 def madogram(data, *, lags: Sequence[int] = (1, 2), nodata: Optional[float] = None,
              scale_range: ScaleRange = None) -> DimensionFit:
     """Madogram estimator of a profile's dimension: :func:`power_variation`
-    with ``p=1, order=1`` (Gneiting et al. 2012). ``D = 2 - slope``."""
+    with ``p=1, order=1`` (Gneiting et al. 2012). ``D = 2 - slope``.
+
+    Parameters
+    ----------
+    data : array_like, shape (n,)
+        The profile, on a regular grid. NaN and ``nodata`` are skipped.
+    lags : sequence of int, default (1, 2)
+        Lags in samples; the default pair is the recommendation of Gneiting et
+        al. (2012).
+    nodata : float, optional
+        Value meaning "no data".
+    scale_range : None, "auto" or (low, high)
+        Lags used in the fit; see :func:`fractalgeo_rs.fit.fit_loglog`.
+
+    Returns
+    -------
+    DimensionFit
+        ``measures`` are half the mean absolute increments at ``lags``;
+        ``extra["hurst"]`` is ``2 - D``. With two lags the fit is exact and its
+        interval is NaN.
+
+    References
+    ----------
+    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
+    dimension: assessing the roughness of time series and spatial data,
+    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> round(fg.madogram(np.arange(100.0)).dimension, 6)  # a line: mean |increment| = k, D = 1
+    1.0
+    >>> x = fg.fbm(4096, 0.3, method='exact', seed=0)  # D = 2 - H = 1.7
+    >>> round(fg.madogram(x).dimension, 1)
+    1.7
+    """
     return power_variation(data, p=1.0, order=1, lags=lags, nodata=nodata, scale_range=scale_range)
 
 
@@ -237,6 +329,27 @@ def surface_variation(
         ``extra["hurst"]`` is ``3 - D``. For ``"transect"`` the fit shown is
         that of the pooled increments; ``dimension`` is the median and
         ``extra["transect_dimensions"]`` holds every row's and column's value.
+
+    References
+    ----------
+    G. Chan and A. T. A. Wood, Increment-based estimators of fractal
+    dimension for two-dimensional surface data, *Statistica Sinica* 10
+    (2000) 343-376.
+
+    J. T. Kent and A. T. A. Wood, Estimating the fractal dimension of a
+    locally self-similar Gaussian process by using increments, *Journal of
+    the Royal Statistical Society B* 59(3) (1997) 679-699,
+    doi:10.1111/1467-9868.00091.
+
+    Examples
+    --------
+    >>> import fractalgeo_rs as fg
+    >>> z = fg.fbm_surface((256, 256), 0.7, method='exact', seed=1)  # D = 3 - H = 2.3
+    >>> fit = fg.surface_variation(z)
+    >>> round(fit.dimension, 1), round(fit.extra['hurst'], 1)
+    (2.3, 0.7)
+    >>> round(fg.surface_variation(z, estimator='transect').dimension, 1)
+    2.3
     """
     z = _with_nodata(_real_array(data, (2,)), data, nodata)
     check_choice(estimator, "estimator", ("square", "first", "transect"))
