@@ -34,6 +34,9 @@ INPUTS = {
     "differential_box_counting": (SURFACE, {}), "dimension": (MASK, {}), "self_affine_box_counting": (SURFACE, {}),
     "fractal_transform": (SURFACE, {"window_size": 9}), "lacunarity_map": (np.abs(SURFACE), {"window_size": 9}),
     "validate_surface": (SURFACE, {}), "hillshade": (SURFACE, {}), "lakes": (SURFACE, {"level": 0.0}),
+    "gls_dimension": (SURFACE, {}), "fractal_resample": (SURFACE, {"hurst": 0.7, "sigma": 1.0, "seed": 1}),
+    "tin_from_dem": (SURFACE, {"max_error": 0.5}), "delaunay": (POINTS, {}),
+    "grid_from_points": (POINTS, {"values": POINTS[:, 0] + POINTS[:, 1], "shape": (16, 16)}),
 }
 
 

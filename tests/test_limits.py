@@ -1,6 +1,5 @@
 """Memory guards and bounded threads: huge requests raise Python exceptions
 (never an abort), also under a lowered address-space limit."""
-import os
 import subprocess
 import sys
 import textwrap

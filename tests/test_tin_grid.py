@@ -84,7 +84,9 @@ def test_natural_is_smoother_than_linear(scattered):
     tr = (10.0, 0.1, 0.0, 40.0, 0.0, -0.1)
     gn = grid_from_points(p, v, (300, 300), tr, method="natural")
     gl = grid_from_points(p, v, (300, 300), tr, method="linear")
-    d2 = lambda g: np.abs(np.diff(g, 2, axis=1)).mean()
+    def d2(g):
+        return np.abs(np.diff(g, 2, axis=1)).mean()
+
     assert d2(gn) < d2(gl)
 
 

@@ -5,7 +5,6 @@ import numbers
 import os
 import warnings
 from dataclasses import dataclass
-from typing import Optional
 
 import numpy as np
 

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numbers
 from dataclasses import dataclass
-from typing import Optional, Tuple
+from typing import Tuple
 
 import numpy as np
 
@@ -146,6 +146,22 @@ class TIN:
     transform : tuple of float
         ``(a, b, c, d, e, f)``: pixel corner ``(col, row)`` maps to
         ``(a col + b row + c, d col + e row + f)`` (rasterio's ``Affine``).
+
+    References
+    ----------
+    Garland, M., Heckbert, P. S. (1995). Fast polygonal approximation of
+    terrains and height fields. Technical Report CMU-CS-95-181, Carnegie
+    Mellon University.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> i, j = np.indices((9, 9))
+    >>> tin = fg.tin_from_dem(0.5 * i + 0.25 * j, max_error=0.01)
+    >>> len(tin), tin.vertices.shape  # a plane needs only its four corners
+    (2, (4, 3))
+    >>> bool(np.allclose(tin.to_grid(), 0.5 * i + 0.25 * j))
+    True
     """
 
     vertices: np.ndarray
