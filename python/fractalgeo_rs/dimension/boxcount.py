@@ -45,7 +45,7 @@ __all__ = [
 ]
 
 
-def _lattice_fit(method, sizes, counts, offset_reduce, scale_range, x_label, y_label, extra) -> DimensionFit:
+def _lattice_fit(method, sizes, counts, offset_reduce, scale_range, x_label, y_label, extra, domain) -> DimensionFit:
     """Fit ``D = -slope`` to lattice counts combined over the shifted lattices."""
     return fit_loglog(
         sizes,
@@ -55,6 +55,7 @@ def _lattice_fit(method, sizes, counts, offset_reduce, scale_range, x_label, y_l
         x_label=x_label,
         y_label=y_label,
         extra={"counts": counts, "offset_reduce": offset_reduce, **extra},
+        domain=domain,
     )
 
 
@@ -174,6 +175,7 @@ def box_counting(
     return _lattice_fit(
         "box", s, counts, offset_reduce, scale_range, "box size s (samples)", "occupied boxes N(s)",
         {"n_foreground": int(n_fg), "bbox": (tuple(lo), tuple(hi)), "offsets": offsets, "anchor": anchor},
+        (0.0, float(b.ndim)),
     )
 
 
@@ -241,6 +243,7 @@ def box_counting_points(
     return _lattice_fit(
         "points", s, counts, offset_reduce, scale_range, "box size s", "occupied boxes N(s)",
         {"n_points": n, "offsets": offsets},
+        (0.0, float(pts.shape[1])),
     )
 
 
@@ -383,6 +386,7 @@ def differential_box_counting(
     return _lattice_fit(
         "dbc", s, counts, offset_reduce, scale_range, "box size s (pixels)", "box count N(s)",
         {"z_scale": z_unit, "z0": z0, "offsets": offsets, "edge_blocks": edge_blocks},
+        (2.0, 3.0),
     )
 
 
@@ -520,6 +524,7 @@ def self_affine_box_counting(
         s,
         covered,
         method="affine",
+        domain=(float(d), d + 1.0),
         dim_offset=d + 1.0,
         dim_factor=-1.0,
         scale_range=scale_range,

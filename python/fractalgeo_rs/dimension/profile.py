@@ -69,7 +69,7 @@ def higuchi(data, *, k_max: Optional[int] = None, nodata: Optional[float] = None
     ks = np.arange(1, k_max + 1)
     # Rust kernel: one streaming pass per k, k values in parallel
     L = _core.higuchi_lengths(np.ascontiguousarray(z, dtype=np.float64), k_max, check_n_threads(n_threads))
-    return fit_loglog(ks, L, method="higuchi", dim_offset=0.0, dim_factor=-1.0, scale_range=scale_range,
+    return fit_loglog(ks, L, method="higuchi", domain=(1.0, 2.0), dim_offset=0.0, dim_factor=-1.0, scale_range=scale_range,
                       x_label="interval k (samples)", y_label="curve length L(k)")
 
 
@@ -156,7 +156,7 @@ def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, sample_spacin
     if sig.size < 3 or sig[0] <= 0 or not np.isfinite(sig).all():
         raise ValueError(f"sigmas: need at least 3 distinct positive widths, got {sig.tolist()}")
     lengths = np.array([np.sum(np.hypot(dx, np.diff(g))) for g in _gaussian_bank(z, sig)])
-    return fit_loglog(sig, lengths, method="scale_space", dim_offset=1.0, dim_factor=-1.0,
+    return fit_loglog(sig, lengths, method="scale_space", domain=(1.0, 2.0), dim_offset=1.0, dim_factor=-1.0,
                       scale_range=scale_range, x_label="sigma (samples)", y_label="length L(sigma)",
                       extra={"sample_spacing": dx})
 
@@ -223,7 +223,8 @@ def wavelet_dimension(data, *, levels: Optional[Sequence[int]] = None, nodata: O
         raise ValueError(f"data: shape {z.shape} gives fewer than 3 wavelet levels with enough coefficients")
     var = np.array([np.mean(det[j - 1] ** 2) for j in sel])
     offset = 2.5 if z.ndim == 1 else 4.0
-    fit = fit_loglog(2.0 ** np.array(sel), var, method="wavelet", dim_offset=offset, dim_factor=-0.5,
+    fit = fit_loglog(2.0 ** np.array(sel), var, method="wavelet", domain=(float(z.ndim), z.ndim + 1.0),
+                     open_domain=True, dim_offset=offset, dim_factor=-0.5,
                      scale_range=scale_range, x_label="scale 2^j (samples)", y_label="detail variance")
     fit.extra["hurst"] = (fit.slope - z.ndim) / 2
     return fit
