@@ -170,11 +170,11 @@ def test_user_range_is_never_replaced():
     m = np.where(s < 16, s**2, 256 * (s / 16) ** 0.8)
     with pytest.warns(FractalRangeWarning, match="below"):
         fit = fit_loglog(s, m, method="t", dim_offset=2.0, dim_factor=-0.5, scale_range=(1, 8),
-                         domain=(1.0, 2.0), open_domain=True)
+                         domain=(1.0, 2.0), open_domain=True, restrict=True)
     assert fit.range_selection == "user" and not fit.valid
     # the message points at the fractal range found among the fitted scales
     with pytest.warns(FractalRangeWarning, match="fractal range"):
-        auto = fit_loglog(s, m, method="t", dim_offset=2.0, dim_factor=-0.5, domain=(1.0, 2.0), open_domain=True)
+        auto = fit_loglog(s, m, method="t", dim_offset=2.0, dim_factor=-0.5, domain=(1.0, 2.0), open_domain=True, restrict=True)
     assert auto.valid and auto.ranges[0].scale_range[1] == pytest.approx(16, rel=1e-6)
     assert auto.scale_range[0] == 32  # one octave beyond the break (BREAK_MARGIN)
     assert auto.dimension == pytest.approx(1.6, abs=1e-9)
@@ -186,7 +186,7 @@ def test_plot_shows_the_ranges(tmp_path):
     s = 2.0 ** np.arange(12)
     m = np.where(s < 16, s**2, 256 * (s / 16) ** 0.8)
     with pytest.warns(FractalRangeWarning):
-        fit = fit_loglog(s, m, method="t", dim_offset=2.0, dim_factor=-0.5, domain=(1.0, 2.0), open_domain=True)
+        fit = fit_loglog(s, m, method="t", dim_offset=2.0, dim_factor=-0.5, domain=(1.0, 2.0), open_domain=True, restrict=True)
     ax = fit.plot()
     labels = [str(line.get_label()) for line in ax.lines]
     assert any(lb.startswith("range 1..") and "(invalid)" in lb for lb in labels)
