@@ -37,9 +37,10 @@ from fractalgeo_rs._validation import (
     check_positive_int,
 )
 
+from fractalgeo_rs.transform._defaults import default_z_scale
 from fractalgeo_rs.transform.segment import segment
 
-__all__ = ["fractal_transform", "lacunarity_map", "segment", "TRANSFORM_METHODS"]
+__all__ = ["default_z_scale", "fractal_transform", "lacunarity_map", "segment", "TRANSFORM_METHODS"]
 
 TRANSFORM_METHODS = {
     # name: (power p, square increments); "mass", "dbc", "blanket" have their own kernels
@@ -137,7 +138,7 @@ def fractal_transform(
     lags: Sequence[int] = (1, 2),
     box_sizes: Optional[Sequence[int]] = None,
     epsilons: Optional[Sequence[int]] = None,
-    z_scale: float = 1.0,
+    z_scale: Union[float, str] = "auto",
     edge_blocks: str = "drop",
     step: int = 1,
     nodata: Optional[float] = None,
@@ -227,9 +228,13 @@ def fractal_transform(
     epsilons : sequence of int, optional
         ``"blanket"``: blanket thicknesses, at least three, default
         ``1, 2, 3, 4``.
-    z_scale : float, default 1
+    z_scale : float or "auto", default "auto"
         ``"mass"``, ``"dbc"``, ``"blanket"``: height units per pixel (e.g. 1
         grey level, 1 dB or 1 metre); the estimates depend on this unit.
+        ``"auto"``: :func:`default_z_scale` of the whole image, ``1.4826 *
+        median |lag-1 increment|`` (one typical step per box), recorded in
+        the xarray output's ``attrs["z_scale"]``; maps are comparable only
+        at equal ``z_scale``, so pass a fixed number across scenes.
     edge_blocks : {"drop", "count"}, default "drop"
         ``"dbc"``: leave out or count the partial blocks of the window's last
         row and column (counting them biases ``D`` low: a 33-pixel window has
@@ -294,7 +299,10 @@ def fractal_transform(
     check_choice(method, "method", tuple(TRANSFORM_METHODS))
     check_choice(edge_blocks, "edge_blocks", ("drop", "count"))
     nodata = check_nodata(nodata)
-    if method in ("mass", "dbc", "blanket"):
+    auto_z = isinstance(z_scale, str)
+    if auto_z and z_scale != "auto":
+        raise TypeError(f"z_scale: expected a positive number or 'auto', got {z_scale!r}")
+    if not auto_z and method in ("mass", "dbc", "blanket"):
         z_scale = check_positive_float(z_scale, "z_scale")
     n_threads = check_n_threads(n_threads)
     step = check_positive_int(step, "step")
@@ -332,6 +340,8 @@ def fractal_transform(
     if 0 in arr.shape:
         raise ValueError(f"image: array is empty (shape {arr.shape})")
     w = _check_window(window_size, arr.shape)
+    if auto_z:
+        z_scale = default_z_scale(arr, nodata) if method in ("mass", "dbc", "blanket") else None
     opts = {"lags": lags, "z_scale": z_scale}
     half = w // 2
     if method == "mass":
@@ -407,7 +417,14 @@ def fractal_transform(
         out = (d, r2) if return_fit else d
     if xr_obj is not None:
         grid = xr_obj.isel({xr_obj.dims[0]: slice(None, None, step), xr_obj.dims[1]: slice(None, None, step)})
-        wrap = lambda a: grid.copy(data=a).astype(np.float32).rename("fractal_dimension")  # noqa: E731
+        attrs = {"fractal_method": method, "window_size": w}
+        if z_scale is not None and method in ("mass", "dbc", "blanket"):
+            attrs["z_scale"] = float(z_scale)
+
+        def wrap(a):
+            out = grid.copy(data=a).astype(np.float32).rename("fractal_dimension")
+            out.attrs.update(attrs)
+            return out
         out = tuple(wrap(a) for a in out) if return_fit else wrap(out)
     return out
 
