@@ -70,7 +70,7 @@ def default_z_scale(image, nodata: Optional[float] = None) -> float:
     >>> from fractalgeo_rs.transform import default_z_scale
     >>> i, j = np.indices((50, 50))
     >>> round(default_z_scale(3.0 * i + 4.0 * j), 4)  # median of |3| and |4| steps
-    5.189
+    5.1891
     """
     shape = image.shape
     if len(shape) != 2:
