@@ -81,3 +81,15 @@ def test_power_variation_method_is_the_key():
     assert fit.method == "variation"
     assert fg.dimension(PROFILE, method="variation", p=1.5, order=2).dimension == fit.dimension
     assert fg.surface_variation(SURFACE, estimator="transect").method == "surface_variation"
+
+
+def test_box_counting_default_sizes_on_an_uneven_extent():
+    # a Sierpinski triangle cropped to 1000 x 1000: the extent's divisors
+    # (8, 20, 40, 100, 200) jump unevenly; the default counts on powers of 2
+    i, j = np.indices((1024, 1024))
+    fit = fg.box_counting(((i & j) == 0)[:1000, :1000])
+    assert fit.scales.tolist() == [1, 2, 4, 8, 16, 32, 64, 128]
+    assert abs(fit.dimension - np.log2(3)) < 0.01
+    # an even divisor chain is kept (filled cube of side 60: 1, 2, 3, 5, 10, 15)
+    cube = fg.box_counting(np.ones((60, 60, 60), bool))
+    assert cube.scales.tolist() == [1, 2, 3, 5, 10, 15] and cube.dimension == pytest.approx(3.0)

@@ -59,6 +59,52 @@ def _lattice_fit(method, sizes, counts, offset_reduce, scale_range, x_label, y_l
     )
 
 
+def _uneven(sizes) -> bool:
+    """Consecutive ratios of ``sizes`` neither all equal nor all <= 2."""
+    r = np.asarray(sizes, dtype=float)
+    if r.size < 3:
+        return False
+    q = r[1:] / r[:-1]
+    return not (np.allclose(q, q[0]) or np.all(q <= 2.0 + 1e-12))
+
+
+def _default_box_sizes(b: np.ndarray, bbox: bool) -> Optional[list]:
+    """Powers of 2 or of 3 up to a quarter of the set's extent (at least 3
+    sizes), the base whose powers come closest to the extent in log scale:
+    an exact fractal of side b^L, cropped, offset or padded, is then counted
+    on boxes of its own base (a carpet of side 729 on 1, 3, 9, ...; a
+    triangle cropped to 1000 on 1, 2, 4, ...). ``None`` leaves the choice to
+    the kernel (empty set, extent under 4)."""
+    if bbox:
+        ext = 0
+        for ax in range(b.ndim):
+            occ = np.flatnonzero(b.any(axis=tuple(a for a in range(b.ndim) if a != ax)))
+            if occ.size == 0:
+                return None
+            ext = max(ext, int(occ[-1] - occ[0] + 1))
+    else:
+        ext = max(b.shape)
+    if ext < 4:
+        return None
+
+    def powers(base):
+        out, v = [], 1
+        while v <= ext / 4:
+            out.append(v)
+            v *= base
+        return out
+
+    def misfit(base):
+        x = math.log(ext, base)
+        return abs(x - round(x)) * math.log(base)  # distance in natural-log units
+
+    best = min((2, 3), key=misfit)
+    sizes = powers(best)
+    if len(sizes) < 3:
+        sizes = powers(2)
+    return sizes if len(sizes) >= 3 else None
+
+
 def _binary_bytes(data) -> Tuple[np.ndarray, bool]:
     """A C-contiguous uint8 view (0/1) of a binary set, and whether the axes
     were reversed (a Fortran-ordered input is counted through its transpose,
@@ -118,7 +164,11 @@ def box_counting(
     box_sizes : sequence of int, optional
         Box sides in samples; any positive integers (not only powers of two),
         at least three distinct, none larger than the longest axis. Default:
-        ``1, 2, 4, ...`` up to a quarter of the set's largest extent.
+        the divisors of the set's extent when they form an even chain (all
+        ratios equal, or all at most 2), else powers of 2 or of 3 (the base
+        whose powers come closest to the extent) up to a quarter of the
+        extent; ``docs/boxcounting.md`` has the error table on cropped,
+        offset and padded exact fractals.
     offsets : int, default 1
         Number of lattice shifts per axis (``offsets**ndim`` lattices). The
         shifts ``j * s_max / offsets`` are global (the same for every box
@@ -170,6 +220,13 @@ def box_counting(
     check_choice(anchor, "anchor", ("bbox", "array"))
     n_threads = check_n_threads(n_threads)
     s, counts, n_fg, lo, hi = _core.box_count_binary(b, sizes or [], offsets, anchor == "bbox", n_threads)
+    if sizes is None and _uneven(s):
+        # the kernel's default (divisors of the extent, else powers of 2)
+        # jumps unevenly on extents such as 1000 (8, 20, 40, 100): count
+        # again on powers of the base closest to the extent
+        alt = _default_box_sizes(b, anchor == "bbox")
+        if alt is not None:
+            s, counts, n_fg, lo, hi = _core.box_count_binary(b, alt, offsets, anchor == "bbox", n_threads)
     if transposed:
         lo, hi = lo[::-1], hi[::-1]
     return _lattice_fit(
