@@ -161,7 +161,7 @@ def numpy_mass_windows_rows(z: np.ndarray, w: int, rows: int) -> float:
             win = np.lib.stride_tricks.sliding_window_view(a[i - h: i + h + 1], (w, w))
             y.append(np.log(win.mean(axis=(-2, -1))[0]))
         y = np.array(y)
-        slope = ((x - x.mean())[:, None] * (y - y.mean(axis=0))).sum(0) / ((x - x.mean()) ** 2).sum()
+        _slope = ((x - x.mean())[:, None] * (y - y.mean(axis=0))).sum(0) / ((x - x.mean()) ** 2).sum()
     return time.perf_counter() - t0
 
 

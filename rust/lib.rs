@@ -15,7 +15,10 @@
 //! | [`lsystem`] | L-systems, turtle geometry and IFS |
 //! | [`transform`] | moving-window maps of local dimension |
 
+#![warn(clippy::undocumented_unsafe_blocks)]
+
 pub mod buffers;
+pub mod checks;
 pub mod dem;
 pub mod dimension;
 pub mod error;

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from fractalgeo_rs.lsystem import (LSystem, Mesh, plant_mesh, plants_on_terrain, turtle_2d, turtle_3d, write_obj,
-                                   write_ply, write_png, write_svg)
+                                   write_png, write_svg)
 from fractalgeo_rs.lsystem import _cli
 
 BUSH = {

@@ -4,7 +4,6 @@ import math
 import numpy as np
 import pytest
 
-import fractalgeo_rs as fg
 from fractalgeo_rs.synth import expected_relief_std, synthetic_dem
 
 

@@ -520,3 +520,38 @@ def test_new_methods_plane_and_roughness():
     rough = fg.fractal_transform(spectral_surface(128, 0.2, 1) * 30, 17, method="dbc", z_scale=1.0)
     smooth = fg.fractal_transform(spectral_surface(128, 0.8, 1) * 30, 17, method="dbc", z_scale=1.0)
     assert np.nanmean(rough) > np.nanmean(smooth) + 0.1
+
+
+def test_lacunarity_map_on_dask_and_xarray_equals_in_memory():
+    """The backend dispatcher gives lacunarity_map the Dask and xarray paths
+    of the dimension maps: same values for any chunking (NaN halo = the
+    in-memory edge policy), coords and attrs kept."""
+    da = pytest.importorskip("dask.array")
+    xr = pytest.importorskip("xarray")
+    rng = np.random.default_rng(3)
+    img = rng.gamma(2.0, size=(70, 53))
+    img[10:14, 20:30] = np.nan
+    ref = fg.lacunarity_map(img, 9, [1, 2, 4])
+    for chunks in [(70, 53), (20, 17), (5, 40)]:
+        got = fg.lacunarity_map(da.from_array(img, chunks=chunks), 9, [1, 2, 4]).compute()
+        np.testing.assert_allclose(got, ref, rtol=1e-5, atol=1e-6, equal_nan=True)
+    x = xr.DataArray(img, dims=("y", "x"), coords={"y": np.arange(70) * -10.0, "x": np.arange(53) * 10.0},
+                     attrs={"units": "linear"})
+    out = fg.lacunarity_map(x, 9, [1, 2, 4])
+    assert out.dims == ("box_size", "y", "x")
+    assert list(out.box_size.values) == [1, 2, 4]
+    np.testing.assert_array_equal(out.x.values, x.x.values)
+    assert out.attrs["units"] == "linear"
+    np.testing.assert_allclose(out.values, ref, equal_nan=True)
+
+
+def test_transform_xarray_outputs_named_and_keep_attrs():
+    xr = pytest.importorskip("xarray")
+    z = spectral_surface(64, 0.5, seed=2)
+    x = xr.DataArray(z, dims=("y", "x"), coords={"y": np.arange(64.0), "x": np.arange(64.0)},
+                     attrs={"crs": "EPSG:32611"})
+    d, r2 = fg.fractal_transform(x, 9, method="variogram", step=2, return_fit=True)
+    assert d.name == "fractal_dimension" and r2.name == "r_squared"
+    assert d.attrs["crs"] == "EPSG:32611"
+    np.testing.assert_array_equal(d.y.values, np.arange(0.0, 64.0, 2.0))
+    np.testing.assert_allclose(d.values, fg.fractal_transform(z, 9, method="variogram", step=2))

@@ -39,8 +39,31 @@ BREAK_MARGIN = 2.0
 class FractalRangeWarning(UserWarning):
     """A dimension outside its valid domain, pinned at a bound of a search,
     or fitted on part of the scales only (the data are not fractal over the
-    whole range). The message names the cause and the remedy; the fit object
-    carries the same text in ``warning`` and the cause in ``flags``."""
+    whole range).
+
+    The message names the cause and the remedy; the fit object carries the
+    same text in ``warning`` and the cause in ``flags``.
+
+    Attributes
+    ----------
+    args : tuple of str
+        The message.
+
+    References
+    ----------
+    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
+    dimension: assessing the roughness of time series and spatial data,
+    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+
+    Examples
+    --------
+    >>> import warnings, numpy as np, fractalgeo_rs as fg
+    >>> with warnings.catch_warnings(record=True) as rec:
+    ...     warnings.simplefilter("always")
+    ...     fit = fg.variogram(np.arange(100.0))  # a line: H = 1, smooth
+    >>> fit.valid, fit.flags, rec[0].category.__name__
+    (False, ('below_domain',), 'FractalRangeWarning')
+    """
 
 
 @dataclass(frozen=True)
@@ -137,6 +160,26 @@ class DimensionFit:
         within 0.025, ``tests/test_scales.py``).
     domain : tuple of float or None
         Valid interval of ``dimension`` (``None``: not checked).
+
+    References
+    ----------
+    K. Falconer, *Fractal Geometry: Mathematical Foundations and
+    Applications*, Wiley, 1990.
+
+    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
+    dimension: assessing the roughness of time series and spatial data,
+    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> fit = fg.box_counting(np.ones((64, 64), dtype=bool))  # a filled square: D = 2
+    >>> round(fit.dimension, 6), round(fit.r_squared, 6)
+    (2.0, 1.0)
+    >>> fit.scales.tolist()
+    [1.0, 2.0, 4.0, 8.0, 16.0]
+    >>> fit.measures.tolist()
+    [4096.0, 1024.0, 256.0, 64.0, 16.0]
     """
 
     dimension: float

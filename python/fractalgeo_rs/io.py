@@ -61,6 +61,11 @@ def read_raster(path, band: int = 1) -> Tuple[np.ndarray, Optional[dict]]:
         for files read through rasterio, else ``None``. Nodata values are
         returned as stored: mask them with ``profile["nodata"]``.
 
+    References
+    ----------
+    GDAL/OGR contributors, *GDAL/OGR Geospatial Data Abstraction software
+    Library*, Open Source Geospatial Foundation, doi:10.5281/zenodo.5884351.
+
     Examples
     --------
     >>> import numpy as np, os, tempfile, fractalgeo_rs as fg
@@ -129,6 +134,27 @@ def write_raster(path, data, *, profile: Optional[dict] = None, crs=None, transf
         size, count and dtype follow ``data``.
     crs, transform, nodata
         GeoTIFF only: override the profile's (``transform`` an ``Affine``).
+
+    Returns
+    -------
+    None
+        The file is written next to its final name and renamed into place, so a
+        reader never sees a partial file.
+
+    References
+    ----------
+    GDAL/OGR contributors, *GDAL/OGR Geospatial Data Abstraction software
+    Library*, Open Source Geospatial Foundation, doi:10.5281/zenodo.5884351.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> path = os.path.join(tempfile.mkdtemp(), 'heights.npy')
+    >>> fg.write_raster(path, np.arange(6.0).reshape(2, 3))
+    >>> z, profile = fg.read_raster(path)
+    >>> z.tolist(), profile
+    ([[0.0, 1.0, 2.0], [3.0, 4.0, 5.0]], None)
     """
     a = as_array(data, "data")
     p = os.fspath(path)

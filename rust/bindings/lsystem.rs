@@ -2,6 +2,7 @@
 //! and plants on terrain. The documented API is `fractalgeo_rs.lsystem`.
 //! Every kernel runs through `run_in_pool`, so even a bug (a panic) comes
 //! back as RuntimeError, never as a PanicException.
+use super::convert::{array2, c_order, rows_in, run};
 use crate::lsystem::derive::LSystem;
 use crate::lsystem::grammar::{parse_module_string, parse_rule_text, ModString};
 use crate::lsystem::mesh::{build_mesh, Mesh};
@@ -11,9 +12,7 @@ use crate::lsystem::{export, ifs};
 use crate::parallel::run_in_pool;
 use glam::DVec3;
 use numpy::ndarray::{Array1, Array2};
-use numpy::{
-    IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods,
-};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use std::path::PathBuf;
@@ -50,8 +49,7 @@ fn turtle_params(t: TurtleArgs) -> TurtleParams {
 }
 
 fn rows<T: Copy, const N: usize>(v: Vec<[T; N]>) -> Array2<T> {
-    let n = v.len();
-    Array2::from_shape_vec((n, N), v.into_flattened()).expect("rectangular rows")
+    Array2::from_shape_fn((v.len(), N), |(i, k)| v[i][k])
 }
 
 fn flat_polys<const N: usize>(polys: Vec<Vec<[f64; N]>>) -> (Array2<f64>, Array1<u64>) {
@@ -104,7 +102,7 @@ impl LSystemCore {
     ) -> PyResult<ModuleString> {
         let l = self.inner.clone();
         let seed = seed.unwrap_or(l.seed);
-        let s = py.detach(|| run_in_pool(n_threads, || l.derive_with_seed(n, seed)))?;
+        let s = run(py, n_threads, || l.derive_with_seed(n, seed))?;
         Ok(ModuleString { inner: Arc::new(s) })
     }
 
@@ -193,7 +191,7 @@ fn turtle_polylines<'py>(
 )> {
     let s = lstring.inner.clone();
     let p = turtle_params(turtle);
-    let r = py.detach(|| run_in_pool(Some(1), || polylines(&s, &p)))?;
+    let r = run(py, Some(1), || polylines(&s, &p))?;
     let off: Vec<u64> = r.offsets.iter().map(|&v| v as u64).collect();
     let (pp, po) = flat_polys(r.polygons);
     Ok((
@@ -222,7 +220,7 @@ fn turtle_segments<'py>(
 )> {
     let s = lstring.inner.clone();
     let p = turtle_params(turtle);
-    let r = py.detach(|| run_in_pool(Some(1), || segments(&s, &p)))?;
+    let r = run(py, Some(1), || segments(&s, &p))?;
     let (pp, po) = flat_polys(r.polygons);
     Ok((
         rows(r.starts).into_pyarray(py),
@@ -270,25 +268,8 @@ fn turtle_mesh<'py>(
 ) -> PyResult<MeshArrays<'py>> {
     let s = lstring.inner.clone();
     let p = turtle_params(turtle);
-    let m = py.detach(|| run_in_pool(n_threads, || build_mesh(&s, &p, sides)))?;
+    let m = run(py, n_threads, || build_mesh(&s, &p, sides))?;
     Ok(mesh_arrays(py, m))
-}
-
-fn to_rows<T: numpy::Element + Copy, const N: usize>(
-    a: &PyReadonlyArray2<'_, T>,
-    name: &str,
-) -> PyResult<Vec<[T; N]>> {
-    let v = a.as_array();
-    if v.ncols() != N {
-        return Err(PyValueError::new_err(format!(
-            "{name}: expected shape (n, {N}), got {:?}",
-            a.shape()
-        )));
-    }
-    Ok(v.rows()
-        .into_iter()
-        .map(|r| std::array::from_fn(|k| r[k]))
-        .collect())
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -303,10 +284,10 @@ fn mesh_from_arrays(
     instances: PyReadonlyArray1<'_, u32>,
 ) -> PyResult<Mesh> {
     Ok(Mesh {
-        vertices: to_rows(&vertices, "vertices")?,
-        normals: to_rows(&normals, "normals")?,
-        uvs: to_rows(&uvs, "uvs")?,
-        faces: to_rows(&faces, "faces")?,
+        vertices: rows_in(&vertices, "vertices")?,
+        normals: rows_in(&normals, "normals")?,
+        uvs: rows_in(&uvs, "uvs")?,
+        faces: rows_in(&faces, "faces")?,
         part_ids: part_ids.as_array().to_vec(),
         kinds: kinds.as_array().to_vec(),
         colors: colors.as_array().to_vec(),
@@ -335,8 +316,8 @@ fn write_mesh(
         vertices, normals, uvs, faces, part_ids, kinds, colors, instances,
     )?;
     match format {
-        "obj" => py.detach(|| run_in_pool(Some(1), || export::write_obj(&m, &path)))?,
-        "ply" => py.detach(|| run_in_pool(Some(1), || export::write_ply(&m, &path)))?,
+        "obj" => run(py, Some(1), || export::write_obj(&m, &path))?,
+        "ply" => run(py, Some(1), || export::write_ply(&m, &path))?,
         _ => {
             return Err(PyValueError::new_err(format!(
                 "format: expected 'obj' or 'ply', got {format:?}"
@@ -364,8 +345,8 @@ fn plants_on_terrain<'py>(
     sides: usize,
     n_threads: Option<usize>,
 ) -> PyResult<(MeshArrays<'py>, Bound<'py, PyArray2<f64>>)> {
-    let (r, c) = (dem.shape()[0], dem.shape()[1]);
-    let z: Vec<f64> = dem.as_array().iter().copied().collect();
+    let z = c_order(&dem);
+    let (r, c) = z.rows_cols();
     let l = lsystem.inner.clone();
     let p = SceneParams {
         n,
@@ -377,7 +358,7 @@ fn plants_on_terrain<'py>(
         scale,
         max_plants,
     };
-    let (m, bases) = py.detach(|| run_in_pool(n_threads, || scene_kernel(&l, &z, r, c, &p)))?;
+    let (m, bases) = run(py, n_threads, || scene_kernel(&l, &z.data, r, c, &p))?;
     Ok((mesh_arrays(py, m), rows(bases).into_pyarray(py)))
 }
 
@@ -385,7 +366,7 @@ fn ifs_from(
     maps: &PyReadonlyArray2<'_, f64>,
     probabilities: Option<Vec<f64>>,
 ) -> PyResult<ifs::Ifs> {
-    let rows_: Vec<[f64; 6]> = to_rows(maps, "maps")?;
+    let rows_: Vec<[f64; 6]> = rows_in(maps, "maps")?;
     Ok(run_in_pool(Some(1), || {
         ifs::Ifs::new(&rows_, probabilities.as_deref())
     })?)
@@ -443,7 +424,7 @@ fn ifs_chaos_game<'py>(
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let f = ifs_from(&maps, probabilities)?;
-    let pts = py.detach(|| run_in_pool(n_threads, || f.chaos_game(n_points, seed)))?;
+    let pts = run(py, n_threads, || f.chaos_game(n_points, seed))?;
     Ok(rows(pts).into_pyarray(py))
 }
 
@@ -458,7 +439,7 @@ fn ifs_iterate<'py>(
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let f = ifs_from(&maps, None)?;
-    let pts = py.detach(|| run_in_pool(n_threads, || f.iterate(depth, max_points)))?;
+    let pts = run(py, n_threads, || f.iterate(depth, max_points))?;
     Ok(rows(pts).into_pyarray(py))
 }
 
@@ -472,11 +453,10 @@ fn ifs_rasterize<'py>(
     n_cols: usize,
     bounds: Option<[f64; 4]>,
 ) -> PyResult<(Bound<'py, PyArray2<u8>>, [f64; 4])> {
-    let pts: Vec<[f64; 2]> = to_rows(&points, "points")?;
+    let pts: Vec<[f64; 2]> = rows_in(&points, "points")?;
     let b = bounds.unwrap_or_else(|| ifs::bounds(&pts));
-    let img = py.detach(|| run_in_pool(Some(1), || ifs::rasterize(&pts, n_rows, n_cols, b)))?;
-    let a = Array2::from_shape_vec((n_rows, n_cols), img).expect("raster shape");
-    Ok((a.into_pyarray(py), b))
+    let img = run(py, Some(1), || ifs::rasterize(&pts, n_rows, n_cols, b))?;
+    Ok((array2(py, (n_rows, n_cols), img)?, b))
 }
 
 /// Root of Moran's equation sum r_i^s = 1.

@@ -6,6 +6,8 @@ use crate::error::CoreError;
 use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 
+pub mod convert;
+mod dem;
 mod dimension;
 mod io;
 mod lsystem;
@@ -25,6 +27,7 @@ impl From<CoreError> for PyErr {
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    dem::register(m)?;
     dimension::register(m)?;
     io::register(m)?;
     synth::register(m)?;

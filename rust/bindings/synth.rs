@@ -1,18 +1,12 @@
-//! Bindings of `crate::synth` and `crate::dem`.
-use crate::dem::hillshade::{self, ShadeParams};
-use crate::io::exr_io;
-use crate::parallel::run_in_pool;
+//! Bindings of `crate::synth`.
+use super::convert::{array1, c_order, run};
 use crate::synth::additions::{self, AdditionsParams};
 use crate::synth::davies_harte;
 use crate::synth::midpoint::{self, RefineParams};
 use crate::synth::rng;
 use crate::synth::spectral;
-use numpy::ndarray::Array2;
-use numpy::PyUntypedArrayMethods;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use std::path::PathBuf;
 
 /// `n` standard normals of stream `(seed, stream)` at indices `start ..`.
 #[pyfunction]
@@ -25,12 +19,10 @@ fn normal_noise<'py>(
     start: u64,
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let v = py.detach(|| {
-        run_in_pool(n_threads, || {
-            let mut v = vec![0.0; n];
-            rng::fill_normal(&mut v, seed, stream, start);
-            Ok(v)
-        })
+    let v = run(py, n_threads, || {
+        let mut v = vec![0.0; n];
+        rng::fill_normal(&mut v, seed, stream, start);
+        Ok(v)
     })?;
     Ok(v.into_pyarray(py))
 }
@@ -85,7 +77,7 @@ fn midpoint_refine_1d<'py>(
         seed,
         first_level,
     );
-    let v = py.detach(|| run_in_pool(n_threads, || midpoint::refine_1d_levels(&c, levels, &p)))?;
+    let v = run(py, n_threads, || midpoint::refine_1d_levels(&c, levels, &p))?;
     Ok(v.into_pyarray(py))
 }
 
@@ -117,7 +109,7 @@ fn midpoint_refine_2d<'py>(
         seed,
         first_level,
     );
-    let v = py.detach(|| run_in_pool(n_threads, || midpoint::refine_2d_levels(c, levels, &p)))?;
+    let v = run(py, n_threads, || midpoint::refine_2d_levels(c, levels, &p))?;
     Ok(v.into_pyarray(py))
 }
 
@@ -156,10 +148,8 @@ fn additions_refine_2d<'py>(
         origin: (0, 0),
         global_cols: 0,
     };
-    let v = py.detach(|| {
-        run_in_pool(n_threads, || {
-            additions::refine_2d_levels_window(c, levels, &p, shape)
-        })
+    let v = run(py, n_threads, || {
+        additions::refine_2d_levels_window(c, levels, &p, shape)
     })?;
     Ok(v.into_pyarray(py))
 }
@@ -173,8 +163,9 @@ fn fgn_sqrt_eigenvalues<'py>(
     hurst: f64,
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let v =
-        py.detach(|| run_in_pool(n_threads, || davies_harte::fgn_sqrt_eigenvalues(m, hurst)))?;
+    let v = run(py, n_threads, || {
+        davies_harte::fgn_sqrt_eigenvalues(m, hurst)
+    })?;
     Ok(v.into_pyarray(py))
 }
 
@@ -190,7 +181,7 @@ fn spectral_filter_2d<'py>(
     hurst: f64,
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let v = py.detach(|| run_in_pool(n_threads, || spectral::filter_2d(n0, n1, hurst)))?;
+    let v = run(py, n_threads, || spectral::filter_2d(n0, n1, hurst))?;
     Ok(v.into_pyarray(py))
 }
 
@@ -205,91 +196,14 @@ fn davies_harte_fbm<'py>(
     stream: u64,
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let s = sqrt_eig.as_array();
-    let owned;
-    let sl: &[f64] = match s.as_slice() {
-        Some(x) => x,
-        None => {
-            owned = s.to_vec();
-            &owned
-        }
-    };
-    let v = py.detach(|| {
-        run_in_pool(n_threads, || {
-            davies_harte::fbm_from_eigenvalues(sl, n, seed, stream)
-        })
+    let s = c_order(&sqrt_eig);
+    let v = run(py, n_threads, || {
+        davies_harte::fbm_from_eigenvalues(&s.data, n, seed, stream)
     })?;
-    Ok(v.into_pyarray(py))
-}
-
-/// Hillshade in [0, 1] (NaN = nodata); `dx` per row, `dy` scalar.
-#[pyfunction]
-#[pyo3(signature = (dem, dx, dy, azimuth, altitude, z_factor, multidirectional, n_threads=None))]
-#[allow(clippy::too_many_arguments)]
-fn hillshade_f64<'py>(
-    py: Python<'py>,
-    dem: PyReadonlyArray2<'py, f64>,
-    dx: Vec<f64>,
-    dy: f64,
-    azimuth: f64,
-    altitude: f64,
-    z_factor: f64,
-    multidirectional: bool,
-    n_threads: Option<usize>,
-) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    let z = dem.as_array();
-    let p = ShadeParams {
-        azimuth,
-        altitude,
-        z_factor,
-        multidirectional,
-    };
-    let v = py.detach(|| run_in_pool(n_threads, || hillshade::hillshade(z, &dx, dy, &p)))?;
-    Ok(v.into_pyarray(py))
-}
-
-/// GDAL's byte encoding of a reflectance array: round(1 + 254 L), 0 for NaN.
-#[pyfunction]
-#[pyo3(signature = (shade, n_threads=None))]
-fn shade_to_byte<'py>(
-    py: Python<'py>,
-    shade: PyReadonlyArray2<'py, f32>,
-    n_threads: Option<usize>,
-) -> PyResult<Bound<'py, PyArray2<u8>>> {
-    let a = shade.as_array();
-    let dim = a.dim();
-    let std = a.as_standard_layout();
-    let v = std
-        .as_slice()
-        .ok_or_else(|| PyValueError::new_err("shade: internal: not contiguous"))?;
-    let b = py.detach(|| run_in_pool(n_threads, || Ok(hillshade::to_byte(v))))?;
-    let arr =
-        Array2::from_shape_vec(dim, b).map_err(|_| PyValueError::new_err("internal: shape"))?;
-    Ok(arr.into_pyarray(py))
-}
-
-/// Read the "Y" (or only) channel of a float EXR as a 2D float32 array.
-#[pyfunction]
-fn read_exr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    let (v, rows, cols) = py.detach(|| exr_io::read_exr_gray(&path))?;
-    let a = Array2::from_shape_vec((rows, cols), v)
-        .map_err(|_| PyValueError::new_err("internal: EXR pixel count does not match its size"))?;
-    Ok(a.into_pyarray(py))
-}
-
-/// Write a 2D float32 array as a single-channel ("Y") float EXR, atomically.
-#[pyfunction]
-fn write_exr(py: Python<'_>, path: PathBuf, image: PyReadonlyArray2<'_, f32>) -> PyResult<()> {
-    let (rows, cols) = (image.shape()[0], image.shape()[1]);
-    let v: Vec<f32> = image.as_array().iter().copied().collect();
-    py.detach(|| exr_io::write_exr_gray(&path, v, rows, cols))?;
-    Ok(())
+    Ok(array1(py, v))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(read_exr, m)?)?;
-    m.add_function(wrap_pyfunction!(shade_to_byte, m)?)?;
-    m.add_function(wrap_pyfunction!(write_exr, m)?)?;
     m.add_function(wrap_pyfunction!(normal_noise, m)?)?;
     m.add_function(wrap_pyfunction!(midpoint_refine_1d, m)?)?;
     m.add_function(wrap_pyfunction!(midpoint_refine_2d, m)?)?;
@@ -297,6 +211,5 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fgn_sqrt_eigenvalues, m)?)?;
     m.add_function(wrap_pyfunction!(davies_harte_fbm, m)?)?;
     m.add_function(wrap_pyfunction!(spectral_filter_2d, m)?)?;
-    m.add_function(wrap_pyfunction!(hillshade_f64, m)?)?;
     Ok(())
 }

@@ -1,67 +1,39 @@
 //! Bindings of `crate::transform`.
-use crate::parallel::run_in_pool;
+use super::convert::{array1, array2, array3, c_order, run, FloatArray2};
 use crate::transform::blanket::{blanket_areas, blanket_transform, BlanketMapOptions};
 use crate::transform::dbc::{dbc_transform, DbcMapOptions, LocalMap};
 use crate::transform::lacunarity::lacunarity_transform;
 use crate::transform::mass::{mass_curve, mass_transform, MassOptions};
 use crate::transform::variation::{variation_transform, Increments, VariationOptions};
-use numpy::ndarray::Array2;
-use numpy::ndarray::Array3;
-use numpy::PyArray3;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use crate::with_float;
+use numpy::{PyArray1, PyArray2, PyArray3, PyReadonlyArray2};
 use pyo3::prelude::*;
 
-/// Run `f` on the pixels of a C-contiguous image with the GIL released, in a
-/// pool of `n_threads`; returns `(result, rows, cols)`.
-fn run_on_image<T: numpy::Element + Sync, R: Send>(
-    py: Python<'_>,
-    a: &PyReadonlyArray2<'_, T>,
-    n_threads: Option<usize>,
-    f: impl FnOnce(&[T], usize, usize) -> crate::error::CoreResult<R> + Send,
-) -> PyResult<(R, usize, usize)> {
-    let (rows, cols) = (a.shape()[0], a.shape()[1]);
-    let z = a
-        .as_slice()
-        .map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
-    let r = py.detach(|| run_in_pool(n_threads, || f(z, rows, cols)))?;
-    Ok((r, rows, cols))
-}
-
-/// Run a map kernel on a 2D float32 or float64 image, read in place (no
-/// float64 copy of a float32 scene); evaluates to `(result, rows, cols)`.
-macro_rules! on_float_image {
-    ($py:expr, $image:expr, $n_threads:expr, |$z:ident, $rows:ident, $cols:ident| $body:expr) => {{
-        if let Ok(a) = $image.extract::<PyReadonlyArray2<'_, f32>>() {
-            run_on_image($py, &a, $n_threads, |$z, $rows, $cols| $body)?
-        } else if let Ok(a) = $image.extract::<PyReadonlyArray2<'_, f64>>() {
-            run_on_image($py, &a, $n_threads, |$z, $rows, $cols| $body)?
-        } else {
-            return Err(PyTypeError::new_err(
-                "image: expected a 2D float32 or float64 array",
-            ));
-        }
-    }};
-}
+type MapPair<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>);
 
 /// The (dimension, r²) pair of a map on the grid of every `step`-th pixel.
 fn step_maps<'py>(
     py: Python<'py>,
     (d, r2): (Vec<f32>, Vec<f32>),
-    rows: usize,
-    cols: usize,
+    (rows, cols): (usize, usize),
     step: usize,
 ) -> PyResult<MapPair<'py>> {
     let shape = (rows.div_ceil(step.max(1)), cols.div_ceil(step.max(1)));
-    let bad = |_| PyValueError::new_err("internal: map size");
-    Ok((
-        Array2::from_shape_vec(shape, d)
-            .map_err(bad)?
-            .into_pyarray(py),
-        Array2::from_shape_vec(shape, r2)
-            .map_err(bad)?
-            .into_pyarray(py),
-    ))
+    Ok((array2(py, shape, d)?, array2(py, shape, r2)?))
+}
+
+/// Run `kernel(z, rows, cols)` on a 2D float32 or float64 image, read in
+/// place (no float64 copy of a float32 scene); evaluates to
+/// `(result, (rows, cols))`.
+macro_rules! on_float_image {
+    ($py:expr, $image:expr, $n_threads:expr, $kernel:path, $opt:expr) => {
+        with_float!(FloatArray2::extract($image, "image")?, |a| {
+            let z = c_order(&a);
+            let (rows, cols) = z.rows_cols();
+            let r = run($py, $n_threads, || $kernel(&z.data, rows, cols, $opt))?;
+            (r, (rows, cols))
+        })
+    };
 }
 
 /// Moving-window increment estimator on a float32 or float64 image.
@@ -92,10 +64,8 @@ fn variation_transform_map<'py>(
         min_valid,
         step,
     };
-    let (maps, rows, cols) = on_float_image!(py, image, n_threads, |z, rows, cols| {
-        variation_transform(z, rows, cols, &opt)
-    });
-    step_maps(py, maps, rows, cols, step)
+    let (maps, shape) = on_float_image!(py, image, n_threads, variation_transform, &opt);
+    step_maps(py, maps, shape, step)
 }
 
 /// Moving-window P(m, L) mass dimension on a float32 or float64 image.
@@ -120,24 +90,13 @@ fn mass_transform_map<'py>(
         min_valid,
         step,
     };
-    let (maps, rows, cols) = on_float_image!(py, image, n_threads, |z, rows, cols| {
-        mass_transform(z, rows, cols, &opt)
-    });
-    step_maps(py, maps, rows, cols, step)
+    let (maps, shape) = on_float_image!(py, image, n_threads, mass_transform, &opt);
+    step_maps(py, maps, shape, step)
 }
 
-type MapPair<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>);
-
 fn local_map_arrays(py: Python<'_>, m: LocalMap) -> PyResult<MapPair<'_>> {
-    let bad = |_| PyValueError::new_err("internal: map size");
-    Ok((
-        Array2::from_shape_vec((m.rows, m.cols), m.dim)
-            .map_err(bad)?
-            .into_pyarray(py),
-        Array2::from_shape_vec((m.rows, m.cols), m.r2)
-            .map_err(bad)?
-            .into_pyarray(py),
-    ))
+    let shape = (m.rows, m.cols);
+    Ok((array2(py, shape, m.dim)?, array2(py, shape, m.r2)?))
 }
 
 /// Moving-window differential box counting on the grid of every `step`-th
@@ -157,10 +116,9 @@ fn dbc_transform_map<'py>(
     step: usize,
     n_threads: Option<usize>,
 ) -> PyResult<MapPair<'py>> {
-    let (rows, cols) = (image.shape()[0], image.shape()[1]);
-    let z = image
-        .as_slice()
-        .map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
+    let img = c_order(&image);
+    let (rows, cols) = img.rows_cols();
+    let z = &img.data[..];
     let opt = DbcMapOptions {
         window: window_size,
         box_sizes,
@@ -170,7 +128,7 @@ fn dbc_transform_map<'py>(
         step,
         partial_blocks,
     };
-    let m = py.detach(|| run_in_pool(n_threads, || dbc_transform(z, rows, cols, &opt)))?;
+    let m = run(py, n_threads, || dbc_transform(z, rows, cols, &opt))?;
     local_map_arrays(py, m)
 }
 
@@ -189,10 +147,9 @@ fn blanket_transform_map<'py>(
     step: usize,
     n_threads: Option<usize>,
 ) -> PyResult<MapPair<'py>> {
-    let (rows, cols) = (image.shape()[0], image.shape()[1]);
-    let z = image
-        .as_slice()
-        .map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
+    let img = c_order(&image);
+    let (rows, cols) = img.rows_cols();
+    let z = &img.data[..];
     let opt = BlanketMapOptions {
         window: window_size,
         epsilons,
@@ -200,7 +157,7 @@ fn blanket_transform_map<'py>(
         min_valid,
         step,
     };
-    let m = py.detach(|| run_in_pool(n_threads, || blanket_transform(z, rows, cols, &opt)))?;
+    let m = run(py, n_threads, || blanket_transform(z, rows, cols, &opt))?;
     local_map_arrays(py, m)
 }
 
@@ -215,13 +172,13 @@ fn blanket_areas_image<'py>(
     z_scale: f64,
     n_threads: Option<usize>,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, usize)> {
-    let (rows, cols) = (image.shape()[0], image.shape()[1]);
-    let z = image
-        .as_slice()
-        .map_err(|_| PyValueError::new_err("data: internal: must be C-contiguous"))?;
-    let (a, n) =
-        py.detach(|| run_in_pool(n_threads, || blanket_areas(z, rows, cols, eps_max, z_scale)))?;
-    Ok((a.into_pyarray(py), n))
+    let img = c_order(&image);
+    let (rows, cols) = img.rows_cols();
+    let z = &img.data[..];
+    let (a, n) = run(py, n_threads, || {
+        blanket_areas(z, rows, cols, eps_max, z_scale)
+    })?;
+    Ok((array1(py, a), n))
 }
 
 /// Moving-window gliding-box lacunarity, shape (n_sizes, rows, cols) float32.
@@ -235,19 +192,14 @@ fn lacunarity_transform_map<'py>(
     min_valid: f64,
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
-    let (rows, cols) = (image.shape()[0], image.shape()[1]);
-    let z = image
-        .as_slice()
-        .map_err(|_| PyValueError::new_err("image: internal: must be C-contiguous"))?;
+    let img = c_order(&image);
+    let (rows, cols) = img.rows_cols();
+    let z = &img.data[..];
     let n = box_sizes.len();
-    let l = py.detach(|| {
-        run_in_pool(n_threads, || {
-            lacunarity_transform(z, rows, cols, window_size, &box_sizes, min_valid)
-        })
+    let l = run(py, n_threads, || {
+        lacunarity_transform(z, rows, cols, window_size, &box_sizes, min_valid)
     })?;
-    Ok(Array3::from_shape_vec((n, rows, cols), l)
-        .map_err(|_| PyValueError::new_err("internal: map size"))?
-        .into_pyarray(py))
+    array3(py, (n, rows, cols), l)
 }
 
 /// Image-wide P(m, L) curve N(L) of a grayscale image (NaN = no point).
@@ -260,13 +212,13 @@ fn mass_curve_image<'py>(
     z_scale: f64,
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let (rows, cols) = (image.shape()[0], image.shape()[1]);
-    let z = image
-        .as_slice()
-        .map_err(|_| PyValueError::new_err("data: internal: must be C-contiguous"))?;
-    let n =
-        py.detach(|| run_in_pool(n_threads, || mass_curve(z, rows, cols, &box_sizes, z_scale)))?;
-    Ok(n.into_pyarray(py))
+    let img = c_order(&image);
+    let (rows, cols) = img.rows_cols();
+    let z = &img.data[..];
+    let n = run(py, n_threads, || {
+        mass_curve(z, rows, cols, &box_sizes, z_scale)
+    })?;
+    Ok(array1(py, n))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -150,12 +150,7 @@ pub fn dbc_count<T: Sample>(
     if rows * cols == 0 || data.len() != rows * cols {
         return Err(CoreError::invalid("data", "image is empty"));
     }
-    if !(z_unit.is_finite() && z_unit > 0.0) {
-        return Err(CoreError::invalid(
-            "z_scale",
-            format!("must be a positive finite number, got {z_unit}"),
-        ));
-    }
+    crate::checks::positive_finite(z_unit, "z_scale")?;
     if !z0.is_finite() {
         return Err(CoreError::invalid(
             "data",

@@ -22,26 +22,7 @@ pub const DEFAULT_MAX_LENGTH: usize = 100_000_000;
 /// otherwise let a huge `n` run for hours).
 pub const MAX_STEPS: usize = 1_000_000;
 
-/// SplitMix64 finaliser (Steele, Lea and Flood 2014).
-#[inline]
-pub fn mix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
-/// A hash of three words, for counter-based random numbers.
-#[inline]
-pub fn hash3(seed: u64, a: u64, b: u64) -> u64 {
-    mix64(mix64(mix64(seed) ^ a) ^ b)
-}
-
-/// Uniform number in [0, 1) from `(seed, a, b)`.
-#[inline]
-pub fn unit3(seed: u64, a: u64, b: u64) -> f64 {
-    (hash3(seed, a, b) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-}
+pub use crate::synth::rng::{chain_hash3 as hash3, chain_unit3 as unit3};
 
 /// Rule of each symbol of a context-free, condition-free, non-parametric
 /// system: ASCII by code (`u32::MAX` = none), others by map.

@@ -225,7 +225,13 @@ pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2
     // odd and reads only samples with i + j even (written by pass A), so the
     // rows can be processed in parallel through a shared pointer.
     struct Shared(*mut f64);
+    // SAFETY: the pointer is shared by the rows of pass B only, and they
+    // never touch the same cell mutably: row i writes its own odd-parity
+    // cells and reads only even-parity cells, which no row writes in this
+    // pass; `fine` outlives the parallel loop and is not otherwise borrowed.
     unsafe impl Sync for Shared {}
+    // SAFETY: as for Sync: the raw pointer is only dereferenced inside the
+    // loop below, under the parity rule stated there.
     unsafe impl Send for Shared {}
     impl Shared {
         fn get(&self) -> *mut f64 {
@@ -294,6 +300,9 @@ pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2
             } else {
                 mean + delta_s * ks.normal(gbase + j as u64)
             };
+            debug_assert!(i * fc + j < fr * fc);
+            // SAFETY: (i, j) has i + j odd, a cell only row i writes in this
+            // pass, and i < fr, j < fc keep it inside the fr * fc buffer.
             unsafe { *base.add(i * fc + j) = v };
             j += 2;
         }

@@ -26,8 +26,9 @@
 //! `e`. The cost per pixel is `O(w e_max^2)`: it still grows with the window,
 //! linearly instead of as `w^2`.
 //!
-use super::dbc::{check_step, LocalMap};
+use super::dbc::LocalMap;
 use super::sat::{band_rows, check_window, line_fit, log_axis, rect, sat};
+use crate::checks::{positive_finite, step_grid};
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 
@@ -276,17 +277,6 @@ fn stream_sums(
     colsum.chunks(cols).map(|c| c.iter().sum::<f64>()).collect()
 }
 
-fn check_z_scale(z_scale: f64) -> CoreResult<()> {
-    if z_scale.is_finite() && z_scale > 0.0 {
-        Ok(())
-    } else {
-        Err(CoreError::invalid(
-            "z_scale",
-            format!("expected a positive number, got {z_scale}"),
-        ))
-    }
-}
-
 /// Image-wide blanket areas `A(e)` for `e = 1 ..= eps_max` and the number of
 /// valid pixels. Bands of 256 rows grow their own blankets with a halo of
 /// `eps_max` rows (a wrong value at a band's cut spreads one row per step,
@@ -305,7 +295,7 @@ pub fn blanket_areas(
     if eps_max == 0 {
         return Err(CoreError::invalid("epsilons", "expected positive integers"));
     }
-    check_z_scale(z_scale)?;
+    positive_finite(z_scale, "z_scale")?;
     let band = 256usize;
     let parts: Vec<(Vec<f64>, usize)> = (0..rows.div_ceil(band))
         .into_par_iter()
@@ -542,7 +532,7 @@ pub fn blanket_transform(
 ) -> CoreResult<LocalMap> {
     let w = opt.window;
     let min_pixels = check_window(z.len(), rows, cols, w, opt.min_valid)?;
-    let (orows, ocols) = check_step(opt.step, rows, cols)?;
+    let (orows, ocols) = step_grid(opt.step, rows, cols)?;
     let mut eps = opt.epsilons.clone();
     eps.sort_unstable();
     eps.dedup();
@@ -555,7 +545,7 @@ pub fn blanket_transform(
             ),
         ));
     }
-    check_z_scale(opt.z_scale)?;
+    positive_finite(opt.z_scale, "z_scale")?;
     let emax = *eps.last().unwrap();
     let (xs, xm, sxx) = log_axis(&eps);
     let (h, step) = (w / 2, opt.step);

@@ -25,6 +25,7 @@
 //! grid offset). The cost per pixel does not grow with the window.
 use super::sat::{band_rows, check_window, line_fit, log_axis, rect, sat};
 use super::sliding::rect_minmax;
+use crate::checks::{finite, positive_finite, step_grid};
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 
@@ -55,14 +56,6 @@ pub struct LocalMap {
     pub r2: Vec<f32>,
     pub rows: usize,
     pub cols: usize,
-}
-
-/// Check `step` and return the output grid shape.
-pub(crate) fn check_step(step: usize, rows: usize, cols: usize) -> CoreResult<(usize, usize)> {
-    if step == 0 {
-        return Err(CoreError::invalid("step", "expected a positive integer"));
-    }
-    Ok((rows.div_ceil(step), cols.div_ceil(step)))
 }
 
 /// Strided-table read that is 0 above or left of the plane.
@@ -108,7 +101,7 @@ pub fn dbc_transform(
 ) -> CoreResult<LocalMap> {
     let w = opt.window;
     let min_pixels = check_window(z.len(), rows, cols, w, opt.min_valid)?;
-    let (orows, ocols) = check_step(opt.step, rows, cols)?;
+    let (orows, ocols) = step_grid(opt.step, rows, cols)?;
     let mut sizes = opt.box_sizes.clone();
     sizes.sort_unstable();
     sizes.dedup();
@@ -121,15 +114,8 @@ pub fn dbc_transform(
             ),
         ));
     }
-    if !(opt.z_unit.is_finite() && opt.z_unit > 0.0) {
-        return Err(CoreError::invalid(
-            "z_scale",
-            format!("expected a positive number, got {}", opt.z_unit),
-        ));
-    }
-    if !opt.z0.is_finite() {
-        return Err(CoreError::invalid("z0", "expected a finite number"));
-    }
+    positive_finite(opt.z_unit, "z_scale")?;
+    finite(opt.z0, "z0")?;
     let step = opt.step;
     let (xs, xm, sxx) = log_axis(&sizes);
     let h = w / 2;

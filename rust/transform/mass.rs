@@ -15,7 +15,8 @@
 //! point's mass does not depend on where the analysis window sits and the
 //! window sums come from summed-area tables: the cost per pixel is the box
 //! neighbourhood (`L_max^2`), independent of the window.
-use super::sat::{band_rows, check_step, check_window, line_fit, log_axis, rect, sat_into};
+use super::sat::{band_rows, check_window, line_fit, log_axis, rect, sat_into};
+use crate::checks::{positive_finite, step_grid};
 use crate::dimension::dbc::Sample;
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
@@ -336,12 +337,7 @@ pub fn mass_curve(
             format!("box sides must be odd and positive, got {box_sizes:?}"),
         ));
     }
-    if !(z_scale.is_finite() && z_scale > 0.0) {
-        return Err(CoreError::invalid(
-            "z_scale",
-            format!("expected a positive number, got {z_scale}"),
-        ));
-    }
+    positive_finite(z_scale, "z_scale")?;
     let mut order: Vec<usize> = (0..box_sizes.len()).collect();
     order.sort_by_key(|&i| box_sizes[i]);
     let ks: Vec<usize> = order.iter().map(|&i| box_sizes[i] / 2).collect();
@@ -410,13 +406,9 @@ pub fn mass_transform<T: Sample>(
             ),
         ));
     }
-    if !(opt.z_scale.is_finite() && opt.z_scale > 0.0) {
-        return Err(CoreError::invalid(
-            "z_scale",
-            format!("expected a positive number, got {}", opt.z_scale),
-        ));
-    }
-    let step = check_step(opt.step)?;
+    positive_finite(opt.z_scale, "z_scale")?;
+    let step = opt.step;
+    step_grid(step, rows, cols)?;
     let ks: Vec<usize> = sizes.iter().map(|l| l / 2).collect();
     let (xs, xm, sxx) = log_axis(&sizes);
     let h = w / 2;

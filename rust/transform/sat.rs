@@ -67,17 +67,6 @@ pub(crate) fn rect(s: &[f64], w: usize, r0: usize, r1: usize, c0: usize, c1: usi
     s[r1 * w + c1] - s[r0 * w + c1] - s[r1 * w + c0] + s[r0 * w + c0]
 }
 
-/// Check an output `step` (a positive number of pixels).
-pub(crate) fn check_step(step: usize) -> CoreResult<usize> {
-    if step == 0 {
-        return Err(CoreError::invalid(
-            "step",
-            "must be a positive integer, got 0",
-        ));
-    }
-    Ok(step)
-}
-
 /// Check the image buffer, the window (odd, >= 3, not larger than the image)
 /// and `min_valid` (a fraction); returns the fewest valid pixels a window needs.
 pub(crate) fn check_window(

@@ -14,9 +14,8 @@
 //! increment powers and counts, built per band of rows at fixed positions,
 //! so the cost per pixel is independent of `w` and the result does not
 //! depend on the thread count.
-use super::sat::{
-    band_rows, check_step, check_window, line_fit, log_axis, rect, sat_into, sats_into,
-};
+use super::sat::{band_rows, check_window, line_fit, log_axis, rect, sat_into, sats_into};
+use crate::checks::{positive_finite, step_grid};
 use crate::dimension::dbc::Sample;
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
@@ -64,13 +63,9 @@ pub fn variation_transform<T: Sample>(
             ),
         ));
     }
-    if !(opt.p.is_finite() && opt.p > 0.0) {
-        return Err(CoreError::invalid(
-            "p",
-            format!("expected a positive number, got {}", opt.p),
-        ));
-    }
-    let step = check_step(opt.step)?;
+    positive_finite(opt.p, "p")?;
+    let step = opt.step;
+    step_grid(step, rows, cols)?;
     let h = w / 2;
     let (xs, xm, sxx) = log_axis(&lags);
     // output grid (pixels 0, step, 2 step, ...) and its rows per band

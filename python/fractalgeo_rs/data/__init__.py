@@ -43,17 +43,91 @@ def _srtm(key: str, description: str) -> Tuple[np.ndarray, Dict[str, Any]]:
 
 
 def srtm_alps() -> Tuple[np.ndarray, Dict[str, Any]]:
-    """SRTM DEM of the Maritime Alps, 256 x 256 int16 metres (no voids)."""
+    """SRTM DEM of the Maritime Alps, 256 x 256 int16 metres (no voids).
+
+    Returns
+    -------
+    dem : numpy.ndarray of int16, shape (256, 256)
+        Heights in metres above the EGM96 geoid.
+    info : dict
+        ``description``, ``attribution``, ``crs`` (EPSG:4326), ``transform``
+        (the crop's affine transform, rasterio order), ``cell_size`` (metres,
+        east-west and north-south), ``nodata`` and ``units``.
+
+    References
+    ----------
+    T. G. Farr et al., The Shuttle Radar Topography Mission, *Reviews of
+    Geophysics* 45 (2007) RG2004, doi:10.1029/2005RG000183.
+
+    NASA JPL, NASA Shuttle Radar Topography Mission Global 3 arc second,
+    NASA EOSDIS Land Processes DAAC, 2013,
+    doi:10.5067/MEaSUREs/SRTM/SRTMGL3.003.
+
+    Examples
+    --------
+    >>> import fractalgeo_rs as fg
+    >>> dem, info = fg.data.srtm_alps()
+    >>> dem.shape, dem.dtype.name, int(dem.min()), int(dem.max())
+    ((256, 256), 'int16', 494, 2328)
+    """
     return _srtm("alps", "SRTM N44E007 rows 536:792, cols 288:544: Maritime Alps")
 
 
 def srtm_po_plain() -> Tuple[np.ndarray, Dict[str, Any]]:
-    """SRTM DEM of the Po plain, 400 x 400 int16 metres (no voids)."""
+    """SRTM DEM of the Po plain, 400 x 400 int16 metres (no voids).
+
+    Returns
+    -------
+    dem : numpy.ndarray of int16, shape (400, 400)
+        Heights in metres above the EGM96 geoid.
+    info : dict
+        ``description``, ``attribution``, ``crs`` (EPSG:4326), ``transform``
+        (the crop's affine transform, rasterio order), ``cell_size`` (metres,
+        east-west and north-south), ``nodata`` and ``units``.
+
+    References
+    ----------
+    T. G. Farr et al., The Shuttle Radar Topography Mission, *Reviews of
+    Geophysics* 45 (2007) RG2004, doi:10.1029/2005RG000183.
+
+    NASA JPL, NASA Shuttle Radar Topography Mission Global 3 arc second,
+    NASA EOSDIS Land Processes DAAC, 2013,
+    doi:10.5067/MEaSUREs/SRTM/SRTMGL3.003.
+
+    Examples
+    --------
+    >>> import fractalgeo_rs as fg
+    >>> dem, info = fg.data.srtm_po_plain()
+    >>> dem.shape, dem.dtype.name, int(dem.min()), int(dem.max())
+    ((400, 400), 'int16', 171, 544)
+    """
     return _srtm("po_plain", "SRTM N44E007 rows 170:570, cols 740:1140: Po plain")
 
 
 def kilauea_land_mask() -> Tuple[np.ndarray, Dict[str, Any]]:
-    """Land mask of the Kilauea 30 m DEM, 793 x 857 bool (False = ocean)."""
+    """Land mask of the Kilauea 30 m DEM, 793 x 857 bool (False = ocean).
+
+    Returns
+    -------
+    land : numpy.ndarray of bool, shape (793, 857)
+        True on land, False on the ocean (the DEM's nodata), 30 m cells.
+    info : dict
+        ``description``, ``attribution``, ``crs`` (EPSG:32605), ``transform``
+        and ``cell_size`` (metres).
+
+    References
+    ----------
+    P. Wessel, J. F. Luis, L. Uieda, R. Scharroo, F. Wobbe, W. H. F. Smith
+    and D. Tian, The Generic Mapping Tools version 6, *Geochemistry,
+    Geophysics, Geosystems* 20 (2019) 5556-5564, doi:10.1029/2019GC008515.
+
+    Examples
+    --------
+    >>> import fractalgeo_rs as fg
+    >>> land, info = fg.data.kilauea_land_mask()
+    >>> land.shape, land.dtype.name, round(float(land.mean()), 3)
+    ((793, 857), 'bool', 0.923)
+    """
     with _load("kilauea_land_mask.npz") as f:
         shape = tuple(int(v) for v in f["shape"])
         mask = np.unpackbits(f["packed"], axis=1, count=shape[1]).astype(bool)
@@ -86,10 +160,61 @@ def _sentinel1(key: str, pol: str) -> Tuple[np.ndarray, Dict[str, Any]]:
 
 
 def sentinel1_vv_db() -> Tuple[np.ndarray, Dict[str, Any]]:
-    """Sentinel-1 sigma0 VV in dB, Vega Baja del Segura (Spain), 512 x 512 float32."""
+    """Sentinel-1 sigma0 VV in dB, Vega Baja del Segura (Spain), 512 x 512 float32.
+
+    Returns
+    -------
+    vv : numpy.ndarray of float32, shape (512, 512)
+        Backscatter coefficient sigma0 in dB on a 0.3 arc-second grid (about
+        8 x 10 m).
+    info : dict
+        ``description``, ``attribution`` ("Contains modified Copernicus
+        Sentinel data 2019"), ``crs`` (EPSG:4326), ``transform``, ``cell_size``
+        (metres) and ``units``.
+
+    References
+    ----------
+    D. Bonafilia, B. Tellman, T. Anderson and E. Issenberg, Sen1Floods11: a
+    georeferenced dataset to train and test deep learning flood algorithms
+    for Sentinel-1, *CVPR Workshops* (2020) 835-845,
+    doi:10.1109/CVPRW50498.2020.00113.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> vv, info = fg.data.sentinel1_vv_db()
+    >>> vv.shape, vv.dtype.name, round(float(np.nanmedian(vv)), 1)
+    ((512, 512), 'float32', -10.5)
+    """
     return _sentinel1("vv_db", "VV")
 
 
 def sentinel1_vh_db() -> Tuple[np.ndarray, Dict[str, Any]]:
-    """Sentinel-1 sigma0 VH in dB, the same scene and grid as :func:`sentinel1_vv_db`."""
+    """Sentinel-1 sigma0 VH in dB, the same scene and grid as :func:`sentinel1_vv_db`.
+
+    Returns
+    -------
+    vh : numpy.ndarray of float32, shape (512, 512)
+        Backscatter coefficient sigma0 in dB on a 0.3 arc-second grid (about
+        8 x 10 m).
+    info : dict
+        ``description``, ``attribution`` ("Contains modified Copernicus
+        Sentinel data 2019"), ``crs`` (EPSG:4326), ``transform``, ``cell_size``
+        (metres) and ``units``.
+
+    References
+    ----------
+    D. Bonafilia, B. Tellman, T. Anderson and E. Issenberg, Sen1Floods11: a
+    georeferenced dataset to train and test deep learning flood algorithms
+    for Sentinel-1, *CVPR Workshops* (2020) 835-845,
+    doi:10.1109/CVPRW50498.2020.00113.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> vh, info = fg.data.sentinel1_vh_db()
+    >>> vv, _ = fg.data.sentinel1_vv_db()
+    >>> vh.shape == vv.shape, bool(np.nanmedian(vv - vh) > 0)  # co-polarised returns are stronger
+    (True, True)
+    """
     return _sentinel1("vh_db", "VH")

@@ -61,6 +61,17 @@ def lakes(dem, level, *, closed_only=False, nodata=None, coastlines=True):
     -------
     Lakes
 
+    References
+    ----------
+    B. B. Mandelbrot, How long is the coast of Britain? Statistical self-
+    similarity and fractional dimension, *Science* 156 (1967) 636-638,
+    doi:10.1126/science.156.3775.636.
+
+    M. Datcu and K. Seidel, Fractal and multiresolution techniques for the
+    understanding of geo-information, in *Fractals in Geoscience and Remote
+    Sensing*, Proceedings of a Joint JRC/EARSeL Expert Meeting, Ispra, 1994
+    (published 1995).
+
     Examples
     --------
     >>> import numpy as np, fractalgeo_rs as fg

@@ -126,6 +126,17 @@ def dimension(data, method: str = "box", **options) -> DimensionFit:
     -------
     DimensionFit
 
+    References
+    ----------
+    M. Datcu and K. Seidel, Fractal and multiresolution techniques for the
+    understanding of geo-information, in *Fractals in Geoscience and Remote
+    Sensing*, Proceedings of a Joint JRC/EARSeL Expert Meeting, Ispra, 1994
+    (published 1995).
+
+    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
+    dimension: assessing the roughness of time series and spatial data,
+    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+
     Examples
     --------
     >>> import numpy as np, fractalgeo_rs as fg

@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 import numbers
 import warnings
-from typing import Optional, Sequence, Tuple, Union
+from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -57,6 +57,9 @@ def _lattice_fit(method, sizes, counts, offset_reduce, scale_range, x_label, y_l
         extra={"counts": counts, "offset_reduce": offset_reduce, **extra},
         domain=domain,
     )
+
+
+_NEAR_POWER = math.log(1.05)  # extents within 5 % of a power of 2 or 3
 
 
 def _uneven(sizes) -> bool:
@@ -99,6 +102,8 @@ def _default_box_sizes(b: np.ndarray, bbox: bool) -> Optional[list]:
         return abs(x - round(x)) * math.log(base)  # distance in natural-log units
 
     best = min((2, 3), key=misfit)
+    if misfit(best) > _NEAR_POWER:  # not a set of side b^L: keep the kernel's sizes
+        return None
     sizes = powers(best)
     if len(sizes) < 3:
         sizes = powers(2)
@@ -165,8 +170,8 @@ def box_counting(
         Box sides in samples; any positive integers (not only powers of two),
         at least three distinct, none larger than the longest axis. Default:
         the divisors of the set's extent when they form an even chain (all
-        ratios equal, or all at most 2), else powers of 2 or of 3 (the base
-        whose powers come closest to the extent) up to a quarter of the
+        ratios equal, or all at most 2) or when the extent is not within 5 %
+        of a power of 2 or 3, else powers of that base up to a quarter of the
         extent; ``docs/boxcounting.md`` has the error table on cropped,
         offset and padded exact fractals.
     offsets : int, default 1
@@ -201,6 +206,16 @@ def box_counting(
     of two need no padding or cropping. Where the lattice matches a
     self-similar construction (boxes ``2^k`` on a ``2^L`` Sierpinski
     triangle, ``3^k`` on a ``3^L`` carpet) the counts are exact.
+
+    References
+    ----------
+    K. Falconer, *Fractal Geometry: Mathematical Foundations and
+    Applications*, Wiley, 1990.
+
+    M. Datcu and K. Seidel, Fractal and multiresolution techniques for the
+    understanding of geo-information, in *Fractals in Geoscience and Remote
+    Sensing*, Proceedings of a Joint JRC/EARSeL Expert Meeting, Ispra, 1994
+    (published 1995).
 
     Examples
     --------
@@ -264,6 +279,22 @@ def box_counting_points(
     Returns
     -------
     DimensionFit
+
+    References
+    ----------
+    K. Falconer, *Fractal Geometry: Mathematical Foundations and
+    Applications*, Wiley, 1990.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> t = np.linspace(0.0, 1.0, 4097)
+    >>> segment = np.c_[t, 0.5 * t]  # points on a straight segment: D = 1
+    >>> round(fg.box_counting_points(segment).dimension, 2)
+    1.0
+    >>> square = np.random.default_rng(0).random((100_000, 2))  # dense in the unit square: D = 2
+    >>> round(fg.box_counting_points(square, box_sizes=[1/4, 1/8, 1/16, 1/32]).dimension, 2)
+    2.0
     """
     arr = as_array(points, "points")
     if arr.dtype.kind not in "iuf":
@@ -408,6 +439,22 @@ def differential_box_counting(
     Blocks at the right and bottom edges that hold fewer than ``s x s``
     pixels are counted with the pixels they hold (the lattice count of the
     surface over its domain); blocks with no valid pixel are skipped.
+
+    References
+    ----------
+    N. Sarkar and B. B. Chaudhuri, An efficient differential box-counting
+    approach to compute fractal dimension of image, *IEEE Transactions on
+    Systems, Man, and Cybernetics* 24(1) (1994) 115-120,
+    doi:10.1109/21.259692.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> round(fg.differential_box_counting(np.zeros((64, 64))).dimension, 6)  # a flat image: D = 2
+    2.0
+    >>> dem, info = fg.data.srtm_alps()
+    >>> round(fg.differential_box_counting(dem).dimension, 3)
+    2.094
     """
     z = _surface_float(image, nodata, "image")
     sizes = check_box_sizes(box_sizes)
@@ -525,6 +572,22 @@ def self_affine_box_counting(
     ``delta_1`` is the mean range of unit columns. The ``+ 1`` of each column
     is what separates this estimator from a plain range-scaling fit; it
     cancels only at the self-affine ``h``.
+
+    References
+    ----------
+    B. B. Mandelbrot, Self-affine fractals and fractal dimension, *Physica
+    Scripta* 32 (1985) 257-260, doi:10.1088/0031-8949/32/4/001.
+
+    K. Falconer, *Fractal Geometry: Mathematical Foundations and
+    Applications*, Wiley, 1990.
+
+    Examples
+    --------
+    >>> import fractalgeo_rs as fg
+    >>> x = fg.fbm(4097, 0.7, method='exact', seed=0)  # H = 0.7, D = 2 - H = 1.3
+    >>> fit = fg.self_affine_box_counting(x)
+    >>> round(fit.extra['hurst'], 1), round(fit.dimension, 1)
+    (0.7, 1.3)
     """
     z = _surface_float(data, nodata, "data", ndims=(1, 2))
     profile = z.ndim == 1

@@ -39,6 +39,23 @@ class Lacunarity:
         ``Lambda(r)``.
     n_boxes : ndarray
         Number of box positions (boxes touching NaN are left out).
+
+    References
+    ----------
+    C. Allain and M. Cloitre, Characterizing the lacunarity of random and
+    deterministic fractal sets, *Physical Review A* 44 (1991) 3552-3558,
+    doi:10.1103/PhysRevA.44.3552.
+
+    R. E. Plotnick, R. H. Gardner and R. V. O'Neill, Lacunarity indices as
+    measures of landscape texture, *Landscape Ecology* 8(3) (1993) 201-211,
+    doi:10.1007/BF00125351.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> lac = fg.lacunarity(np.ones((32, 32), dtype=bool), box_sizes=[1, 2, 4])
+    >>> lac.box_sizes.tolist(), lac.lacunarity.tolist()
+    ([1, 2, 4], [1.0, 1.0, 1.0])
     """
 
     box_sizes: np.ndarray
@@ -72,6 +89,26 @@ def lacunarity(data, box_sizes: Optional[Sequence[int]] = None) -> Lacunarity:
     Returns
     -------
     Lacunarity
+
+    References
+    ----------
+    C. Allain and M. Cloitre, Characterizing the lacunarity of random and
+    deterministic fractal sets, *Physical Review A* 44 (1991) 3552-3558,
+    doi:10.1103/PhysRevA.44.3552.
+
+    R. E. Plotnick, R. H. Gardner and R. V. O'Neill, Lacunarity indices as
+    measures of landscape texture, *Landscape Ecology* 8(3) (1993) 201-211,
+    doi:10.1007/BF00125351.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> full = fg.lacunarity(np.ones((32, 32), dtype=bool), box_sizes=[1, 2, 4])
+    >>> full.lacunarity.tolist()  # a full set has no gaps: Lambda = 1
+    [1.0, 1.0, 1.0]
+    >>> half = np.zeros((32, 32), dtype=bool); half[:, ::2] = True
+    >>> fg.lacunarity(half, box_sizes=[1]).lacunarity.tolist()  # single pixels: Lambda(1) = 1 / fill fraction
+    [2.0]
     """
     arr = as_array(data)
     if arr.ndim != 2:

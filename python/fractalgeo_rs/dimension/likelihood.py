@@ -322,7 +322,7 @@ def whittle(
     -----
     Measured on exact fBm (``docs/accuracy.md``, 100 replicates): RMSE of
     ``D`` about 0.004-0.005 at 256², 0.016-0.019 at 64² and 0.037-0.044 at
-    32² for ``0.3 <= H <= 0.7`` with the default filter, |bias| <= 0.004.
+    32² for ``0.3 <= H <= 0.7`` with the default filter, ``|bias| <= 0.004``.
     On small grids the debiased Whittle likelihood is not efficient: at 32²
     its RMSE is 25-30 % above that of the exact likelihood and 40 % above
     the Cramér-Rao bound (``benches/crb_fbm_surface.py``); use

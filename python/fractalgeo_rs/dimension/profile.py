@@ -17,7 +17,7 @@ from typing import Optional, Sequence
 import numpy as np
 
 from fractalgeo_rs import _core
-from fractalgeo_rs._validation import check_n_threads, check_positive_float, check_positive_int
+from fractalgeo_rs._validation import check_n_threads, check_positive_int
 from fractalgeo_rs.dimension.variation import _real_array, _with_nodata
 from fractalgeo_rs.fit import DimensionFit, ScaleRange, fit_loglog
 
@@ -64,6 +64,21 @@ def higuchi(data, *, k_max: Optional[int] = None, nodata: Optional[float] = None
     -------
     DimensionFit
         ``scales`` are the intervals ``k``, ``measures`` ``L(k)``.
+
+    References
+    ----------
+    T. Higuchi, Approach to an irregular time series on the basis of the
+    fractal theory, *Physica D* 31 (1988) 277-283,
+    doi:10.1016/0167-2789(88)90081-4.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> round(fg.higuchi(np.arange(1000.0)).dimension, 6)  # a straight line: D = 1
+    1.0
+    >>> x = fg.fbm(4096, 0.5, method='exact', seed=0)  # Brownian motion: D = 2 - H = 1.5
+    >>> round(fg.higuchi(x).dimension, 1)
+    1.5
     """
     z = _with_nodata(_real_array(data, (1,)), data, nodata)
     _gap_free(z, "Higuchi's method")
@@ -151,6 +166,22 @@ def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, sample_spacin
     DimensionFit
         ``D = 1 - slope``. Edges are handled by reflection
         (``scipy.ndimage.gaussian_filter1d``, mode "reflect").
+
+    References
+    ----------
+    T. Lindeberg, *Scale-Space Theory in Computer Vision*, Kluwer, 1994,
+    doi:10.1007/978-1-4757-6465-9.
+
+    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
+    dimension: assessing the roughness of time series and spatial data,
+    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> x = fg.fbm(4096, 0.5, method='exact', seed=0)  # D = 2 - H = 1.5
+    >>> round(fg.scale_space(x).dimension, 1)
+    1.5
     """
     z = _with_nodata(_real_array(data, (1,)), data, nodata)
     _gap_free(z, "scale space")
@@ -214,6 +245,19 @@ def wavelet_dimension(data, *, levels: Optional[Sequence[int]] = None, nodata: O
     -------
     DimensionFit
         ``scales`` are ``2^j`` samples, ``measures`` the detail variances.
+
+    References
+    ----------
+    P. Flandrin, Wavelet analysis and synthesis of fractional Brownian
+    motion, *IEEE Transactions on Information Theory* 38(2) (1992) 910-917,
+    doi:10.1109/18.119751.
+
+    Examples
+    --------
+    >>> import fractalgeo_rs as fg
+    >>> x = fg.fbm(4096, 0.5, method='exact', seed=0)  # D = 2 - H = 1.5
+    >>> round(fg.wavelet_dimension(x).dimension, 1)
+    1.5
     """
     z = _with_nodata(_real_array(data, (1, 2)), data, nodata)
     _gap_free(z, "the wavelet estimator")

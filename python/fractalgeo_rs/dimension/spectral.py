@@ -92,6 +92,27 @@ def spectral_dimension(
         ``scales`` are frequencies in cycles per sample, ``measures`` the mean
         power per bin; ``extra["beta"]`` is ``-slope`` and ``extra["hurst"]``
         ``(beta - 1) / 2`` (1D) or ``(beta - 2) / 2`` (2D).
+
+    References
+    ----------
+    R. F. Voss, Fractals in nature: from characterization to simulation, in
+    H.-O. Peitgen and D. Saupe (eds.), *The Science of Fractal Images*,
+    Springer, 1988, 21-70, doi:10.1007/978-1-4612-3784-6_1.
+
+    M. Datcu and K. Seidel, Fractal and multiresolution techniques for the
+    understanding of geo-information, in *Fractals in Geoscience and Remote
+    Sensing*, Proceedings of a Joint JRC/EARSeL Expert Meeting, Ispra, 1994
+    (published 1995).
+
+    Examples
+    --------
+    >>> import fractalgeo_rs as fg
+    >>> z = fg.fbm_surface((256, 256), 0.7, method='exact', seed=1)  # D = 3 - H = 2.3
+    >>> round(fg.spectral_dimension(z).dimension, 1)  # the periodogram slope is biased on small grids
+    2.4
+    >>> x = fg.fbm(4096, 0.5, method='exact', seed=0)  # a profile: D = 2 - H = 1.5
+    >>> round(fg.spectral_dimension(x).dimension, 1)
+    1.5
     """
     z = _with_nodata(_real_array(data, (1, 2)), data, nodata)
     if np.isnan(z).any():

@@ -54,6 +54,28 @@ def minkowski(data, *, radii: Optional[Sequence[float]] = None, scale_range: Sca
     DimensionFit
         ``measures`` are the sausage volumes (samples within distance ``r``
         of the set, the set included).
+
+    References
+    ----------
+    B. Dubuc, J. F. Quiniou, C. Roques-Carmes, C. Tricot and S. W. Zucker,
+    Evaluating the fractal dimension of profiles, *Physical Review A* 39
+    (1989) 1500-1512, doi:10.1103/PhysRevA.39.1500.
+
+    M. Datcu and K. Seidel, Fractal and multiresolution techniques for the
+    understanding of geo-information, in *Fractals in Geoscience and Remote
+    Sensing*, Proceedings of a Joint JRC/EARSeL Expert Meeting, Ispra, 1994
+    (published 1995).
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> point = np.zeros((101, 101), dtype=bool); point[50, 50] = True
+    >>> abs(round(fg.minkowski(point, radii=[4, 8, 16, 32]).dimension, 1))  # V(r) = pi r^2: D = 2 - 2 = 0
+    0.0
+    >>> land, info = fg.data.kilauea_land_mask()
+    >>> coast = land & ~np.roll(land, 1, axis=0)  # land pixels with sea to the north
+    >>> round(fg.minkowski(coast).dimension, 2)
+    0.99
     """
     from scipy.ndimage import distance_transform_edt
 
@@ -135,6 +157,22 @@ def mass_dimension(
     -------
     DimensionFit
         ``measures`` are ``N(L)``; boxes are clipped at the data edge.
+
+    References
+    ----------
+    R. F. Voss, Characterization and measurement of random fractals,
+    *Physica Scripta* T13 (1986) 27-32, doi:10.1088/0031-8949/1986/T13/004.
+
+    M. Datcu and K. Seidel, Fractal and multiresolution techniques for the
+    understanding of geo-information, in *Fractals in Geoscience and Remote
+    Sensing*, Proceedings of a Joint JRC/EARSeL Expert Meeting, Ispra, 1994
+    (published 1995).
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> round(fg.mass_dimension(np.ones((128, 128), dtype=bool)).dimension, 1)  # a filled plane: D = 2
+    2.0
     """
     check_choice(kind, "kind", ("auto", "binary", "points", "grayscale"))
     arr = as_array(data)

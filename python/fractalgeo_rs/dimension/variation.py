@@ -163,6 +163,26 @@ def power_variation(
         ``scales`` are the lags, ``measures`` ``V_p(l)``; ``extra["hurst"]``
         is ``slope / p``. With two lags the fit is exact: ``stderr`` and
         ``ci95`` are NaN.
+
+    References
+    ----------
+    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
+    dimension: assessing the roughness of time series and spatial data,
+    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+
+    J. T. Kent and A. T. A. Wood, Estimating the fractal dimension of a
+    locally self-similar Gaussian process by using increments, *Journal of
+    the Royal Statistical Society B* 59(3) (1997) 679-699,
+    doi:10.1111/1467-9868.00091.
+
+    Examples
+    --------
+    >>> import fractalgeo_rs as fg
+    >>> x = fg.fbm(4096, 0.5, method='exact', seed=0)  # D = 2 - H = 1.5
+    >>> round(fg.power_variation(x).dimension, 1)  # p = 1, second-order increments
+    1.5
+    >>> round(fg.power_variation(x, p=2.0, order=1).dimension, 1)  # the variogram
+    1.5
     """
     z = _with_nodata(_real_array(data, (1,)), data, nodata)
     p = check_positive_float(p, "p")
@@ -199,12 +219,40 @@ def variogram(data, *, lags: Sequence[int] = (1, 2), nodata: Optional[float] = N
     variogram on the axes, :func:`surface_variation` with
     ``estimator="first", p=2``, ``D = 3 - slope / 2``.
 
+    Parameters
+    ----------
+    data : array_like, shape (n,) or (rows, cols)
+        The profile or surface, on a regular grid. NaN and ``nodata`` are skipped.
+    lags : sequence of int, default (1, 2)
+        Lags in samples; the default pair is the recommendation of Gneiting et
+        al. (2012).
+    nodata : float, optional
+        Value meaning "no data".
+    scale_range : None, "auto" or (low, high)
+        Lags used in the fit; see :func:`fractalgeo_rs.fit.fit_loglog`.
+
+    Returns
+    -------
+    DimensionFit
+        ``measures`` are half the mean squared increments at ``lags`` (the
+        semivariogram);
+        ``extra["hurst"]`` is ``2 - D``. With two lags the fit is exact and its
+        interval is NaN.
+
+    References
+    ----------
+    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
+    dimension: assessing the roughness of time series and spatial data,
+    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+
     Examples
     --------
-    >>> import fractalgeo_rs as fg
-    >>> x = fg.fbm(4096, 0.5, seed=1)
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> round(fg.variogram(np.arange(100.0)).dimension, 6)  # a line: gamma(k) = k^2, D = 1
+    1.0
+    >>> x = fg.fbm(4096, 0.3, method='exact', seed=0)  # D = 2 - H = 1.7
     >>> round(fg.variogram(x).dimension, 1)
-    1.5
+    1.7
     """
     return _first_order(data, 2.0, "variogram", lags, nodata, scale_range)
 
@@ -217,12 +265,39 @@ def madogram(data, *, lags: Sequence[int] = (1, 2), nodata: Optional[float] = No
     2012), ``D = 2 - slope``. Surfaces (2D input): :func:`surface_variation`
     with ``estimator="first", p=1``, ``D = 3 - slope``.
 
+    Parameters
+    ----------
+    data : array_like, shape (n,) or (rows, cols)
+        The profile or surface, on a regular grid. NaN and ``nodata`` are skipped.
+    lags : sequence of int, default (1, 2)
+        Lags in samples; the default pair is the recommendation of Gneiting et
+        al. (2012).
+    nodata : float, optional
+        Value meaning "no data".
+    scale_range : None, "auto" or (low, high)
+        Lags used in the fit; see :func:`fractalgeo_rs.fit.fit_loglog`.
+
+    Returns
+    -------
+    DimensionFit
+        ``measures`` are half the mean absolute increments at ``lags``;
+        ``extra["hurst"]`` is ``2 - D``. With two lags the fit is exact and its
+        interval is NaN.
+
+    References
+    ----------
+    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
+    dimension: assessing the roughness of time series and spatial data,
+    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+
     Examples
     --------
-    >>> import fractalgeo_rs as fg
-    >>> z = fg.fbm_surface((128, 128), 0.5, seed=1)
-    >>> round(fg.madogram(z).dimension, 1)
-    2.5
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> round(fg.madogram(np.arange(100.0)).dimension, 6)  # a line: mean |increment| = k, D = 1
+    1.0
+    >>> x = fg.fbm(4096, 0.3, method='exact', seed=0)  # D = 2 - H = 1.7
+    >>> round(fg.madogram(x).dimension, 1)
+    1.7
     """
     return _first_order(data, 1.0, "madogram", lags, nodata, scale_range)
 
@@ -271,6 +346,27 @@ def surface_variation(
         ``extra["hurst"]`` is ``3 - D``. For ``"transect"`` the fit shown is
         that of the pooled increments; ``dimension`` is the median and
         ``extra["transect_dimensions"]`` holds every row's and column's value.
+
+    References
+    ----------
+    G. Chan and A. T. A. Wood, Increment-based estimators of fractal
+    dimension for two-dimensional surface data, *Statistica Sinica* 10
+    (2000) 343-376.
+
+    J. T. Kent and A. T. A. Wood, Estimating the fractal dimension of a
+    locally self-similar Gaussian process by using increments, *Journal of
+    the Royal Statistical Society B* 59(3) (1997) 679-699,
+    doi:10.1111/1467-9868.00091.
+
+    Examples
+    --------
+    >>> import fractalgeo_rs as fg
+    >>> z = fg.fbm_surface((256, 256), 0.7, method='exact', seed=1)  # D = 3 - H = 2.3
+    >>> fit = fg.surface_variation(z)
+    >>> round(fit.dimension, 1), round(fit.extra['hurst'], 1)
+    (2.3, 0.7)
+    >>> round(fg.surface_variation(z, estimator='transect').dimension, 1)
+    2.3
     """
     z = _with_nodata(_real_array(data, (2,)), data, nodata)
     check_choice(estimator, "estimator", ("square", "first", "transect"))

@@ -10,7 +10,6 @@ import os
 import secrets
 from typing import Any, Mapping, Optional, Sequence, Union
 
-import numpy as np
 
 from fractalgeo_rs import _core
 from fractalgeo_rs._validation import check_n_threads
@@ -81,6 +80,26 @@ class LString:
     Returned by :meth:`LSystem.derive`; also built from text with
     :meth:`LString.parse`. ``str(s)`` gives the text form (``A(1,2.5)B``),
     ``len(s)`` the number of modules.
+
+    Parameters
+    ----------
+    core : _core.ModuleString
+        The Rust string of modules; build an ``LString`` with
+        :meth:`LString.parse` or :meth:`LSystem.derive` rather than directly.
+
+    References
+    ----------
+    P. Prusinkiewicz and A. Lindenmayer, *The Algorithmic Beauty of Plants*,
+    Springer, 1990, doi:10.1007/978-1-4613-8476-2.
+
+    Examples
+    --------
+    >>> from fractalgeo_rs import LString, LSystem
+    >>> s = LString.parse('A(1,2.5)B')
+    >>> len(s), str(s), s.count('A')
+    (2, 'A(1,2.5)B', 1)
+    >>> str(LSystem('b', {'b': 'a', 'a': 'ab'}).derive(4))  # Fibonacci words, eq. 23 of the paper
+    'abaab'
     """
 
     __slots__ = ("_core",)
@@ -260,6 +279,7 @@ class LSystem:
 
     @property
     def axiom(self) -> str:
+        """The axiom (the word of generation 0)."""
         return self._axiom
 
     @property
@@ -269,6 +289,7 @@ class LSystem:
 
     @property
     def ignore(self) -> str:
+        """Symbols skipped when matching the context of context-sensitive rules."""
         return self._ignore
 
     @property
@@ -278,6 +299,7 @@ class LSystem:
 
     @property
     def is_stochastic(self) -> bool:
+        """True when a predecessor has more than one weighted successor."""
         return self._core.is_stochastic
 
     def __repr__(self) -> str:

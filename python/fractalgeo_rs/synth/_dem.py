@@ -73,6 +73,17 @@ def synthetic_dem(shape, hurst, *, cell_size, relief, relief_lag=None, mean_elev
     numpy.ndarray
         float64 heights in metres, shape ``shape``.
 
+    References
+    ----------
+    M. L. Stein, Fast and exact simulation of fractional Brownian surfaces,
+    *Journal of Computational and Graphical Statistics* 11(3) (2002)
+    587-599, doi:10.1198/106186002466.
+
+    M. Datcu and K. Seidel, Fractal and multiresolution techniques for the
+    understanding of geo-information, in *Fractals in Geoscience and Remote
+    Sensing*, Proceedings of a Joint JRC/EARSeL Expert Meeting, Ispra, 1994
+    (published 1995).
+
     Examples
     --------
     >>> import fractalgeo_rs as fg

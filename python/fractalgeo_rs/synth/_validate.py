@@ -49,6 +49,22 @@ class SurfaceReport:
         Box-counting dimension of the level lines at the 30th-70th
         percentile heights (``2 - H`` expected for fBm), NaN when not
         computed (see :func:`coastline_dimension`).
+
+    References
+    ----------
+    M. L. Stein, Fast and exact simulation of fractional Brownian surfaces,
+    *Journal of Computational and Graphical Statistics* 11(3) (2002)
+    587-599, doi:10.1198/106186002466.
+
+    Examples
+    --------
+    >>> import fractalgeo_rs as fg
+    >>> z = fg.fbm_surface((256, 256), 0.5, method='exact', seed=1)
+    >>> r = fg.validate_surface(z, 0.5, coastline=False)
+    >>> round(r.hurst_variogram, 1), r.lags
+    (0.5, (8, 16, 32, 64))
+    >>> sorted(r.as_dict())[:3]
+    ['axis_ratio', 'coastline_dimension', 'crease_ratio']
     """
 
     hurst_requested: float | None
@@ -67,6 +83,7 @@ class SurfaceReport:
     lags: tuple = field(default=(8, 16, 32, 64))
 
     def as_dict(self) -> dict:
+        """The report's fields as a plain ``dict`` (field name to value)."""
         return asdict(self)
 
     def __str__(self) -> str:
@@ -224,6 +241,15 @@ def validate_surface(z, hurst=None, *, lags=None, periodic=None, coastline=True)
         Spectral slope and the H it implies, variogram H, isotropy,
         Gaussianity of the increments, crease ratio, periodicity and coastline
         dimension (see :class:`SurfaceReport`).
+
+    References
+    ----------
+    M. L. Stein, Fast and exact simulation of fractional Brownian surfaces,
+    *Journal of Computational and Graphical Statistics* 11(3) (2002)
+    587-599, doi:10.1198/106186002466.
+
+    H.-O. Peitgen and D. Saupe (eds.), *The Science of Fractal Images*,
+    Springer, 1988, doi:10.1007/978-1-4612-3784-6.
 
     Examples
     --------

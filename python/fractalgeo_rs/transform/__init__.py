@@ -23,11 +23,12 @@ Voss, R. F. (1986). Characterization and measurement of random fractals.
 """
 from __future__ import annotations
 
-from typing import Optional, Sequence, Tuple, Union
+from typing import Optional, Sequence
 
 import numpy as np
 
 from fractalgeo_rs import _core
+from fractalgeo_rs._backend import array_kind, run_raster
 from fractalgeo_rs._validation import (
     as_array,
     check_choice,
@@ -80,17 +81,6 @@ def _int_list(values, name: str, what: str) -> list:
             raise TypeError(f"{name}: expected a sequence of {what}, got {values!r}")
         out.append(int(v))
     return sorted(set(out))
-
-
-def _even_chunks(n: int, size: int, step: int, depth: int) -> tuple:
-    """Chunks of ``size`` rounded up to a multiple of ``step``, the last one
-    merged into its neighbour when it is shorter than ``depth``."""
-    size = -(-size // step) * step
-    out = [size] * (n // size) + ([n % size] if n % size else [])
-    if len(out) > 1 and out[-1] < depth:
-        tail = out.pop()
-        out[-1] += tail
-    return tuple(out)
 
 
 def _float_dtype(dtype) -> type:
@@ -314,31 +304,7 @@ def fractal_transform(
     except (TypeError, ValueError):
         raise TypeError(f"lags: expected a sequence of positive ints, got {lags!r}") from None
 
-    xr_obj = None
-    try:  # xarray: compute on its data, re-wrap coords and attrs
-        import xarray as xr  # noqa: F401
-
-        if type(image).__module__.startswith("xarray") and hasattr(image, "dims"):
-            xr_obj = image
-            image = image.data
-    except ImportError:
-        pass
-    is_dask = type(image).__module__.startswith("dask")
-    arr = image if is_dask else as_array(image, "image")
-    if arr.ndim == 3:
-        if band is None:
-            raise ValueError(f"band: a 3D input of shape {arr.shape} needs band= (0-based band index)")
-        if not (0 <= int(band) < arr.shape[0]):
-            raise ValueError(f"band: expected an index in [0, {arr.shape[0]}), got {band}")
-        arr = arr[int(band)]
-        if xr_obj is not None:
-            xr_obj = xr_obj[int(band)]
-    if arr.ndim != 2:
-        raise ValueError(f"image: expected a 2D image, got {arr.ndim} dimensions")
-    if arr.dtype.kind not in "iuf" or arr.dtype.kind == "b":
-        raise TypeError(f"image: expected a real numeric array, got dtype {arr.dtype}")
-    if 0 in arr.shape:
-        raise ValueError(f"image: array is empty (shape {arr.shape})")
+    arr, image = _select_band(image, band)
     w = _check_window(window_size, arr.shape)
     if auto_z:
         z_scale = default_z_scale(arr, nodata) if method in ("mass", "dbc", "blanket") else None
@@ -370,63 +336,65 @@ def fractal_transform(
     elif len(lags) < 2 or lags[0] < 1 or lags[-1] >= w:
         raise ValueError(f"lags: need at least 2 distinct lags in [1, {w}), got {lags}")
 
-    def kernel(block):
-        """Stacked (dimension, r²) on the ``step`` grid from the block's origin."""
+    def prepare(block):
         z = np.asarray(block, dtype=_float_dtype(block.dtype))
         if nodata is not None:
             z = np.where(_nodata_mask(z, nodata), np.nan, z)
-        d, r2 = _grid(z, w, method, opts, min_valid, step, n_threads)
-        return np.stack([d, r2])
+        return z
 
-    if is_dask:
-        import dask.array as da
+    def kernel(z):
+        """Stacked (dimension, r²) on the ``step`` grid from the block's origin."""
+        return np.stack(_grid(z, w, method, opts, min_valid, step, n_threads))
 
-        # halo: what a window reaches, rounded up to the step so that every
-        # chunk's first output pixel sits on the step grid of its padded block
-        depth = -(-half // step) * step
-        chunks = arr.chunks
-        if step > 1 or min(min(c) for c in chunks) < depth:
-            # every chunk must hold the halo its neighbours need, and with a
-            # step every chunk but the last a multiple of it
-            arr = arr.rechunk(tuple(_even_chunks(n, max(depth, max(c)), step, depth)
-                                    for n, c in zip(arr.shape, chunks)))
-        zf = arr.astype(_float_dtype(arr.dtype))
-        padded = da.overlap.overlap(zf, depth=depth, boundary=np.nan)
-        d0 = depth // step
+    image = _prepared(image, arr, prepare)
+    out = run_raster(kernel, image, depth=half, n_out=2, step=step,
+                     prepare=prepare if array_kind(arr) == "dask" else None,
+                     names=("fractal_dimension", "r_squared" if method != "whittle" else "standard_error"))
+    if array_kind(image) == "xarray":  # record what makes maps comparable
+        for o in out:
+            o.attrs.update({"fractal_method": method, "window_size": w})
+            if method in ("mass", "dbc", "blanket"):
+                o.attrs["z_scale"] = float(z_scale)
+    return tuple(out) if return_fit else out[0]
 
-        def block_fn(b):
-            res = kernel(b)
-            n0 = -(-(b.shape[0] - 2 * depth) // step)
-            n1 = -(-(b.shape[1] - 2 * depth) // step)
-            return res[:, d0:d0 + n0, d0:d0 + n1].astype(np.float32)
 
-        out_chunks = ((2,),) + tuple(tuple(-(-(c - 2 * depth) // step) for c in cs) for cs in padded.chunks)
-        res = padded.map_blocks(block_fn, new_axis=0, chunks=out_chunks, dtype=np.float32,
-                                meta=np.empty((0, 0, 0), np.float32))
-        out = (res[0], res[1]) if return_fit else res[0]
+def _select_band(image, band):
+    """``(array, image)``: the 2D array to check (numpy or dask) and the
+    object to compute on (the same, or the xarray DataArray), with ``band``
+    (0-based) taken from a 3D input."""
+    kind = array_kind(image)
+    data = image.data if kind == "xarray" else image
+    arr = data if array_kind(data) == "dask" else as_array(data, "image")
+    if arr.ndim == 3:
+        if band is None:
+            raise ValueError(f"band: a 3D input of shape {arr.shape} needs band= (0-based band index)")
+        if isinstance(band, bool) or not isinstance(band, (int, np.integer)) or not (0 <= band < arr.shape[0]):
+            raise ValueError(f"band: expected an index in [0, {arr.shape[0]}), got {band!r}")
+        arr = arr[int(band)]
+        image = image[int(band)] if kind == "xarray" else arr
+    elif kind != "xarray":
+        image = arr
+    if arr.ndim != 2:
+        raise ValueError(f"image: expected a 2D image, got {arr.ndim} dimensions")
+    if arr.dtype.kind not in "iuf":
+        raise TypeError(f"image: expected a real numeric array, got dtype {arr.dtype}")
+    if 0 in arr.shape:
+        raise ValueError(f"image: array is empty (shape {arr.shape})")
+    return arr, image
+
+
+def _prepared(image, arr, prepare):
+    """In memory: the image prepared once (float, nodata as NaN) and checked
+    for a valid value; on Dask: cast to float so the NaN halo can be added
+    (the blocks are prepared by the runner)."""
+    if array_kind(arr) == "dask":
+        z = arr.astype(_float_dtype(arr.dtype))
     else:
-        # no copy of a float32 or float64 image (never modified), one of
-        # other types
-        z = np.asarray(arr, dtype=_float_dtype(arr.dtype))
-        if nodata is not None:
-            z = np.where(_nodata_mask(z, nodata), np.nan, z)
+        z = prepare(arr)
         # fmax ignores NaN: the reduction is NaN only when every value is
         if np.isnan(np.fmax.reduce(z, axis=None)):
             raise ValueError("image: no valid value (all NaN or nodata)")
-        d, r2 = _grid(z, w, method, opts, min_valid, step, n_threads)
-        out = (d, r2) if return_fit else d
-    if xr_obj is not None:
-        grid = xr_obj.isel({xr_obj.dims[0]: slice(None, None, step), xr_obj.dims[1]: slice(None, None, step)})
-        attrs = {"fractal_method": method, "window_size": w}
-        if z_scale is not None and method in ("mass", "dbc", "blanket"):
-            attrs["z_scale"] = float(z_scale)
-
-        def wrap(a):
-            out = grid.copy(data=a).astype(np.float32).rename("fractal_dimension")
-            out.attrs.update(attrs)
-            return out
-        out = tuple(wrap(a) for a in out) if return_fit else wrap(out)
-    return out
+    return image.copy(data=z) if array_kind(image) == "xarray" else z
 
 
 def lacunarity_map(
@@ -449,8 +417,10 @@ def lacunarity_map(
 
     Parameters
     ----------
-    image : array_like, shape (rows, cols)
-        Non-negative values (intensity, a binary mask as 0/1; not dB).
+    image : array_like, dask.array.Array or xarray.DataArray, shape (rows, cols)
+        Non-negative values (intensity, a binary mask as 0/1; not dB). On
+        Dask the sign check is left to the caller (it would read the
+        whole scene).
     window_size : int
         Odd window side (>= 3).
     box_sizes : sequence of int, optional
@@ -461,27 +431,29 @@ def lacunarity_map(
     Returns
     -------
     ndarray of float32, shape (len(box_sizes), rows, cols)
+        Or the input's dask/xarray type (xarray: a leading ``box_size``
+        dimension). On Dask each chunk is computed with a NaN halo of
+        ``window_size // 2``, the edge policy of the in-memory call, so the
+        results are equal.
 
     References
     ----------
     Allain, C., Cloitre, M. (1991). *Physical Review A* 44(6), 3552-3558.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> lam = fg.lacunarity_map(np.ones((16, 16)), 5, box_sizes=[1, 2])
+    >>> lam.shape, float(np.nanmax(np.abs(lam - 1.0)))  # a constant image has no gaps: Lambda = 1
+    ((2, 16, 16), 0.0)
     """
-    arr = as_array(image, "image")
-    if arr.ndim != 2:
-        raise ValueError(f"image: expected a 2D image, got {arr.ndim} dimensions")
-    if arr.dtype.kind not in "biuf":
-        raise TypeError(f"image: expected a real or boolean array, got dtype {arr.dtype}")
-    if 0 in arr.shape:
-        raise ValueError(f"image: array is empty (shape {arr.shape})")
+    if array_kind(image) == "numpy":
+        image = as_array(image, "image")
+        if image.dtype == bool:
+            image = image.astype(np.uint8)
+    arr, image = _select_band(image, None)
     w = _check_window(window_size, arr.shape)
     nodata = check_nodata(nodata)
-    z = np.array(arr, dtype=np.float64)
-    if nodata is not None:
-        z[arr == nodata] = np.nan
-    if np.isnan(z).all():
-        raise ValueError("image: no valid value (all NaN or nodata)")
-    if (z[~np.isnan(z)] < 0).any():
-        raise ValueError("image: lacunarity needs non-negative masses (e.g. intensity, not dB)")
     if box_sizes is None:
         sizes = [r for r in (1, 2, 4, 8) if r <= w]
     else:
@@ -493,5 +465,29 @@ def lacunarity_map(
             raise ValueError(f"box_sizes: box sides must be in [1, {w}], got {sizes}")
     if isinstance(min_valid, bool) or not np.isscalar(min_valid) or not (0.0 <= float(min_valid) <= 1.0):
         raise ValueError(f"min_valid: expected a fraction in [0, 1], got {min_valid!r}")
-    return _core.lacunarity_transform_map(np.ascontiguousarray(z), w, sizes, float(min_valid),
-                                          check_n_threads(n_threads))
+    min_valid = float(min_valid)
+    n_threads = check_n_threads(n_threads)
+
+    def prepare(block):
+        z = np.array(block, dtype=np.float64)
+        if nodata is not None:
+            z[block == nodata] = np.nan
+        return z
+
+    def kernel(z):
+        return _core.lacunarity_transform_map(np.ascontiguousarray(z), w, sizes, min_valid, n_threads)
+
+    if array_kind(arr) == "dask":
+        data = arr.astype(np.float64)
+        image = image.copy(data=data) if array_kind(image) == "xarray" else data
+        prep = prepare
+    else:
+        z = prepare(arr)
+        if np.isnan(z).all():
+            raise ValueError("image: no valid value (all NaN or nodata)")
+        if (z[~np.isnan(z)] < 0).any():
+            raise ValueError("image: lacunarity needs non-negative masses (e.g. intensity, not dB)")
+        image = image.copy(data=z) if array_kind(image) == "xarray" else z
+        prep = None
+    return run_raster(kernel, image, depth=w // 2, n_out=len(sizes), prepare=prep,
+                      names=("lacunarity",), stack_dim=("box_size", sizes))

@@ -60,6 +60,15 @@ def segment(
     ----------
     Otsu, N. (1979). A threshold selection method from gray-level histograms.
     *IEEE Trans. SMC* 9(1), 62-66.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> img = np.array([[0.1, 0.2, 2.0, 2.1], [0.0, 0.3, 1.9, 2.2]])
+    >>> fg.segment(img).tolist()  # Otsu: two classes
+    [[0, 0, 1, 1], [0, 1, 1, 1]]
+    >>> fg.segment([img, -img], method='kmeans', n_classes=2, seed=0).tolist()
+    [[0, 0, 1, 1], [0, 0, 1, 1]]
     """
     check_choice(method, "method", ("otsu", "kmeans"))
     X = _stack(features)
