@@ -26,6 +26,7 @@ pub mod io;
 pub mod lsystem;
 pub mod parallel;
 pub mod synth;
+pub mod tin;
 pub mod transform;
 
 #[cfg(feature = "python")]

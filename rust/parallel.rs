@@ -25,6 +25,20 @@ use std::sync::{Arc, Mutex};
 
 use crate::error::{CoreError, CoreResult};
 
+/// At most this many threads per available core (the Python layer checks
+/// the same cap first, see `_validation.check_n_threads`).
+pub const MAX_THREADS_PER_CORE: usize = 4;
+
+/// The cap never goes below this many threads (so a thread count chosen on
+/// a larger machine still runs on a small one).
+pub const MIN_THREAD_CAP: usize = 16;
+
+/// The largest `n_threads` accepted: [`MAX_THREADS_PER_CORE`] times the
+/// cores, at least [`MIN_THREAD_CAP`].
+pub fn max_threads() -> usize {
+    (MAX_THREADS_PER_CORE * resolve_threads(None)).max(MIN_THREAD_CAP)
+}
+
 /// Resolve `n_threads`: `None` or `Some(0)` means all available cores
 /// (looked up once per process: on Linux the lookup reads cgroup files,
 /// which costs as much as a small kernel).
@@ -61,7 +75,12 @@ fn build_pool(n: usize) -> CoreResult<rayon::ThreadPool> {
     rayon::ThreadPoolBuilder::new()
         .num_threads(n)
         .build()
-        .map_err(|e| CoreError::Internal(format!("cannot start a thread pool of {n}: {e}")))
+        .map_err(|e| {
+            CoreError::System(format!(
+                "n_threads: the operating system refused to start {n} threads ({e}); \
+                 use fewer threads (n_threads=None uses one per core)"
+            ))
+        })
 }
 
 /// A kept pool of `n` threads, built on first use: shared by the process
@@ -120,6 +139,16 @@ where
     F: FnOnce() -> CoreResult<T> + Send,
 {
     let n = resolve_threads(n_threads);
+    if n > max_threads() {
+        return Err(CoreError::invalid(
+            "n_threads",
+            format!(
+                "expected at most {} ({MAX_THREADS_PER_CORE} per available core, at least \
+                 {MIN_THREAD_CAP}), got {n}",
+                max_threads()
+            ),
+        ));
+    }
     let run = || std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
     // already on a worker of a pool of this size (a kernel calling a kernel):
     // run here rather than keep pools in the worker's thread
@@ -160,6 +189,16 @@ mod tests {
             run_in_pool(Some(1), || Ok(rayon::current_num_threads())).unwrap(),
             1
         );
+    }
+
+    #[test]
+    fn too_many_threads_is_a_clear_error() {
+        let r: CoreResult<()> = run_in_pool(Some(max_threads() + 1), || Ok(()));
+        match r {
+            Err(CoreError::InvalidArgument { param, .. }) => assert_eq!(param, "n_threads"),
+            other => panic!("expected InvalidArgument, got {other:?}"),
+        }
+        assert_eq!(run_in_pool(Some(max_threads()), || Ok(1)).unwrap(), 1);
     }
 
     #[test]

@@ -80,6 +80,15 @@ CASES = {
         a, 2, 0.5, 1.0, 1.0, 0.0625, [0.5, 0.5, 0.5, 0.5], False, 3)),
     "davies_harte_fbm": (np.sqrt(np.linspace(1.0, 2.0, 65)), lambda a: _core.davies_harte_fbm(a, 64, 1, 0)),
     "hillshade_f64": (IMG, lambda a: _core.hillshade_f64(a, [1.0] * a.shape[0], 1.0, 315.0, 45.0, 1.0, False)),
+    "hillshade_gdal_byte": (IMG.astype(np.float32), lambda a: _core.hillshade_gdal_byte(a, 1.0, 1.0, 315.0, 45.0, 1.0, False)),
+    "fractal_resample": (IMG[:16, :12], lambda a: _core.fractal_resample(
+        a, np.full(a.shape, 0.6) + 0.01 * a / a.max(), np.full(a.shape, 1.0), 1, False, 5, [True])),
+    "tin_delaunay": (rng.random((60, 3)), lambda a: _core.tin_delaunay(a)),
+    "tin_greedy": (IMG[:20, :17].copy(), lambda a: _core.tin_greedy(a, 0.5)),
+    "tin_grid": (rng.random((60, 2)) * 10, lambda a: _core.tin_grid(
+        a, np.sin(a[:, 0]) + a[:, 1], 8, 9, [0.0, 1.0, 0.0, 0.0, 0.0, 1.0], "natural")),
+    "tin_rasterize": (np.array([[0.0, 0.0], [7.0, 0.0], [0.0, 6.0], [7.0, 6.0]]), lambda a: _core.tin_rasterize(
+        a, np.array([1.0, 2.0, 3.0, 4.0]), np.array([[0, 1, 2], [1, 3, 2]], np.int64), 7, 8)),
     "shade_to_byte": (np.abs(np.sin(IMG)).astype(np.float32), lambda a: _core.shade_to_byte(a)),
     "write_exr": (IMG.astype(np.float32), lambda a: _file_bytes(_core.write_exr, a, ".exr")),
     "write_mesh": (rng.random((3, 3)).astype(np.float32), _mesh),

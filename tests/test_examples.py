@@ -38,3 +38,16 @@ def test_urban_mask_is_bright_double_bounce_and_reproducible(urban):
     assert not np.array_equal(m, r["mask_without_dimension"])
     again = urban["built_up"]()
     assert np.array_equal(again["mask"], m)
+
+
+def test_fractal_resampling_example(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    mod = runpy.run_path(os.path.join(ROOT, "examples", "fractal_resampling.py"))
+    out = tmp_path / "r.png"
+    r = mod["main"](["--out", str(out)])
+    with open(out, "rb") as f:
+        assert f.read(8) == b"\x89PNG\r\n\x1a\n"
+    assert "hillshade roughness" in capsys.readouterr().out
+    # bicubic is smoother than the real DEM, the fractal resampling is not
+    assert r["bicubic"]["lag1"] < 0.9 and r["fractal"]["lag1"] > 1.0
+    assert r["bicubic"]["roughness"] < r["real"]["roughness"] < r["fractal"]["roughness"]

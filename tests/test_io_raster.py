@@ -69,7 +69,7 @@ def test_atomic_write_leaves_old_file_on_failure(tmp_path):
     p = tmp_path / "a.npy"
     write_raster(p, np.ones((2, 2)))
     with pytest.raises(ValueError):
-        write_raster(tmp_path / "a.png", np.ones((2, 2), dtype=np.uint8), crs="EPSG:4326")
+        write_raster(tmp_path / "a.exr", np.ones((2, 2), dtype=np.float32), crs="EPSG:4326")
     with pytest.raises(TypeError):
         write_raster(p, None)
     np.testing.assert_array_equal(read_raster(p)[0], np.ones((2, 2)))

@@ -39,8 +39,10 @@ from fractalgeo_rs.dimension import (
 from fractalgeo_rs.lsystem import IFS, LString, LSystem
 from fractalgeo_rs.transform import fractal_transform, lacunarity_map, segment
 from fractalgeo_rs.synth import fbm, fbm_surface, validate_surface, SurfaceReport, synthetic_dem  # noqa: E402
-from fractalgeo_rs.dem import hillshade, lakes  # noqa: E402
+from fractalgeo_rs.dem import fractal_resample, hillshade, lakes  # noqa: E402
 from fractalgeo_rs.io import read_raster, write_raster  # noqa: E402
+from fractalgeo_rs import tin  # noqa: E402
+from fractalgeo_rs.tin import TIN, delaunay, grid_from_points, tin_from_dem  # noqa: E402
 
 __all__ = [
     "__version__",
@@ -82,6 +84,13 @@ __all__ = [
     "synthetic_dem",
     "hillshade",
     "lakes",
+    "fractal_resample",
     "read_raster",
     "write_raster",
+    # tin
+    "tin",
+    "TIN",
+    "delaunay",
+    "grid_from_points",
+    "tin_from_dem",
 ]

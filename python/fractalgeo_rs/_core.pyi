@@ -22,8 +22,10 @@ __all__ = [
     "dbc_count",
     "dbc_transform_map",
     "fgn_sqrt_eigenvalues",
+    "fractal_resample",
     "higuchi_lengths",
     "hillshade_f64",
+    "hillshade_gdal_byte",
     "ifs_chaos_game",
     "ifs_check",
     "ifs_iterate",
@@ -49,6 +51,7 @@ __all__ = [
     "write_exr",
     "write_mesh",
     "write_png",
+    "resample_stencil",
 ]
 
 # ---- dimension ----
@@ -144,6 +147,16 @@ def hillshade_f64(
     multidirectional: bool,
     n_threads: Optional[int] = None,
 ) -> npt.NDArray[np.float32]: ...
+def hillshade_gdal_byte(
+    dem: npt.NDArray[np.float32],
+    dx: float,
+    dy: float,
+    azimuth: float,
+    altitude: float,
+    z_factor: float,
+    multidirectional: bool,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.uint8]: ...
 def shade_to_byte(shade: npt.NDArray[np.float32], n_threads: Optional[int] = None) -> npt.NDArray[np.uint8]: ...
 def read_exr(path: str | PathLike[str]) -> npt.NDArray[np.float32]: ...
 def write_exr(path: str | PathLike[str], image: npt.NDArray[np.float32]) -> None: ...
@@ -296,5 +309,54 @@ def mass_curve_image(
     image: npt.NDArray[np.float64],
     box_sizes: Sequence[int],
     z_scale: float,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...
+
+
+# --- dem: fractal resampling ---
+RESAMPLE_HALO: int
+
+def fractal_resample(
+    dem: npt.NDArray[np.float64],
+    hurst: npt.NDArray[np.float64],
+    sigma: npt.NDArray[np.float64],
+    levels: int,
+    area: bool,
+    seed: int,
+    detail: Sequence[bool],
+    origin: Tuple[int, int] = (0, 0),
+    global_cols: int = 0,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...
+def resample_stencil(
+    which: int, hurst: float
+) -> Tuple[list[float], float, list[Tuple[int, int]]]: ...
+def tin_delaunay(
+    points: npt.NDArray[np.float64],
+    constraints: Optional[npt.NDArray[np.int64]] = None,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.int64]: ...
+def tin_greedy(
+    dem: npt.NDArray[np.float64],
+    max_error: float,
+    max_triangles: Optional[int] = None,
+    shared_edges: bool = True,
+    n_threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.int64], npt.NDArray[np.float64], npt.NDArray[np.int64], float]: ...
+def tin_grid(
+    points: npt.NDArray[np.float64],
+    values: npt.NDArray[np.float64],
+    rows: int,
+    cols: int,
+    transform: Sequence[float],
+    method: str,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...
+def tin_rasterize(
+    xy: npt.NDArray[np.float64],
+    z: npt.NDArray[np.float64],
+    triangles: npt.NDArray[np.int64],
+    rows: int,
+    cols: int,
     n_threads: Optional[int] = None,
 ) -> npt.NDArray[np.float64]: ...

@@ -4,6 +4,11 @@ Each domain adds its subcommands from its own ``_cli`` module, listed in
 ``_DOMAIN_CLIS``: the module has ``add_parsers(subparsers)`` which registers
 subparsers whose ``func`` attribute takes the parsed ``args`` and returns an
 exit code.
+
+Exit codes: 0 success; 1 a user error (bad argument value, unreadable or
+unwritable file, a request above the memory limit, a missing optional
+dependency), reported as one line on stderr (``--debug`` shows the
+traceback); 2 a command-line usage error (argparse); 130 interrupted.
 """
 from __future__ import annotations
 
@@ -13,10 +18,12 @@ import sys
 from typing import Optional, Sequence
 
 _DOMAIN_CLIS = (
+    "fractalgeo_rs.dem._cli",
     "fractalgeo_rs.dimension._cli",
     "fractalgeo_rs.lsystem._cli",
     "fractalgeo_rs.synth._cli",
     "fractalgeo_rs.transform._cli",
+    "fractalgeo_rs.tin._cli",
     # each issue adds its domain's _cli module here
 )
 
@@ -29,6 +36,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Fractal geometry for geo-information processing (fractalgeo_rs).",
     )
     parser.add_argument("--version", action="version", version=f"fractalgeo_rs {__version__}")
+    parser.add_argument("--debug", action="store_true",
+                        help="show the full traceback of an error instead of one line")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in _DOMAIN_CLIS:
         importlib.import_module(name).add_parsers(sub)
@@ -43,9 +52,35 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         return 2
     try:
         return int(args.func(args) or 0)
-    except (ValueError, TypeError, OSError) as exc:
+    except KeyboardInterrupt:
+        if args.debug:
+            raise
+        print(f"fractalgeo {args.command}: interrupted", file=sys.stderr)
+        return 130
+    except ModuleNotFoundError as exc:
+        if args.debug:
+            raise
+        print(f"fractalgeo {args.command}: error: {missing_dependency_message(exc)}", file=sys.stderr)
+        return 1
+    except (ValueError, TypeError, OSError, MemoryError) as exc:
+        if args.debug:
+            raise
         print(f"fractalgeo {args.command}: error: {exc}", file=sys.stderr)
         return 1
+
+
+#: Optional dependencies and the extra that installs them.
+_EXTRAS = {"dask": "dask", "distributed": "dask", "xarray": "dask", "rasterio": "geo",
+           "matplotlib": "plot"}
+
+
+def missing_dependency_message(exc: ModuleNotFoundError) -> str:
+    """One line naming the missing module and the extra that installs it."""
+    name = (exc.name or "").split(".")[0]
+    extra = _EXTRAS.get(name)
+    if extra is None:
+        return f"missing module {name or exc}: {exc}"
+    return f"this needs {name}, which is not installed: pip install \"fractalgeo_rs[{extra}]\""
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,6 +1,8 @@
-//! Bindings of `crate::dem`.
+//! Bindings of `crate::dem`: shaded relief and fractal resampling.
 use super::convert::{array2, c_order, run};
 use crate::dem::hillshade::{self, ShadeParams};
+use crate::dem::resample::{self, ResampleParams, Support};
+use crate::error::CoreError;
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
 
@@ -30,6 +32,35 @@ fn hillshade_f64<'py>(
     Ok(v.into_pyarray(py))
 }
 
+/// `gdaldem hillshade -compute_edges` bytes of a float32 DEM (NaN = nodata)
+/// with cells `dx` by `dy`, bit for bit.
+#[pyfunction]
+#[pyo3(signature = (dem, dx, dy, azimuth, altitude, z_factor, multidirectional, n_threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn hillshade_gdal_byte<'py>(
+    py: Python<'py>,
+    dem: PyReadonlyArray2<'py, f32>,
+    dx: f64,
+    dy: f64,
+    azimuth: f64,
+    altitude: f64,
+    z_factor: f64,
+    multidirectional: bool,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray2<u8>>> {
+    let z = dem.as_array();
+    let p = ShadeParams {
+        azimuth,
+        altitude,
+        z_factor,
+        multidirectional,
+    };
+    let v = run(py, n_threads, || {
+        hillshade::hillshade_gdal_byte(z, dx, dy, &p)
+    })?;
+    Ok(v.into_pyarray(py))
+}
+
 /// GDAL's byte encoding of a reflectance array: round(1 + 254 L), 0 for NaN.
 #[pyfunction]
 #[pyo3(signature = (shade, n_threads=None))]
@@ -43,8 +74,69 @@ fn shade_to_byte<'py>(
     array2(py, a.rows_cols(), b)
 }
 
+/// Fractal resampling by `2^levels`; `detail[l]` turns the residual of level
+/// `l` on. `origin` and `global_cols` place a tile in the whole input grid.
+#[pyfunction]
+#[pyo3(signature = (dem, hurst, sigma, levels, area, seed, detail, origin=(0, 0), global_cols=0, n_threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn fractal_resample<'py>(
+    py: Python<'py>,
+    dem: PyReadonlyArray2<'py, f64>,
+    hurst: PyReadonlyArray2<'py, f64>,
+    sigma: PyReadonlyArray2<'py, f64>,
+    levels: u32,
+    area: bool,
+    seed: u64,
+    detail: Vec<bool>,
+    origin: (u64, u64),
+    global_cols: u64,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let (d, h, s) = (dem.as_array(), hurst.as_array(), sigma.as_array());
+    let p = ResampleParams {
+        levels,
+        support: if area { Support::Area } else { Support::Point },
+        seed,
+        detail,
+        origin,
+        global_cols: if global_cols == 0 {
+            d.dim().1 as u64
+        } else {
+            global_cols
+        },
+    };
+    let out = run(py, n_threads, || resample::resample(d, h, s, &p))?;
+    Ok(out.into_pyarray(py))
+}
+
+/// Full-stencil kriging weights (16) and residual standard deviation (unit
+/// sigma, coarse spacing 1) of stencil `which` (0 diamond, 1 square, 2-5 area
+/// quadrants) at `hurst`, and the stencil's source offsets.
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn resample_stencil(
+    py: Python<'_>,
+    which: usize,
+    hurst: f64,
+) -> PyResult<(Vec<f64>, f64, Vec<(isize, isize)>)> {
+    run(py, Some(1), || {
+        let st = match which {
+            0 => resample::diamond_stencil(),
+            1 => resample::square_stencil(),
+            2..=5 => resample::area_stencil((which - 2) / 2, (which - 2) % 2),
+            _ => return Err(CoreError::invalid("which", "expected 0 to 5")),
+        };
+        let (w, sd) = resample::table_at(which, hurst);
+        Ok((w.to_vec(), sd, st.offsets.to_vec()))
+    })
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(hillshade_f64, m)?)?;
     m.add_function(wrap_pyfunction!(shade_to_byte, m)?)?;
+    m.add_function(wrap_pyfunction!(hillshade_gdal_byte, m)?)?;
+    m.add_function(wrap_pyfunction!(fractal_resample, m)?)?;
+    m.add_function(wrap_pyfunction!(resample_stencil, m)?)?;
+    m.add("RESAMPLE_HALO", resample::HALO)?;
     Ok(())
 }

@@ -3,7 +3,7 @@
 //! kernel (`py.detach`), runs it in a pool of `n_threads` and maps the error.
 //! Nothing else lives here.
 use crate::error::CoreError;
-use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyMemoryError, PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 
 pub mod convert;
@@ -12,13 +12,15 @@ mod dimension;
 mod io;
 mod lsystem;
 mod synth;
+mod tin;
 mod transform;
 
 impl From<CoreError> for PyErr {
     fn from(e: CoreError) -> PyErr {
         match e {
             CoreError::InvalidArgument { .. } => PyValueError::new_err(e.to_string()),
-            CoreError::Io(_) => PyOSError::new_err(e.to_string()),
+            CoreError::Io(_) | CoreError::System(_) => PyOSError::new_err(e.to_string()),
+            CoreError::OutOfMemory { .. } => PyMemoryError::new_err(e.to_string()),
             CoreError::Internal(_) => PyRuntimeError::new_err(e.to_string()),
         }
     }
@@ -33,5 +35,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     synth::register(m)?;
     lsystem::register(m)?;
     transform::register(m)?;
+    tin::register(m)?;
     Ok(())
 }

@@ -20,7 +20,7 @@ fn normal_noise<'py>(
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let v = run(py, n_threads, || {
-        let mut v = vec![0.0; n];
+        let mut v = crate::buffers::try_zeroed(n, "n")?;
         rng::fill_normal(&mut v, seed, stream, start);
         Ok(v)
     })?;

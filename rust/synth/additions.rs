@@ -407,7 +407,8 @@ pub fn refine_2d_window(
         origin: p.origin,
         gc: p.global_cols.max(p.origin.1 + fc as u64),
     };
-    let mut fine = crate::buffers::zeroed(or * oc);
+    let mut fine =
+        crate::buffers::try_zeroed(crate::buffers::checked_len(or, oc, "shape")?, "shape")?;
     fine.par_chunks_mut(2 * BLOCK_PAIRS * oc)
         .enumerate()
         .for_each_init(

@@ -63,12 +63,14 @@ pub fn fgn_sqrt_eigenvalues(m: usize, hurst: f64) -> CoreResult<Vec<f64>> {
         let k = k as f64;
         0.5 * ((k + 1.0).powf(h2) - 2.0 * k.powf(h2) + (k - 1.0).abs().powf(h2))
     };
-    let n = 2 * m;
-    let mut row: Vec<f64> = (0..n)
-        .into_par_iter()
+    let n = m
+        .checked_mul(2)
+        .ok_or_else(|| CoreError::out_of_memory("m", m, 16))?;
+    let mut row = crate::buffers::try_zeroed(n, "m")?;
+    row.par_iter_mut()
         .with_min_len(1 << 14)
-        .map(|t| g(if t <= m { t } else { n - t }))
-        .collect();
+        .enumerate()
+        .for_each(|(t, v)| *v = g(if t <= m { t } else { n - t }));
     let r2c = forward(n);
     let mut spec = r2c.make_output_vec();
     r2c.process(&mut row, &mut spec)
@@ -114,7 +116,8 @@ pub fn fbm_from_eigenvalues(
     }
     let key = StreamKey::new(seed, stream);
     let half = std::f64::consts::FRAC_1_SQRT_2;
-    let mut spec: Vec<Complex<f64>> = vec![Complex::new(0.0, 0.0); m + 1];
+    let mut spec: Vec<Complex<f64>> =
+        crate::buffers::try_filled(m + 1, Complex::new(0.0, 0.0), "n")?;
     spec.par_iter_mut()
         .with_min_len(1 << 13)
         .enumerate()
@@ -134,7 +137,7 @@ pub fn fbm_from_eigenvalues(
     let mut inc = c2r.make_output_vec();
     c2r.process(&mut spec, &mut inc)
         .map_err(|e| CoreError::Internal(format!("fft: {e}")))?;
-    let mut x = Vec::with_capacity(n);
+    let mut x = crate::buffers::try_with_capacity(n, "n")?;
     x.push(0.0);
     let mut acc = 0.0;
     for v in &inc[..n - 1] {

@@ -113,7 +113,7 @@ pub fn refine_1d(coarse: &[f64], p: &RefineParams) -> CoreResult<Vec<f64>> {
     let kd = key(p, PHASE_DISPLACE);
     let ka = key(p, PHASE_ADD);
     let o = p.origin.1;
-    let mut out = vec![0.0; m];
+    let mut out = crate::buffers::try_zeroed(m, "n")?;
     out.par_chunks_mut(1 << 12)
         .enumerate()
         .for_each(|(ci, chunk)| {
@@ -188,7 +188,8 @@ pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2
     let add = p.additions;
 
     // Pass A (diamond step): old samples and cell centres, row by row.
-    let mut fine = crate::buffers::zeroed(fr * fc);
+    let mut fine =
+        crate::buffers::try_zeroed(crate::buffers::checked_len(fr, fc, "shape")?, "shape")?;
     fine.par_chunks_mut(fc).enumerate().for_each(|(i, row)| {
         let gbase = (o0 + i as u64) * gc + o1;
         let a = i / 2;

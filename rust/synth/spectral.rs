@@ -272,7 +272,7 @@ pub fn filter_2d(n0: usize, n1: usize, hurst: f64) -> CoreResult<Array2<f64>> {
     // Rows k0 and n0 - k0 are equal: compute rows 0 ..= n0/2 (with their
     // lag-one sums, counted twice for the mirrored rows), mirror at the end.
     let half = n0 / 2 + 1;
-    let mut a2 = vec![0.0f64; n0 * m];
+    let mut a2 = crate::buffers::try_zeroed(crate::buffers::checked_len(n0, m, "shape")?, "shape")?;
     let per_row: Vec<(f64, f64)> = a2[..half * m]
         .par_chunks_mut(m)
         .enumerate()

@@ -1,5 +1,12 @@
-"""DEM tools: shaded relief, lakes and coastlines, synthetic DEMs."""
+"""DEM tools: shaded relief, lakes and coastlines, fractal resampling."""
 from fractalgeo_rs.dem._hillshade import hillshade, metres_per_degree, shade_to_byte
 from fractalgeo_rs.dem._lakes import Lakes, lakes
+from fractalgeo_rs.dem._resample import (
+    HURST_RANGE,
+    ResampleAnalysis,
+    fractal_resample,
+    resample_analysis,
+)
 
-__all__ = ["hillshade", "shade_to_byte", "metres_per_degree", "lakes", "Lakes"]
+__all__ = ["hillshade", "shade_to_byte", "metres_per_degree", "lakes", "Lakes", "fractal_resample", "resample_analysis",
+           "ResampleAnalysis", "HURST_RANGE"]

@@ -6,7 +6,7 @@ import numbers
 import numpy as np
 
 from fractalgeo_rs import _core
-from fractalgeo_rs._validation import as_array, check_n_threads, check_nodata
+from fractalgeo_rs._validation import as_array, check_n_threads, check_nodata, check_real_array, check_z_factor
 
 __all__ = ["hillshade", "shade_to_byte", "metres_per_degree"]
 
@@ -69,8 +69,15 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
     GDAL's combination of azimuths 225, 270, 315 and 360 weighted by
     ``sin^2(aspect - azimuth)`` (Mark 1992).
 
-    Edges and nodata neighbours take the centre value (like ``gdaldem
-    -compute_edges``); a nodata cell gives NaN.
+    Edges follow ``gdaldem hillshade -compute_edges``: a neighbour outside
+    the grid is extrapolated linearly from the two cells inward (``2a - b``;
+    in the first and last rows the columns beyond the corners repeat the
+    centre column), a nodata neighbour or an extrapolation from one takes
+    the centre value, a nodata cell gives NaN. With ``byte=True`` (and no
+    ``latitude``) the bytes are those of ``gdaldem hillshade -compute_edges``
+    on the float32 DEM, bit for bit (float32 window sums and GDAL's
+    reciprocal square root; tests/test_dem_hillshade.py compares every
+    pixel with the ``gdaldem`` binary).
 
     Parameters
     ----------
@@ -82,7 +89,8 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
         Cell size, or ``(row spacing, column spacing)``, in the height units
         (metres for a DEM in metres), or in degrees when ``latitude`` is given.
     z_factor : float
-        Vertical exaggeration (and height-unit conversion).
+        Vertical exaggeration (and height-unit conversion), ``> 0`` (a
+        negative factor would invert the relief).
     nodata : float or None
         Height value meaning "no data" (NaN is always nodata).
     multidirectional : bool
@@ -92,7 +100,9 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
         each row's centre. ``cell_size`` is then in degrees and converted to
         metres per row with :func:`metres_per_degree` (WGS84).
     byte : bool
-        Return GDAL's 8-bit encoding (:func:`shade_to_byte`) instead.
+        Return GDAL's 8-bit encoding instead: ``1 + 254 L``, 0 at nodata,
+        computed as ``gdaldem hillshade -compute_edges`` does (float32 heights);
+        with ``latitude`` it is :func:`shade_to_byte` of the reflectance.
     n_threads : int or None
         Threads of the Rust kernel.
 
@@ -115,10 +125,10 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
     >>> round(float(s[1, 1]), 4)  # flat ground: sin(45 deg)
     0.7071
     """
-    z = as_array(dem, "dem")
+    z = check_real_array(dem, "dem")
     if z.ndim != 2 or min(z.shape) < 1:
         raise ValueError(f"dem: expected a non-empty 2D array, got shape {z.shape}")
-    if z.dtype == bool or not np.issubdtype(z.dtype, np.number):
+    if z.dtype == bool:
         raise TypeError(f"dem: expected a numeric array, got dtype {z.dtype}")
     if nodata is None:
         z = np.ascontiguousarray(z, dtype=np.float64)  # the kernel only reads it
@@ -127,9 +137,10 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
     nodata = check_nodata(nodata)
     if nodata is not None:
         z[z == nodata] = np.nan
-    for name, v in (("azimuth", azimuth), ("altitude", altitude), ("z_factor", z_factor)):
+    for name, v in (("azimuth", azimuth), ("altitude", altitude)):
         if isinstance(v, bool) or not isinstance(v, numbers.Real) or not np.isfinite(v):
             raise ValueError(f"{name}: expected a finite number, got {v!r}")
+    z_factor = check_z_factor(z_factor)
     if not 0 <= altitude <= 90:
         raise ValueError(f"altitude: expected degrees in [0, 90], got {altitude}")
     dy, dx = _pair(cell_size)
@@ -146,6 +157,10 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
         dx_rows = dx * m_lon
         dy = dy * float(np.mean(m_lat))
     n_threads = check_n_threads(n_threads)
+    if byte and latitude is None:
+        return _core.hillshade_gdal_byte(np.ascontiguousarray(z, dtype=np.float32), float(dx), float(dy),
+                                         float(azimuth), float(altitude), float(z_factor),
+                                         bool(multidirectional), n_threads)
     s = _core.hillshade_f64(z, dx_rows.tolist(), float(dy), float(azimuth), float(altitude),
                             float(z_factor), bool(multidirectional), n_threads)
     return _core.shade_to_byte(s, n_threads) if byte else s

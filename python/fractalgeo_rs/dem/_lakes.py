@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fractalgeo_rs._validation import as_array
+from fractalgeo_rs._validation import as_array, check_nodata
 
 __all__ = ["Lakes", "lakes"]
 
@@ -88,6 +88,7 @@ def lakes(dem, level, *, closed_only=False, nodata=None, coastlines=True):
     if isinstance(level, bool) or not isinstance(level, numbers.Real) or not np.isfinite(level):
         raise ValueError(f"level: expected a finite number, got {level!r}")
     level = float(level)
+    nodata = check_nodata(nodata)
     valid = np.isfinite(z) if np.issubdtype(z.dtype, np.floating) else np.ones(z.shape, dtype=bool)
     if nodata is not None:
         valid &= z != nodata

@@ -3,10 +3,12 @@ from __future__ import annotations
 
 import argparse
 
+from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads
+
 
 def add_parsers(sub) -> None:
     p = sub.add_parser(
-        "dimension",
+        "dimension", formatter_class=HelpFormatter,
         help="estimate the fractal dimension of a raster file",
         description=(
             "Estimate the fractal dimension of a raster: GeoTIFF (needs the geo extra: rasterio), "
@@ -16,8 +18,9 @@ def add_parsers(sub) -> None:
     )
     p.add_argument("path", help="raster file (.tif, .tiff, .png, .npy, .exr)")
     p.add_argument("--method", default=None, choices=["box", "dbc", "affine"],
-                   help="estimator (default: box for bool/0-1 data, else dbc)")
-    p.add_argument("--band", type=int, default=1, help="band to read (1-based, default 1)")
+                   help="estimator (default: box for a binary mask: bool, or integers with 0 and at most one "
+                        "other value such as 0/1 and 0/255 PNGs; else dbc)")
+    p.add_argument("--band", type=int, default=None, help="band to read (1-based; None: the file's only band)")
     p.add_argument("--threshold", type=float, default=None,
                    help="for --method box: foreground is value > THRESHOLD")
     p.add_argument("--box-sizes", default=None, help="comma-separated box sizes in samples")
@@ -25,10 +28,10 @@ def add_parsers(sub) -> None:
     p.add_argument("--scale-range", default=None,
                    help="'auto' or LOW,HIGH: box sizes used in the fit (default all)")
     p.add_argument("--plot", default=None, metavar="PNG", help="write the log-log plot to this PNG")
-    p.add_argument("--threads", type=int, default=None, help="threads (default: all cores)")
+    add_n_threads(p)
     p.set_defaults(func=_run_dimension)
 
-    d = sub.add_parser("demo", help="run the demo on bundled real data and write a figure",
+    d = sub.add_parser("demo", formatter_class=HelpFormatter, help="run the demo on bundled real data and write a figure",
                        description="Box-counting dimensions of real data bundled with the package "
                                    "(SRTM DEM of the Alps, Kilauea coastline, Sentinel-1 backscatter); "
                                    "prints the fits and writes a PNG figure.")
@@ -52,7 +55,7 @@ def _run_dimension(args: argparse.Namespace) -> int:
     import numpy as np
 
     from fractalgeo_rs.dimension import dimension
-    from fractalgeo_rs.io import read_raster
+    from fractalgeo_rs.io import is_binary_mask, read_raster
 
     data, profile = read_raster(args.path, band=args.band)
     nodata = (profile or {}).get("nodata")
@@ -60,11 +63,11 @@ def _run_dimension(args: argparse.Namespace) -> int:
         data = np.where(data == nodata, np.nan, data.astype(np.float64))
     method = args.method
     if method is None:
-        is_binary = data.dtype == bool or (
-            data.dtype.kind in "iu" and data.size > 0 and np.isin(np.unique(data), (0, 1)).all()
-        )
+        is_binary = is_binary_mask(data)
         method = "box" if is_binary or args.threshold is not None else "dbc"
-    opts = {"n_threads": args.threads, "scale_range": _parse_range(args.scale_range)}
+        if is_binary and args.threshold is None and data.dtype != bool:
+            data = data != 0  # a 0/1 or 0/255 mask: the nonzero value is the foreground
+    opts = {"n_threads": args.n_threads, "scale_range": _parse_range(args.scale_range)}
     if args.box_sizes:
         try:
             opts["box_sizes"] = [int(v) for v in args.box_sizes.split(",")]
@@ -102,5 +105,5 @@ def _run_dimension(args: argparse.Namespace) -> int:
 def _run_demo(args: argparse.Namespace) -> int:
     from fractalgeo_rs.demo import run_demo
 
-    run_demo(args.out)
+    run_demo(args.out)  # prints the fits and the paths it wrote (shown in the README)
     return 0

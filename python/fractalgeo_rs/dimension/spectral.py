@@ -123,8 +123,14 @@ def spectral_dimension(
         raise ValueError(f"data: shape {z.shape} is too small for a spectrum (at least 8 samples per axis)")
     from scipy import fft
 
+    magnitude = float(np.max(np.abs(z)))
     if detrend:
         z = _detrend(z)
+    # degenerate data (constant, or a line/plane removed by the detrend): only
+    # rounding noise is left, whose white spectrum would give D = 2.5 or 4
+    if not np.ptp(z) > 1e-10 * max(magnitude, 1e-300):
+        raise ValueError("data: no variation left" + (" after removing the least-squares line/plane"
+                         if detrend else "") + " (constant or planar data has no fractal dimension)")
     z = z * _window(z.shape, window)
     if z.ndim == 1:
         power = np.abs(fft.rfft(z)) ** 2

@@ -29,7 +29,7 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from fractalgeo_rs._validation import as_array, check_choice, check_nodata, check_positive_float
+from fractalgeo_rs._validation import as_array, check_choice, check_integer_lags, check_nodata, check_positive_float
 from fractalgeo_rs.fit import DimensionFit, ScaleRange, check_domain, fit_loglog
 
 __all__ = ["power_variation", "variogram", "madogram", "surface_variation"]
@@ -62,9 +62,10 @@ def _with_nodata(z: np.ndarray, data, nodata) -> np.ndarray:
 
 def _check_lags(lags, n_max: int, name="lags") -> np.ndarray:
     try:
-        lg = np.asarray(sorted(set(int(v) for v in lags)), dtype=np.int64)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name}: expected a sequence of positive ints, got {lags!r}") from None
+        lg = np.asarray(check_integer_lags(lags, name, minimum=-(2**62)), dtype=np.int64)
+    except (TypeError, ValueError) as exc:
+        raise TypeError(f"{name}: expected a sequence of positive integer lags (1.5 is not a lag), "
+                        f"got {lags!r}") from exc
     if lg.size < 2:
         raise ValueError(f"{name}: need at least 2 distinct lags, got {lg.size}")
     if lg[0] < 1:

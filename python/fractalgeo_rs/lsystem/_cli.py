@@ -17,10 +17,12 @@ import os
 
 
 def add_parsers(sub) -> None:
+    from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads
+
     p = sub.add_parser(
-        "lsystem",
+        "lsystem", formatter_class=HelpFormatter,
         help="derive an L-system and write OBJ/PLY/SVG/PNG",
-        description="Derive an L-system from a rule file (see docs/lsystem.md) and write its geometry.",
+        description="Derive an L-system from a rule file (syntax: help(fractalgeo_rs.LSystem)) and write its geometry.",
     )
     p.add_argument("rules", help="rule file (axiom:, ignore:, key: value directives, A -> B productions)")
     p.add_argument("-n", type=int, default=None, help="derivation steps (default: the file's 'n', else 5)")
@@ -32,7 +34,7 @@ def add_parsers(sub) -> None:
     p.add_argument("--width", type=float, default=None, help="initial segment width")
     p.add_argument("--sides", type=int, default=None, help="sides of branch tubes")
     p.add_argument("--view", choices=("side", "top"), default="side", help="projection of the 3D preview")
-    p.add_argument("--threads", type=int, default=None, help="threads (default: all cores)")
+    add_n_threads(p)
     p.set_defaults(func=run)
 
 
@@ -75,7 +77,7 @@ def run(args: argparse.Namespace) -> int:
         elasticity=_opt(None, d, "elasticity", float, 0.0),
     )
     sides = _opt(args.sides, d, "sides", int, 6)
-    s = system.derive(n, n_threads=args.threads)
+    s = system.derive(n, n_threads=args.n_threads)
     ext = os.path.splitext(args.out)[1].lower() if args.out else ""
     if ext and ext not in (".obj", ".ply", ".svg"):
         raise ValueError(f"--out: expected a .obj, .ply or .svg file, got {args.out!r}")

@@ -3,14 +3,19 @@ from __future__ import annotations
 
 import functools
 import math
-import numbers
-import os
 
 import numpy as np
 import scipy.fft as sfft
 
 from fractalgeo_rs import _core
-from fractalgeo_rs._validation import check_choice, check_n_threads, check_positive_int
+from fractalgeo_rs._validation import (
+    MemoryLimitError,
+    check_choice,
+    check_memory,
+    check_n_threads,
+    check_positive_int,
+    resolve_max_memory,
+)
 from fractalgeo_rs.synth import _additions
 from fractalgeo_rs.synth import _common as c
 
@@ -27,7 +32,7 @@ def _noise(n, seed, stream, n_threads):
 
 # --------------------------------------------------------------------- 1D
 
-def fbm(n, hurst, *, method="exact", seed=None, sigma=1.0, n_threads=None):
+def fbm(n, hurst, *, method="exact", seed=None, sigma=1.0, n_threads=None, max_memory=None):
     r"""Sample fractional Brownian motion :math:`B_H` at ``n`` equally spaced times.
 
     The output starts at 0: ``x[0] = 0`` and ``x[k] = B_H(k)`` for
@@ -71,6 +76,13 @@ def fbm(n, hurst, *, method="exact", seed=None, sigma=1.0, n_threads=None):
         Standard deviation of the unit-lag increments (units of ``x``).
     n_threads : int or None
         Threads of the Rust kernels and of the FFT; ``None`` uses all cores.
+    max_memory : int or None
+        Limit in bytes for the working memory, estimated before anything is
+        allocated as ``BYTES_PER_SAMPLE_1D = 64`` bytes per sample (every
+        method; see ``fbm_memory_bytes``); above it a ``MemoryError`` (also a
+        ``ValueError``) naming ``n`` is raised. ``None``: the package default
+        (half the available memory, ``$FRACTALGEO_MAX_MEMORY`` to override;
+        docs/input_policy.md).
 
     Returns
     -------
@@ -98,6 +110,7 @@ def fbm(n, hurst, *, method="exact", seed=None, sigma=1.0, n_threads=None):
     seed = c.resolve_seed(seed)
     sigma = c.check_sigma(sigma)
     n_threads = check_n_threads(n_threads)
+    check_memory(fbm_memory_bytes(n), "n", max_memory=max_memory, what=f"n={n} samples")
     if method == "exact":
         x = _fbm_exact(n, h, seed, n_threads)
     elif method == "spectral":
@@ -107,6 +120,17 @@ def fbm(n, hurst, *, method="exact", seed=None, sigma=1.0, n_threads=None):
     x = x * sigma
     x -= x[0]
     return x
+
+
+#: Bytes per sample at the peak of ``fbm`` (any method): the noise or the
+#: spectrum (16), the FFT or refinement buffers (8 per sample of a length up
+#: to twice ``n``), the cumulated path and the scaled copy (16).
+BYTES_PER_SAMPLE_1D = 64
+
+
+def fbm_memory_bytes(n):
+    """Estimated peak working memory (bytes) of ``fbm(n, ...)``."""
+    return BYTES_PER_SAMPLE_1D * int(n)
 
 
 def fgn_autocovariance(k, hurst):
@@ -264,11 +288,14 @@ def fbm_surface(shape, hurst, *, method="exact", seed=None, cell_size=1.0, sigma
     n_threads : int or None
         Threads for the Rust kernels and the FFTs; ``None`` = all cores.
     max_memory : int or None
-        Limit in bytes for the working memory of ``"exact"``, estimated
-        before anything is allocated as 48 bytes per cell of the embedding
-        torus (see ``exact_memory_bytes``); above it a ``ValueError`` naming
-        ``shape`` is raised. ``None``: half the physical memory (4 GiB when
-        it cannot be read). Ignored by the other methods.
+        Limit in bytes for the working memory, estimated before anything is
+        allocated (``surface_memory_bytes``): 48 bytes per cell of the
+        embedding torus for ``"exact"`` and of the padded grid for
+        ``"spectral"``, 32 bytes per cell of the refined grid (which covers
+        the shape) for ``"midpoint"`` and ``"additions"``. Above it a
+        ``MemoryError`` (also a ``ValueError``) naming ``shape`` is raised.
+        ``None``: the package default (half the available memory,
+        ``$FRACTALGEO_MAX_MEMORY`` to override; docs/input_policy.md).
 
     Returns
     -------
@@ -308,7 +335,12 @@ def fbm_surface(shape, hurst, *, method="exact", seed=None, cell_size=1.0, sigma
                              '(use method="spectral")')
         _check_exact_memory(rows, cols, h, max_memory)
         z = _surface_exact(rows, cols, h, seed, n_threads)
-    elif method == "spectral":
+        if scale != 1.0:
+            z *= scale
+        return z
+    check_memory(surface_memory_bytes((rows, cols), h, method, bool(periodic)), "shape",
+                 max_memory=max_memory, what=f"method={method!r} on a {rows} x {cols} grid")
+    if method == "spectral":
         z = _surface_spectral(rows, cols, h, seed, bool(periodic), n_threads)
     else:
         z = _surface_midpoint(rows, cols, h, seed, method == "additions", bool(periodic), n_threads)
@@ -382,11 +414,7 @@ def _white_noise_rfft2(n0, n1, seed, stream, n_threads):
 
 
 def _surface_spectral(rows, cols, h, seed, periodic, n_threads):
-    if periodic:
-        n0, n1 = rows, cols
-    else:
-        n0 = sfft.next_fast_len(rows + max(rows, cols) // 4, real=True)
-        n1 = sfft.next_fast_len(cols + max(rows, cols) // 4, real=True)
+    n0, n1 = _spectral_grid(rows, cols, periodic)
     spec = _white_noise_rfft2(n0, n1, seed, c.STREAM_SPECTRAL_2D, n_threads)
     spec *= _spectral_amplitude(n0, n1, h)
     z = sfft.irfft2(spec, s=(n0, n1), workers=_workers(n_threads), overwrite_x=True)
@@ -439,26 +467,51 @@ def exact_memory_bytes(rows, cols, hurst):
     return EXACT_BYTES_PER_CELL * n0 * n1
 
 
-def _default_max_memory():
-    try:
-        return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE") // 2
-    except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
-        return 4 * 2**30
+#: Bytes per cell of the padded grid at the peak of the spectral method: the
+#: half spectrum (8 per cell), the noise drawn for it (8), the filter (4),
+#: the inverse FFT output (8), the crop (8) and temporaries.
+SPECTRAL_BYTES_PER_CELL = 48
+
+#: Bytes per cell of the refined grid at the peak of the midpoint methods:
+#: the fine grid and the previous level (10), the crop and the scaled copy.
+MIDPOINT_BYTES_PER_CELL = 32
+
+
+def _spectral_grid(rows, cols, periodic):
+    if periodic:
+        return rows, cols
+    pad = max(rows, cols) // 4
+    return (sfft.next_fast_len(rows + pad, real=True), sfft.next_fast_len(cols + pad, real=True))
+
+
+def _midpoint_grid(rows, cols, periodic):
+    if periodic:
+        return rows, cols
+    step = 2 ** _levels_for(max(rows, cols) - 1)
+    nr = max(-(-(rows - 1) // step) + 1, 2)
+    nc = max(-(-(cols - 1) // step) + 1, 2)
+    return (nr - 1) * step + 1, (nc - 1) * step + 1
+
+
+def surface_memory_bytes(shape, hurst, method, periodic=False):
+    """Estimated peak working memory (bytes) of ``fbm_surface(shape, hurst,
+    method=method, periodic=periodic)``, computed without allocating."""
+    rows, cols = c.check_shape(shape)
+    if method == "exact":
+        return exact_memory_bytes(rows, cols, hurst)
+    if method == "spectral":
+        n0, n1 = _spectral_grid(rows, cols, periodic)
+        return SPECTRAL_BYTES_PER_CELL * n0 * n1
+    fr, fc = _midpoint_grid(rows, cols, periodic)
+    return MIDPOINT_BYTES_PER_CELL * fr * fc
 
 
 def _check_exact_memory(rows, cols, h, max_memory):
-    if max_memory is None:
-        limit = _default_max_memory()
-    else:
-        if isinstance(max_memory, bool) or not isinstance(max_memory, numbers.Real):
-            raise TypeError(f"max_memory: expected a number of bytes or None, got {max_memory!r}")
-        if not (max_memory > 0 and math.isfinite(max_memory)):
-            raise ValueError(f"max_memory: expected a positive number of bytes, got {max_memory}")
-        limit = max_memory
+    limit = resolve_max_memory(max_memory)
     need = exact_memory_bytes(rows, cols, h)
     if need > limit:
         n0, n1, _ = _stein_torus(rows, cols, h)
-        raise ValueError(
+        raise MemoryLimitError(
             f"shape: method=\"exact\" for {(rows, cols)} at hurst={h} embeds the grid in a "
             f"{n0} x {n1} torus and needs about {need / 2**30:.1f} GiB, above max_memory = "
             f"{limit / 2**30:.1f} GiB; use method=\"spectral\" (or \"additions\") for large grids, "

@@ -3,10 +3,12 @@ from __future__ import annotations
 
 import argparse
 
+from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads
+
 
 def add_parsers(sub) -> None:
     p = sub.add_parser(
-        "transform",
+        "transform", formatter_class=HelpFormatter,
         help="map of local fractal dimension (moving window) as a float32 GeoTIFF",
         description="Moving-window fractal transform of a raster (paper section 4.2). Reads GeoTIFF "
                     "(rasterio) or any format read_raster knows; writes a float32 GeoTIFF with the input's "
@@ -25,9 +27,10 @@ def add_parsers(sub) -> None:
     p.add_argument("--step", type=int, default=1,
                    help="compute every STEP-th row and column only (output cells STEP pixels wide, "
                         "centred on the input pixels they sample; default 1)")
-    p.add_argument("--band", type=int, default=1, help="1-based band (default 1)")
-    p.add_argument("--chunks", type=int, default=None, help="process with Dask in chunks of this side")
-    p.add_argument("--workers", type=int, default=None, help="threads (default: all cores)")
+    p.add_argument("--band", type=int, default=None, help="1-based band (None: the file's only band)")
+    p.add_argument("--chunks", type=int, default=None,
+                   help="process with Dask in chunks of this side, with a progress bar (needs the dask extra)")
+    add_n_threads(p)
     p.set_defaults(func=_run)
 
 
@@ -41,19 +44,21 @@ def _run(args: argparse.Namespace) -> int:
     from fractalgeo_rs.io import read_raster, write_raster
     from fractalgeo_rs.transform import fractal_transform
 
+    if args.chunks is not None and args.chunks < 1:
+        raise ValueError(f"--chunks: expected a positive chunk side in pixels, got {args.chunks}")
     data, profile = read_raster(args.input, band=args.band)
     nodata = (profile or {}).get("nodata")
-    if args.chunks:
+    if args.chunks is not None:
         import dask.array as da
         from dask.diagnostics import ProgressBar
 
         arr = da.from_array(data, chunks=args.chunks)
-        lazy = fractal_transform(arr, args.window, method=args.method, nodata=nodata, n_threads=args.workers,
+        lazy = fractal_transform(arr, args.window, method=args.method, nodata=nodata, n_threads=args.n_threads,
                                  z_scale=args.z_scale, step=args.step)
         with ProgressBar():
             dmap = lazy.compute(scheduler="threads", num_workers=1)
     else:
-        dmap = fractal_transform(data, args.window, method=args.method, nodata=nodata, n_threads=args.workers,
+        dmap = fractal_transform(data, args.window, method=args.method, nodata=nodata, n_threads=args.n_threads,
                                  z_scale=args.z_scale, step=args.step)
     dmap = np.asarray(dmap, dtype=np.float32)
     if args.output.lower().endswith((".tif", ".tiff")):

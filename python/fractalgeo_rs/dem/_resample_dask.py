@@ -1,0 +1,89 @@
+"""Dask runner of :func:`fractalgeo_rs.fractal_resample`: chunk by chunk with
+a halo, equal to the in-memory result for any chunking."""
+from __future__ import annotations
+
+import numpy as np
+
+from fractalgeo_rs import _core
+from fractalgeo_rs.dem import _resample as R
+
+
+def _out_bounds(a, b, n, f, point):
+    """Fine index range of the input rows ``[a, b)`` of ``n``."""
+    if point:
+        return f * a, (f * (b - 1) + 1 if b == n else f * b)
+    return f * a, f * b
+
+
+def _analysis_maps(dem, hurst, sigma, window, support, nodata):
+    """Hurst and sigma maps as dask arrays chunked like ``dem``."""
+    import dask.array as da
+
+    local_h = isinstance(hurst, str) and hurst == "local"
+    local_s = isinstance(sigma, str) and sigma == "local"
+    if local_h or local_s:
+        half = window // 2
+        t = half + 2
+
+        def block(b):
+            hraw, var1 = R._analyse_padded(b, half, support)
+            core = b[t:-t, t:-t] if t else b
+            h, s, _ = R._finish(hraw, var1, np.isfinite(core))
+            return np.stack([h, s])
+
+        z = dem.map_blocks(R._as_float, nodata, dtype=np.float64)
+        padded = da.overlap.overlap(z, depth=t, boundary=np.nan)
+        hs = padded.map_blocks(block, dtype=np.float64, new_axis=0,
+                               chunks=((2,),) + dem.chunks)
+        h_map, s_map = hs[0], hs[1]
+    shape = dem.shape
+    h = h_map if local_h else da.from_array(
+        R._param_map(hurst, "hurst", shape, 0.0, 1.0, True, True), chunks=dem.chunks)
+    s = s_map if local_s else da.from_array(
+        R._param_map(sigma, "sigma", shape, 0.0, np.inf, False, False), chunks=dem.chunks)
+    return h.rechunk(dem.chunks), s.rechunk(dem.chunks)
+
+
+def run_dask(dem, levels, hurst, sigma, window, detail, support, nodata, seed, n_threads,
+             return_analysis):
+    """Lazy fractal resampling of a 2D dask array."""
+    import dask
+    import dask.array as da
+
+    if dem.ndim != 2:
+        raise ValueError(f"dem: expected a 2D array, got shape {dem.shape}")
+    R._check_shape(dem.shape)
+    f = 1 << levels
+    point = support == "point"
+    h_map, s_map = _analysis_maps(dem, hurst, sigma, window, support, nodata)
+    n0, n1 = dem.shape
+    halo = R._HALO
+    row_edges = np.concatenate([[0], np.cumsum(dem.chunks[0])])
+    col_edges = np.concatenate([[0], np.cumsum(dem.chunks[1])])
+
+    def tile(z, h, s, t0, u0, r0, r1, c0, c1):
+        z = R._as_float(z, nodata)
+        out = _core.fractal_resample(z, np.ascontiguousarray(h, dtype=np.float64),
+                                     np.ascontiguousarray(s, dtype=np.float64), levels,
+                                     not point, seed, detail, (t0, u0), n1, n_threads)
+        return out[r0:r1, c0:c1]
+
+    rows = []
+    for bi in range(len(dem.chunks[0])):
+        a, b = int(row_edges[bi]), int(row_edges[bi + 1])
+        t0, t1 = max(a - halo, 0), min(b + halo, n0)
+        fa, fb = _out_bounds(a, b, n0, f, point)
+        row = []
+        for bj in range(len(dem.chunks[1])):
+            c, d = int(col_edges[bj]), int(col_edges[bj + 1])
+            u0, u1 = max(c - halo, 0), min(d + halo, n1)
+            fc, fd = _out_bounds(c, d, n1, f, point)
+            sl = (slice(t0, t1), slice(u0, u1))
+            part = dask.delayed(tile)(dem[sl], h_map[sl], s_map[sl], t0, u0,
+                                      fa - f * t0, fb - f * t0, fc - f * u0, fd - f * u0)
+            row.append(da.from_delayed(part, shape=(fb - fa, fd - fc), dtype=np.float64))
+        rows.append(row)
+    out = da.block(rows)
+    if return_analysis:
+        return out, R.ResampleAnalysis(h_map, s_map, float("nan"), window)
+    return out

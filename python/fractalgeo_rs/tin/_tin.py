@@ -1,0 +1,428 @@
+"""Delaunay triangulation, greedy terrain TINs and gridding (kernels in ``rust/tin``)."""
+from __future__ import annotations
+
+import numbers
+from dataclasses import dataclass
+from typing import Optional, Tuple
+
+import numpy as np
+
+from fractalgeo_rs import _core
+from fractalgeo_rs._validation import (
+    as_array,
+    check_choice,
+    check_n_threads,
+    check_nodata,
+    check_positive_float,
+    check_positive_int,
+)
+
+__all__ = ["TIN", "delaunay", "tin_from_dem", "grid_from_points"]
+
+
+def _points(points, name: str = "points") -> np.ndarray:
+    p = as_array(points, name)
+    if p.ndim != 2 or p.shape[1] not in (2, 3):
+        raise ValueError(f"{name}: expected shape (n, 2) or (n, 3), got {p.shape}")
+    if p.dtype.kind not in "fiu":
+        raise TypeError(f"{name}: expected a real-valued array, got dtype {p.dtype}")
+    return p if p.dtype == np.float64 else p.astype(np.float64)
+
+
+def _affine(transform, cell_size, rows: int) -> Tuple[float, float, float, float, float, float]:
+    """``(a, b, c, d, e, f)`` with ``x = a col + b row + c``, ``y = d col + e row + f``
+    for pixel-corner coordinates (rasterio's ``Affine``)."""
+    if transform is not None and cell_size is not None:
+        raise ValueError("cell_size: give either transform or cell_size, not both")
+    if transform is None:
+        h = 1.0 if cell_size is None else check_positive_float(cell_size, "cell_size")
+        return (h, 0.0, 0.0, 0.0, -h, rows * h)
+    if all(hasattr(transform, k) for k in "abcdef"):
+        t = tuple(float(getattr(transform, k)) for k in "abcdef")
+    else:
+        try:
+            g = [float(v) for v in transform]
+        except (TypeError, ValueError):
+            raise TypeError("transform: expected an Affine or a GDAL 6-tuple") from None
+        if len(g) != 6:
+            raise ValueError(f"transform: expected 6 numbers (GDAL order), got {len(g)}")
+        t = (g[1], g[2], g[0], g[4], g[5], g[3])
+    if not all(np.isfinite(t)) or t[0] * t[4] - t[1] * t[3] == 0:
+        raise ValueError(f"transform: must be finite and invertible, got {t}")
+    return t
+
+
+def delaunay(points, *, constraints=None, n_threads=None) -> np.ndarray:
+    r"""Delaunay triangulation of 2D points, optionally constrained.
+
+    The triangulation is computed by the Rust crate spade (bulk loading,
+    exact predicates), so the empty-circumcircle property holds exactly for
+    the input coordinates: no input point lies strictly inside the
+    circumcircle of any triangle. For points in general position the
+    triangulation is unique and has :math:`2n - 2 - h` triangles (:math:`h`
+    points on the convex hull); for degenerate sets (grids, cocircular
+    points) one of the valid triangulations is returned.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 2) or (n, 3)
+        Coordinates ``x, y`` (a third column, e.g. heights, is ignored and
+        stays with its row). Any strides; converted to float64. Not modified.
+    constraints : array_like of int, shape (k, 2), optional
+        Break lines as pairs of point indices (rivers, ridges, shorelines):
+        the result is the constrained Delaunay triangulation (Chew 1989) in
+        which every constraint segment is a union of triangle edges (split
+        at any input point lying on it). Constraints may share end points
+        but not cross.
+    n_threads : int, optional
+        Accepted for a uniform interface; the triangulation is sequential.
+
+    Returns
+    -------
+    triangles : ndarray of int64, shape (m, 3)
+        Row indices into ``points``, counter-clockwise (positive signed area
+        in the ``x, y`` plane). Exact duplicate points are merged: triangles
+        refer to the first occurrence, later copies appear in no triangle.
+
+    Raises
+    ------
+    ValueError
+        Fewer than 3 distinct points, all points collinear, NaN or infinite
+        coordinates, a constraint index out of range, a constraint joining a
+        point to itself or crossing an earlier one.
+
+    References
+    ----------
+    Delaunay, B. (1934). Sur la sphère vide. Bull. Acad. Sci. URSS 6, 793-800.
+    Chew, L. P. (1989). Constrained Delaunay triangulations. Algorithmica 4,
+    97-108. https://doi.org/10.1007/BF01553881
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fractalgeo_rs.tin import delaunay
+    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.4]])
+    >>> delaunay(sq).shape
+    (4, 3)
+    >>> tri = delaunay(sq[:4], constraints=[[1, 3]])
+    >>> bool(np.all([(1 in t) and (3 in t) for t in tri]))
+    True
+    """
+    p = _points(points)
+    n_threads = check_n_threads(n_threads)
+    c = None
+    if constraints is not None:
+        c = as_array(constraints, "constraints")
+        if c.size == 0:
+            c = None
+        else:
+            if c.dtype.kind not in "iu":
+                raise TypeError(f"constraints: expected integer point indices, got dtype {c.dtype}")
+            if c.ndim != 2 or c.shape[1] != 2:
+                raise ValueError(f"constraints: expected shape (k, 2), got {c.shape}")
+            if c.dtype.kind == "u" and c.size and c.max() > np.iinfo(np.int64).max:
+                raise ValueError("constraints: index out of range")
+            c = np.ascontiguousarray(c, dtype=np.int64)
+    return _core.tin_delaunay(p, c, n_threads)
+
+
+@dataclass(frozen=True)
+class TIN:
+    """A triangulated terrain surface.
+
+    Attributes
+    ----------
+    vertices : ndarray of float64, shape (n, 3)
+        Map coordinates ``x, y`` (sample centres) and height ``z``.
+    triangles : ndarray of int64, shape (m, 3)
+        Vertex indices, counter-clockwise seen from +z.
+    max_error : float
+        Largest vertical distance ``|z - mesh|`` over the valid samples the
+        mesh covers (same unit as the DEM).
+    grid : ndarray of int64, shape (n, 2)
+        ``(col, row)`` of the DEM sample of every vertex.
+    shape : tuple of int
+        The DEM's ``(rows, cols)``.
+    transform : tuple of float
+        ``(a, b, c, d, e, f)``: pixel corner ``(col, row)`` maps to
+        ``(a col + b row + c, d col + e row + f)`` (rasterio's ``Affine``).
+    """
+
+    vertices: np.ndarray
+    triangles: np.ndarray
+    max_error: float
+    grid: np.ndarray
+    shape: Tuple[int, int]
+    transform: Tuple[float, float, float, float, float, float]
+
+    def __len__(self) -> int:
+        return len(self.triangles)
+
+    def _grid_triangles(self) -> np.ndarray:
+        a, b, _, d, e, _ = self.transform
+        return self.triangles if a * e - b * d > 0 else self.triangles[:, [0, 2, 1]]
+
+    def to_grid(self, n_threads=None) -> np.ndarray:
+        """Rasterise the mesh back onto the DEM grid (barycentric
+        interpolation at the sample centres); NaN where no triangle covers a
+        sample (holes, outside the hull).
+
+        Returns
+        -------
+        ndarray of float64, shape ``self.shape``
+        """
+        n_threads = check_n_threads(n_threads)
+        return _core.tin_rasterize(
+            np.ascontiguousarray(self.grid, dtype=np.float64),
+            np.ascontiguousarray(self.vertices[:, 2]),
+            np.ascontiguousarray(self._grid_triangles()),
+            self.shape[0],
+            self.shape[1],
+            n_threads,
+        )
+
+    def normals(self) -> np.ndarray:
+        """Unit per-vertex normals: area-weighted sums of the face normals
+        (the cross product of two edges has length twice the area)."""
+        v = self.vertices
+        t = self.triangles
+        fn = np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]])
+        n = np.zeros_like(v)
+        for k in range(3):
+            np.add.at(n, t[:, k], fn)
+        length = np.linalg.norm(n, axis=1, keepdims=True)
+        return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
+
+    def to_mesh(self):
+        """The TIN as a :class:`fractalgeo_rs.lsystem.geometry.Mesh` for the
+        OBJ/PLY writers: float32 vertices (map coordinates relative to the
+        lower-left vertex, so that float32 keeps centimetres in UTM),
+        per-vertex normals, UVs = map ``x, y`` scaled to [0, 1] over the
+        mesh's bounding box."""
+        from fractalgeo_rs.lsystem.geometry import Mesh
+
+        v = self.vertices
+        lo = v[:, :2].min(axis=0)
+        span = np.maximum(v[:, :2].max(axis=0) - lo, np.finfo(float).tiny)
+        rel = v.copy()
+        rel[:, :2] -= lo
+        m = len(self.triangles)
+        zeros = np.zeros(m, dtype=np.uint32)
+        return Mesh(
+            vertices=rel.astype(np.float32),
+            normals=self.normals().astype(np.float32),
+            uvs=((v[:, :2] - lo) / span).astype(np.float32),
+            faces=self.triangles.astype(np.uint32),
+            part_ids=np.arange(m, dtype=np.uint32),
+            kinds=np.zeros(m, dtype=np.uint8),
+            colors=zeros,
+            instances=zeros.copy(),
+        )
+
+    def write_obj(self, path) -> None:
+        """Write the mesh as Wavefront OBJ (see :meth:`to_mesh`)."""
+        from fractalgeo_rs.lsystem.export import write_obj
+
+        write_obj(self.to_mesh(), path)
+
+    def write_ply(self, path) -> None:
+        """Write the mesh as binary PLY (see :meth:`to_mesh`)."""
+        from fractalgeo_rs.lsystem.export import write_ply
+
+        write_ply(self.to_mesh(), path)
+
+    def write_png(self, path, *, azimuth: float = 315.0, altitude: float = 45.0) -> None:
+        """Write a shaded-relief PNG preview of the mesh: :meth:`to_grid`
+        shaded by :func:`fractalgeo_rs.hillshade` (0 = no triangle)."""
+        from fractalgeo_rs.dem import hillshade
+        from fractalgeo_rs.io import write_raster
+
+        a, b, _, d, e, _ = self.transform
+        cell = float(np.sqrt(abs(a * e - b * d)))
+        shade = hillshade(self.to_grid(), azimuth=azimuth, altitude=altitude, cell_size=cell, byte=True)
+        write_raster(path, shade)
+
+
+def _default_max_error(z: np.ndarray) -> float:
+    valid = z[~np.isnan(z)]
+    if valid.size == 0:
+        return 0.0
+    lo, hi = np.percentile(valid, [2.0, 98.0])
+    return 0.005 * float(hi - lo)
+
+
+def tin_from_dem(dem, *, max_error=None, max_triangles=None, transform=None, cell_size=None,
+                 nodata=None, tile_edges="shared", n_threads=None) -> TIN:
+    r"""Error-bounded triangulated irregular network of a DEM.
+
+    Greedy insertion (Garland and Heckbert 1995, the scheme of Delatin):
+    starting from the convex hull of the valid samples (the four corners of a
+    DEM without nodata), the sample of largest vertical error
+
+    .. math:: e = |z_{ij} - \pi_T(x_j, y_i)|,
+
+    with :math:`\pi_T` the plane of the triangle :math:`T` containing it, is
+    inserted into the Delaunay triangulation until every valid sample is
+    within ``max_error`` of the mesh or the mesh has ``max_triangles``
+    triangles. Only the triangles around each new vertex are re-examined.
+
+    Parameters
+    ----------
+    dem : array_like, shape (rows, cols)
+        Heights; any real dtype. NaN (and ``nodata``) samples are left out:
+        triangles covering them are dropped, so nodata areas become holes.
+        Not modified.
+    max_error : float, optional
+        Largest allowed vertical error (DEM units), >= 0. Default: 0.5 % of
+        the robust relief (98th minus 2nd percentile of the valid heights);
+        ``0`` keeps every sample that is not on a plane through its
+        neighbours.
+    max_triangles : int, optional
+        Triangle budget: refinement stops when it is reached (the achieved
+        ``max_error`` is then larger than asked).
+    transform : Affine or GDAL 6-tuple, optional
+        Georeferencing of the DEM (pixel corners); vertices sit at sample
+        centres. Default: ``cell_size`` spacing, north up, origin at the lower
+        left corner of the raster.
+    cell_size : float, optional
+        Sample spacing when there is no ``transform`` (default 1).
+    nodata : float, optional
+        Height value meaning "no data" (NaN always is).
+    tile_edges : {"shared", "free"}
+        ``"shared"``: the vertices on the four raster edges are chosen from
+        the edge samples alone (Douglas-Peucker within ``max_error`` on each
+        run of valid edge samples) and no other edge sample is inserted, so
+        adjacent tiles of one DEM meshed separately have identical vertices
+        on their common edge and join without cracks. ``"free"``: edge
+        samples are refined like any other (fewer vertices).
+    n_threads : int, optional
+        Accepted for a uniform interface; the refinement is sequential.
+
+    Returns
+    -------
+    TIN
+        ``vertices`` (n, 3), ``triangles`` (m, 3) counter-clockwise from +z,
+        the achieved ``max_error``, ``to_grid()``, ``to_mesh()``.
+
+    References
+    ----------
+    Garland, M. and Heckbert, P. S. (1995). Fast polygonal approximation of
+    terrains and height fields. CMU-CS-95-181, Carnegie Mellon University.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fractalgeo_rs.tin import tin_from_dem
+    >>> yy, xx = np.mgrid[0:65, 0:65]
+    >>> dem = 100.0 + 0.5 * xx - 0.25 * yy          # a plane
+    >>> t = tin_from_dem(dem, max_error=0.01, cell_size=30.0)
+    >>> t.vertices.shape, t.triangles.shape
+    ((4, 3), (2, 3))
+    >>> bool(np.allclose(t.to_grid(), dem))
+    True
+    """
+    a = as_array(dem, "dem")
+    if a.ndim != 2:
+        raise ValueError(f"dem: expected a 2D array, got shape {a.shape}")
+    if a.dtype.kind not in "fiu":
+        raise TypeError(f"dem: expected a real-valued array, got dtype {a.dtype}")
+    z = np.array(a, dtype=np.float64, order="C", copy=True)
+    nd = check_nodata(nodata)
+    if nd is not None and not np.isnan(nd):
+        z[z == nd] = np.nan
+    if max_error is None:
+        max_error = _default_max_error(z)
+    else:
+        if isinstance(max_error, bool) or not isinstance(max_error, numbers.Real):
+            raise TypeError(f"max_error: expected a number >= 0, got {max_error!r}")
+        max_error = float(max_error)
+        if not np.isfinite(max_error) or max_error < 0:
+            raise ValueError(f"max_error: expected a finite number >= 0, got {max_error}")
+    if max_triangles is not None:
+        max_triangles = check_positive_int(max_triangles, "max_triangles")
+    check_choice(tile_edges, "tile_edges", ("shared", "free"))
+    n_threads = check_n_threads(n_threads)
+    t = _affine(transform, cell_size, z.shape[0])
+    grid, zs, tris, achieved = _core.tin_greedy(z, max_error, max_triangles, tile_edges == "shared", n_threads)
+    ta, tb, tc, td, te, tf = t
+    cc = grid[:, 0] + 0.5
+    rr = grid[:, 1] + 0.5
+    verts = np.column_stack([ta * cc + tb * rr + tc, td * cc + te * rr + tf, zs])
+    if ta * te - tb * td < 0:
+        tris = tris[:, [0, 2, 1]]
+    return TIN(vertices=verts, triangles=np.ascontiguousarray(tris), max_error=float(achieved),
+               grid=grid, shape=(int(z.shape[0]), int(z.shape[1])), transform=t)
+
+
+def grid_from_points(points, values, shape, transform=None, *, method="natural", n_threads=None) -> np.ndarray:
+    r"""Grid scattered values through their Delaunay triangulation.
+
+    Methods: ``"natural"``, Sibson's natural-neighbour interpolation
+
+    .. math:: f(\mathbf x) = \sum_i \lambda_i(\mathbf x) f_i,
+
+    with :math:`\lambda_i` the share of the Voronoi cell that
+    :math:`\mathbf x` would take from point :math:`i` (continuous, smooth
+    except at the data points); ``"natural_c1"``, Sibson's C1 variant with
+    gradients estimated from the area-weighted normals of the triangles
+    around each point (flatness 1); ``"linear"``, barycentric interpolation
+    in the Delaunay triangle (``scipy.interpolate.griddata(method="linear")``);
+    ``"nearest"``, the nearest point's value. All methods reproduce linear
+    functions exactly (``nearest`` excepted) and give NaN outside the convex
+    hull of the points.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 2) or (n, 3)
+        Point coordinates ``x, y`` (a third column is ignored). Not modified.
+    values : array_like, shape (n,)
+        Finite values at the points. Exact duplicate points take the value
+        of their first occurrence.
+    shape : (int, int)
+        ``(rows, cols)`` of the output grid.
+    transform : Affine or GDAL 6-tuple, optional
+        Georeferencing of the output grid; values are computed at cell
+        centres. Default: node ``(row, col)`` at ``x = col, y = row``.
+    method : {"natural", "natural_c1", "linear", "nearest"}
+    n_threads : int, optional
+        Rows are interpolated in parallel; the result does not depend on it.
+
+    Returns
+    -------
+    ndarray of float64, shape ``shape``
+
+    References
+    ----------
+    Sibson, R. (1981). A brief description of natural neighbour
+    interpolation. In V. Barnett (ed.), Interpreting Multivariate Data,
+    21-36. Wiley.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fractalgeo_rs.tin import grid_from_points
+    >>> rng = np.random.default_rng(0)
+    >>> pts = np.vstack([[0, 0], [10, 0], [0, 10], [10, 10], rng.uniform(0, 10, (50, 2))])
+    >>> vals = 2.0 * pts[:, 0] - pts[:, 1]
+    >>> g = grid_from_points(pts, vals, (11, 11))
+    >>> yy, xx = np.mgrid[0:11, 0:11]
+    >>> bool(np.allclose(g, 2.0 * xx - yy))
+    True
+    """
+    p = _points(points)
+    v = as_array(values, "values")
+    if v.ndim != 1 or v.shape[0] != p.shape[0]:
+        raise ValueError(f"values: expected shape ({p.shape[0]},), got {v.shape}")
+    if v.dtype.kind not in "fiu":
+        raise TypeError(f"values: expected a real-valued array, got dtype {v.dtype}")
+    if isinstance(shape, (str, bytes)) or not hasattr(shape, "__len__") or len(shape) != 2:
+        raise TypeError(f"shape: expected (rows, cols), got {shape!r}")
+    rows, cols = (check_positive_int(s, "shape") for s in shape)
+    check_choice(method, "method", ("natural", "natural_c1", "linear", "nearest"))
+    n_threads = check_n_threads(n_threads)
+    if transform is None:
+        g = [0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
+    else:
+        a, b, c, d, e, f = _affine(transform, None, rows)
+        g = [c + 0.5 * a + 0.5 * b, a, b, f + 0.5 * d + 0.5 * e, d, e]
+    return _core.tin_grid(p, np.ascontiguousarray(v, dtype=np.float64), rows, cols, g, method, n_threads)

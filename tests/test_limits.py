@@ -1,0 +1,107 @@
+"""Memory guards and bounded threads: huge requests raise Python exceptions
+(never an abort), also under a lowered address-space limit."""
+import os
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+import fractalgeo_rs as fg
+from fractalgeo_rs import _validation as v
+from fractalgeo_rs.synth import _fbm
+
+HUGE = [
+    "fg.fbm(10**12, 0.5, method='{m}')",
+    "fg.fbm(2**62, 0.5, method='{m}')",
+    "fg.fbm_surface((200000, 200000), 0.5, method='{m}')",
+]
+METHODS = ["exact", "midpoint", "additions", "spectral"]
+
+
+@pytest.mark.parametrize("call", [c.format(m=m) for c in HUGE for m in METHODS])
+def test_huge_requests_raise_memory_error_naming_the_parameter(call):
+    with pytest.raises(MemoryError) as info:
+        eval(call)
+    msg = str(info.value)
+    assert msg.startswith(("n:", "shape:")) and "max_memory" in msg and "GiB" in msg
+    assert isinstance(info.value, ValueError)  # also a ValueError: the argument is too large
+
+
+def test_memory_estimate_and_override():
+    need = _fbm.fbm_memory_bytes(10**6)
+    assert need == 64 * 10**6
+    with pytest.raises(MemoryError, match="n:"):
+        fg.fbm(10**6, 0.5, max_memory=need - 1)
+    assert fg.fbm(10**6, 0.5, max_memory=need, seed=1).shape == (10**6,)
+    est = _fbm.surface_memory_bytes((100, 150), 0.5, "spectral")
+    with pytest.raises(MemoryError, match="shape:"):
+        fg.fbm_surface((100, 150), 0.5, method="spectral", max_memory=est - 1)
+    assert fg.fbm_surface((100, 150), 0.5, method="spectral", max_memory=est, seed=1).shape == (100, 150)
+    with pytest.raises(TypeError, match="max_memory"):
+        fg.fbm(100, 0.5, max_memory="1G")
+    with pytest.raises(ValueError, match="max_memory"):
+        fg.fbm(100, 0.5, max_memory=-1)
+
+
+def test_default_limit_follows_environment(monkeypatch):
+    monkeypatch.setenv(v.MAX_MEMORY_ENV, "1e6")
+    assert v.default_max_memory() == 10**6
+    with pytest.raises(MemoryError, match="FRACTALGEO_MAX_MEMORY"):
+        fg.fbm(10**5, 0.5)
+    monkeypatch.setenv(v.MAX_MEMORY_ENV, "lots")
+    with pytest.raises(ValueError, match=v.MAX_MEMORY_ENV):
+        v.default_max_memory()
+    monkeypatch.delenv(v.MAX_MEMORY_ENV)
+    assert 0 < v.default_max_memory() <= v._available_memory()
+
+
+_CHILD = textwrap.dedent("""
+    import resource, sys
+    import fractalgeo_rs as fg
+    import numpy as np
+    resource.setrlimit(resource.RLIMIT_AS, (3 * 2**30, 3 * 2**30))
+    calls = {calls!r}
+    for call in calls:
+        try:
+            eval(call)
+        except (MemoryError, ValueError) as exc:
+            print("ok", type(exc).__name__, call, flush=True)
+        else:
+            print("no exception", call, flush=True)
+            sys.exit(3)
+""")
+
+
+def _run_child(calls):
+    code = _CHILD.format(calls=calls)
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="RLIMIT_AS semantics are Linux's")
+def test_no_abort_under_an_address_space_limit():
+    # The default limit follows RLIMIT_AS; with max_memory raised past it the
+    # allocations themselves fail, in numpy or in Rust (try_reserve): both are
+    # Python MemoryErrors, never SIGABRT (exit code 134 / -6).
+    calls = [c.format(m=m) for c in HUGE for m in METHODS]
+    calls += [c.format(m=m)[:-1] + ", max_memory=2**62)" for c in HUGE[:1] for m in METHODS]
+    calls += ["fg.fbm_surface((40000, 40000), 0.5, method='{m}', max_memory=2**62)".format(m=m)
+              for m in ("midpoint", "additions", "spectral")]
+    calls += ["fg._core.normal_noise(2**40, 1, 0)", "fg._core.normal_noise(2**61, 1, 0)"]
+    r = _run_child(calls)
+    assert r.returncode == 0, (r.returncode, r.stdout[-2000:], r.stderr[-2000:])
+    assert r.stdout.count("ok ") == len(calls)
+
+
+def test_n_threads_is_bounded():
+    cap = v.max_threads()
+    z = np.eye(64, dtype=bool)
+    with pytest.raises(ValueError, match="n_threads: expected at most"):
+        fg.box_counting(z, n_threads=10**6)
+    with pytest.raises(ValueError, match="n_threads"):
+        fg.box_counting(z, n_threads=cap + 1)
+    assert fg.box_counting(z, n_threads=cap).dimension == fg.box_counting(z, n_threads=1).dimension
+    # the Rust layer enforces the same cap for direct callers of _core
+    with pytest.raises(ValueError, match="n_threads"):
+        fg._core.normal_noise(10, 1, 0, 0, cap + 1)

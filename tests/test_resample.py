@@ -1,0 +1,228 @@
+"""Fractal resampling (fractalgeo_rs.fractal_resample)."""
+import os
+import warnings
+
+import numpy as np
+import pytest
+
+import fractalgeo_rs as fg
+from fractalgeo_rs.dem import resample_analysis
+
+DATA = os.path.join(os.path.dirname(__file__), "data")
+
+
+def lag1(z):
+    return 0.5 * (np.nanmean(np.diff(z, axis=0) ** 2) + np.nanmean(np.diff(z, axis=1) ** 2))
+
+
+def hurst_lags(z, lags=range(1, 9)):
+    lags = np.array(list(lags))
+    g = [0.5 * (np.nanmean((z[k:] - z[:-k]) ** 2) + np.nanmean((z[:, k:] - z[:, :-k]) ** 2))
+         for k in lags]
+    return np.polyfit(np.log(lags), np.log(g), 1)[0] / 2
+
+
+def dense_kriging(pts, vals, x0, h):
+    """Ordinary (intrinsic) kriging of fBm with gamma(d) = d^(2H)/2, all data."""
+    d = np.linalg.norm(pts[:, None] - pts[None], axis=-1)
+    n = len(pts)
+    a = np.ones((n + 1, n + 1))
+    a[:n, :n] = 0.5 * d ** (2 * h)
+    a[n, n] = 0.0
+    g0 = 0.5 * np.linalg.norm(pts - x0, axis=1) ** (2 * h)
+    w = np.linalg.solve(a, np.append(g0, 1.0))[:n]
+    mean = w @ vals
+    var = 2 * w @ g0 - w @ (0.5 * d ** (2 * h)) @ w
+    return mean, var
+
+
+@pytest.mark.parametrize("h", [0.3, 0.7])
+def test_conditioning_matches_dense_kriging(h):
+    """One level (factor 2) on a 9 x 9 fBm: mean and variance at a new
+    diamond point and a square point over 1500 seeds, against kriging given
+    all 81 coarse samples. The kernel conditions on 16 samples (and the square
+    step on random diamond samples): tolerance 4 standard errors plus 3 % of
+    the conditional sd for the mean, 8 % for the variance."""
+    z = fg.fbm_surface(9, h, method="exact", seed=11)
+    ii, jj = np.indices(z.shape)
+    pts = np.stack([ii.ravel(), jj.ravel()], 1).astype(float)
+    runs = np.stack([fg.fractal_resample(z, 2, hurst=h, sigma=1.0, seed=s)
+                     for s in range(1500)])
+    for fine, x0 in (((9, 9), (4.5, 4.5)), ((8, 9), (4.0, 4.5))):
+        m, v = dense_kriging(pts, z.ravel(), np.array(x0), h)
+        x = runs[:, fine[0], fine[1]]
+        se = np.sqrt(v / len(x))
+        assert abs(x.mean() - m) < 4 * se + 0.03 * np.sqrt(v), (fine, x.mean(), m)
+        assert abs(x.var() / v - 1) < 0.08, (fine, x.var(), v)
+
+
+def test_point_keeps_samples_and_threads():
+    z = fg.fbm_surface(65, 0.6, method="exact", seed=2)
+    a = fg.fractal_resample(z, 4, seed=3, n_threads=1)
+    b = fg.fractal_resample(z, 4, seed=3, n_threads=2)
+    assert a.shape == (257, 257)
+    assert np.array_equal(a, b)
+    assert np.array_equal(a[::4, ::4], z)
+    c = fg.fractal_resample(z, 4, seed=4)
+    assert not np.array_equal(a, c)
+
+
+def test_area_keeps_block_means():
+    z = fg.fbm_surface(64, 0.5, method="exact", seed=2) * 100 + 1000
+    for f in (2, 4, 8):
+        out = fg.fractal_resample(z, f, hurst=0.5, sigma=3.0, support="area", seed=1)
+        assert out.shape == (64 * f, 64 * f)
+        m = out.reshape(64, f, 64, f).mean(axis=(1, 3))
+        np.testing.assert_allclose(m, z, rtol=1e-9)
+
+
+@pytest.mark.parametrize("h", [0.3, 0.7])
+def test_statistics_on_exact_fbm_point(h):
+    """Truth subsampled by 2 and 4, resampled back with hurst='local'
+    (the 2048^2 table of docs/resampling.md comes from benches/)."""
+    t = fg.fbm_surface(385, h, method="exact", seed=5)
+    for f in (2, 4):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            o = fg.fractal_resample(t[::f, ::f], f, seed=1)
+        assert abs(lag1(o) / lag1(t) - 1) < 0.05
+        assert abs(hurst_lags(o) - hurst_lags(t)) < 0.03
+        assert fg.validate_surface(o).crease_ratio < 1.1
+
+
+def test_mean_only_below_min_scale():
+    z = fg.fbm_surface(33, 0.7, method="exact", seed=2)
+    a = fg.fractal_resample(z, 4, hurst=0.7, sigma=1.0, seed=1, min_scale=0.0)
+    b = fg.fractal_resample(z, 4, hurst=0.7, sigma=1.0, seed=1, cell_size=10.0, min_scale=4.0)
+    m = fg.fractal_resample(z, 4, hurst=0.7, sigma=0.0, seed=1)
+    m2 = fg.fractal_resample(z, 4, hurst=0.7, sigma=1.0, seed=9, cell_size=10.0, min_scale=100)
+    assert np.array_equal(m, m2)  # no level has detail: the conditional mean
+    # First level (5 m cells) has detail, the second (2.5 m) does not.
+    assert not np.array_equal(a, b) and not np.array_equal(b[::2, ::2], m[::2, ::2])
+    c = fg.fractal_resample(z, 2, hurst=0.7, sigma=1.0, seed=1)
+    assert np.array_equal(b[::2, ::2], c)
+
+
+def test_holes_stay_holes():
+    z = fg.fbm_surface(40, 0.5, method="exact", seed=2)
+    z[10:14, 20:25] = -9999.0
+    out = fg.fractal_resample(z, 2, hurst=0.5, sigma=1.0, seed=1, nodata=-9999.0)
+    hole = np.isnan(out)
+    assert hole[20:27, 40:49].all()
+    # Holes grow by at most one fine cell.
+    assert not hole[:19].any() and not hole[28:].any()
+    assert not hole[:, :39].any() and not hole[:, 50:].any()
+    area = fg.fractal_resample(z, 2, hurst=0.5, sigma=1.0, seed=1, nodata=-9999.0,
+                               support="area")
+    assert np.array_equal(np.isnan(area), np.kron(z == -9999.0, np.ones((2, 2))).astype(bool))
+    assert z[10, 20] == -9999.0  # input not modified
+
+
+def test_dask_equals_memory_for_any_chunking():
+    da = pytest.importorskip("dask.array")
+    z = fg.fbm_surface(70, 0.6, method="exact", seed=3)
+    z[30:33, 5:9] = np.nan
+    for support in ("point", "area"):
+        ref = fg.fractal_resample(z, 4, seed=2, support=support, window=9)
+        for chunks in ((20, 30), (70, 13), (35, 70)):
+            out = fg.fractal_resample(da.from_array(z, chunks=chunks), 4, seed=2,
+                                      support=support, window=9)
+            got = out.compute()
+            assert got.shape == ref.shape
+            np.testing.assert_array_equal(got, ref)
+
+
+def test_xarray_coords():
+    xr = pytest.importorskip("xarray")
+    z = fg.fbm_surface(16, 0.6, method="exact", seed=3)
+    y = 1000.0 - 30.0 * (np.arange(16) + 0.5)
+    x = 500.0 + 30.0 * (np.arange(16) + 0.5)
+    a = xr.DataArray(z, dims=("y", "x"), coords={"y": y, "x": x}, attrs={"units": "m"})
+    p = fg.fractal_resample(a, 2, hurst=0.5, sigma=1.0, seed=1)
+    assert p.shape == (31, 31) and p.attrs["units"] == "m"
+    np.testing.assert_allclose(p.x.values[::2], x)
+    q = fg.fractal_resample(a, 2, hurst=0.5, sigma=1.0, seed=1, support="area")
+    np.testing.assert_allclose(q.x.values, 500.0 + 15.0 * (np.arange(32) + 0.5))
+    np.testing.assert_allclose(q.y.values, 1000.0 - 15.0 * (np.arange(32) + 0.5))
+
+
+def test_analysis_matches_a_direct_window_fit():
+    """H and sigma at a few pixels against the pooled increments (first
+    sample inside the window) of the window cut out by hand."""
+    z = fg.fbm_surface(48, 0.6, method="exact", seed=4)
+    z[5, 7] = np.nan
+    a = resample_analysis(z, window=9)
+    for p, q in ((20, 20), (0, 0), (6, 8), (47, 30)):
+        g = []
+        for k in (1, 2):
+            vals = []
+            for i in range(max(p - 4, 0), min(p + 5, 48)):
+                for j in range(max(q - 4, 0), min(q + 5, 48)):
+                    for di, dj in ((k, 0), (0, k)):
+                        if i + di < 48 and j + dj < 48:
+                            d = z[i + di, j + dj] - z[i, j]
+                            if np.isfinite(d):
+                                vals.append(d * d)
+            g.append(np.mean(vals))
+        h = np.clip(0.5 * np.log2(g[1] / g[0]), 0.05, 0.95)
+        assert abs(a.hurst[p, q] - h) < 1e-9
+        assert abs(a.sigma[p, q] - np.sqrt(g[0])) < 1e-9
+
+
+@pytest.mark.parametrize("name", ["bigtujunga_30m_crop256.npy", "n44e007_alps_crop256.npy"])
+def test_real_dem_rougher_than_bicubic(name):
+    from scipy import ndimage
+
+    dem = np.load(os.path.join(DATA, name)).astype(float)
+    c = dem[::4, ::4]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        o = fg.fractal_resample(c, 4, seed=1)
+    b = ndimage.zoom(c, 4, order=3)[: o.shape[0], : o.shape[1]]
+    real = dem[: o.shape[0], : o.shape[1]]
+    # Measured (docs/resampling.md): bicubic keeps 0.76-0.84 of the real
+    # 30 m lag-1 variance; the fBm extrapolation of the 120 m roughness gives
+    # 1.4-1.6 times it (real terrain is smoother below 120 m than fBm).
+    assert lag1(b) < 0.9 * lag1(real)
+    assert 1.0 < lag1(o) / lag1(real) < 2.0
+
+
+@pytest.mark.parametrize("kw, exc, word", [
+    (dict(factor=3), ValueError, "factor"),
+    (dict(factor=1), ValueError, "factor"),
+    (dict(factor=2.0), TypeError, "factor"),
+    (dict(hurst=1.2), ValueError, "hurst"),
+    (dict(hurst=0.0), ValueError, "hurst"),
+    (dict(sigma=-1.0), ValueError, "sigma"),
+    (dict(min_scale=-1.0), ValueError, "min_scale"),
+    (dict(cell_size=float("inf")), ValueError, "cell_size"),
+    (dict(support="block"), ValueError, "support"),
+    (dict(window=4), ValueError, "window"),
+    (dict(seed=-1), ValueError, "seed"),
+])
+def test_bad_input(kw, exc, word):
+    z = np.zeros((16, 16))
+    kw = dict(kw)
+    f = kw.pop("factor", 2)
+    with pytest.raises(exc, match=f"^{word}"):
+        fg.fractal_resample(z, f, **kw)
+
+
+def test_bad_dem():
+    with pytest.raises(ValueError, match="^dem"):
+        fg.fractal_resample(np.zeros((3, 10)), 2, hurst=0.5, sigma=1.0)
+    with pytest.raises(ValueError, match="^dem"):
+        fg.fractal_resample(np.full((8, 8), np.nan), 2, hurst=0.5, sigma=1.0)
+    with pytest.raises(ValueError, match="^hurst"):
+        fg.fractal_resample(np.zeros((8, 8)), 2, hurst=np.zeros((4, 4)), sigma=1.0)
+    with pytest.raises(MemoryError, match="^factor"):
+        fg.fractal_resample(np.zeros((64, 64)), 4096, hurst=0.5, sigma=1.0)
+
+
+def test_docstring_examples_run():
+    import doctest
+
+    from fractalgeo_rs.dem import _resample
+
+    res = doctest.testmod(_resample, optionflags=doctest.ELLIPSIS)
+    assert res.failed == 0 and res.attempted >= 4
