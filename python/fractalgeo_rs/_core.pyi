@@ -2,7 +2,7 @@
 # Each domain keeps its own section; the public, documented API is in the
 # Python modules that wrap these functions.
 from os import PathLike
-from typing import Optional, Sequence, Tuple, final
+from typing import List, Optional, Sequence, Tuple, final
 
 import numpy as np
 import numpy.typing as npt
@@ -23,6 +23,7 @@ __all__ = [
     "dbc_transform_map",
     "fgn_sqrt_eigenvalues",
     "fractal_resample",
+    "gls_transform_map",
     "higuchi_lengths",
     "hillshade_f64",
     "hillshade_gdal_byte",
@@ -253,6 +254,22 @@ def ifs_rasterize(
 def moran_dimension(ratios: Sequence[float]) -> float: ...
 
 # ---- transform ----
+def gls_transform_map(
+    image: npt.NDArray[np.float64],
+    window_size: int,
+    dilations: int,
+    h0: float,
+    dh: float,
+    a: npt.NDArray[np.float64],
+    da: npt.NDArray[np.float64],
+    g: npt.NDArray[np.float64],
+    se: Sequence[float],
+    steps: int,
+    min_valid: float,
+    step: int = 1,
+    anisotropy: bool = False,
+    n_threads: Optional[int] = None,
+) -> List[npt.NDArray[np.float32]]: ...
 def variation_transform_map(
     image: npt.NDArray[np.float64],
     window_size: int,

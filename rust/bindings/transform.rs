@@ -2,11 +2,12 @@
 use super::convert::{array1, array2, array3, c_order, run, FloatArray2};
 use crate::transform::blanket::{blanket_areas, blanket_transform, BlanketMapOptions};
 use crate::transform::dbc::{dbc_transform, DbcMapOptions, LocalMap};
+use crate::transform::gls::{gls_transform, GlsOptions, GlsTables};
 use crate::transform::lacunarity::lacunarity_transform;
 use crate::transform::mass::{mass_curve, mass_transform, MassOptions};
 use crate::transform::variation::{variation_transform, Increments, VariationOptions};
 use crate::with_float;
-use numpy::{PyArray1, PyArray2, PyArray3, PyReadonlyArray2};
+use numpy::{PyArray1, PyArray2, PyArray3, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
 type MapPair<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>);
@@ -92,6 +93,74 @@ fn mass_transform_map<'py>(
     };
     let (maps, shape) = on_float_image!(py, image, n_threads, mass_transform, &opt);
     step_maps(py, maps, shape, step)
+}
+
+/// Moving-window GLS Hurst exponent on a float32 or float64 image, with the
+/// tables of `fractalgeo_rs.dimension.gls.tables` (`a`, `da`, `g`: (nH, K);
+/// `se`: (nH,); grid `h0 + i dh`). Returns [hurst, se] float32 maps on the
+/// `step` grid, and [angle, ratio] after them with `anisotropy`.
+#[pyfunction]
+#[pyo3(signature = (image, window_size, dilations, h0, dh, a, da, g, se, steps, min_valid, step=1, anisotropy=false, n_threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn gls_transform_map<'py>(
+    py: Python<'py>,
+    image: &Bound<'py, PyAny>,
+    window_size: usize,
+    dilations: usize,
+    h0: f64,
+    dh: f64,
+    a: PyReadonlyArray2<'py, f64>,
+    da: PyReadonlyArray2<'py, f64>,
+    g: PyReadonlyArray2<'py, f64>,
+    se: Vec<f64>,
+    steps: usize,
+    min_valid: f64,
+    step: usize,
+    anisotropy: bool,
+    n_threads: Option<usize>,
+) -> PyResult<Vec<Bound<'py, PyArray2<f32>>>> {
+    let n_h = a.shape()[0];
+    let flat = |t: &PyReadonlyArray2<'py, f64>| -> PyResult<Vec<f64>> {
+        if t.shape()[0] != n_h {
+            return Err(pyo3::exceptions::PyValueError::new_err(
+                "tables: a, da and g need the same shape",
+            ));
+        }
+        Ok(t.as_array().iter().copied().collect())
+    };
+    let tab = GlsTables {
+        h0,
+        dh,
+        n_h,
+        a: flat(&a)?,
+        da: flat(&da)?,
+        g: flat(&g)?,
+        se,
+    };
+    let opt = GlsOptions {
+        window: window_size,
+        dilations,
+        steps,
+        min_valid,
+        step,
+        anisotropy,
+    };
+    let (maps, (rows, cols)) = with_float!(FloatArray2::extract(image, "image")?, |z| {
+        let z = c_order(&z);
+        let (rows, cols) = z.rows_cols();
+        let r = run(py, n_threads, || {
+            gls_transform(&z.data, rows, cols, &opt, &tab)
+        })?;
+        (r, (rows, cols))
+    });
+    let shape = (rows.div_ceil(step.max(1)), cols.div_ceil(step.max(1)));
+    let mut out = vec![];
+    for v in [maps.hurst, maps.se, maps.angle, maps.ratio] {
+        if !v.is_empty() {
+            out.push(array2(py, shape, v)?);
+        }
+    }
+    Ok(out)
 }
 
 fn local_map_arrays(py: Python<'_>, m: LocalMap) -> PyResult<MapPair<'_>> {
@@ -225,6 +294,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mass_curve_image, m)?)?;
     m.add_function(wrap_pyfunction!(lacunarity_transform_map, m)?)?;
     m.add_function(wrap_pyfunction!(variation_transform_map, m)?)?;
+    m.add_function(wrap_pyfunction!(gls_transform_map, m)?)?;
     m.add_function(wrap_pyfunction!(mass_transform_map, m)?)?;
     m.add_function(wrap_pyfunction!(dbc_transform_map, m)?)?;
     m.add_function(wrap_pyfunction!(blanket_transform_map, m)?)?;

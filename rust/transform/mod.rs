@@ -7,11 +7,14 @@
 //! * [`lacunarity`]: gliding-box lacunarity per window.
 //! * [`mass`]: Voss's P(m, L) mass dimension, boxes counted over the image.
 //! * [`blanket`]: Peleg's covering blanket, image-wide areas and per-window map.
+//! * [`gls`]: GLS fit of H over the log quadratic variations of increment
+//!   filters (summed-area tables).
 //! * [`dbc`]: differential box counting per window (sliding min/max and
 //!   summed-area tables strided by the box size).
 
 pub mod blanket;
 pub mod dbc;
+pub mod gls;
 pub mod lacunarity;
 pub mod mass;
 mod sat;

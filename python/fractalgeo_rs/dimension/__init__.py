@@ -23,6 +23,7 @@ method         data                                             function
 ``"higuchi"``  profiles and time series                         :func:`higuchi`
 ``"whittle"``  fBm profiles and surfaces (debiased Whittle)     :func:`whittle`
 ``"mle"``      small fBm profiles and surfaces (exact Gaussian) :func:`fbm_mle`
+``"gls"``      fBm profiles and surfaces (GLS of increments)    :func:`gls_dimension`
 =============  ===============================================  =====================================
 
 :func:`lacunarity` (gliding box) returns its own :class:`Lacunarity` result.
@@ -45,6 +46,7 @@ from fractalgeo_rs.dimension.spectral import spectral_dimension
 from fractalgeo_rs.dimension.surface import blanket, mass_dimension, minkowski
 from fractalgeo_rs.dimension.variation import madogram, power_variation, surface_variation, variogram
 from fractalgeo_rs.dimension.likelihood import fbm_mle, whittle
+from fractalgeo_rs.dimension.gls import gls_dimension
 from fractalgeo_rs.fit import DimensionFit
 
 __all__ = [
@@ -64,6 +66,7 @@ __all__ = [
     "variogram",
     "wavelet_dimension",
     "whittle",
+    "gls_dimension",
     "box_counting",
     "box_counting_points",
     "differential_box_counting",
@@ -89,6 +92,7 @@ METHODS: Dict[str, Callable[..., DimensionFit]] = {
     "higuchi": higuchi,
     "whittle": whittle,
     "mle": fbm_mle,
+    "gls": gls_dimension,
 }
 
 
