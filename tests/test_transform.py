@@ -439,7 +439,8 @@ def test_dbc_map_random_image_step_and_nodata():
 def test_dbc_map_real_sar_window():
     vv, _ = fg.data.sentinel1_vv_db()
     z = vv[100:160, 200:250]
-    d = fg.fractal_transform(z, 17, method="dbc")  # sizes 2, 4, 8; 1 dB per pixel
+    # z_scale=1 pinned (the default is "auto" since the real-data defaults)
+    d = fg.fractal_transform(z, 17, method="dbc", z_scale=1.0)  # sizes 2, 4, 8; 1 dB per pixel
     ref = per_window_estimator(z, 17, fg.differential_box_counting, box_sizes=[2, 4, 8], z_scale=1.0, z0=0.0,
                                edge_blocks="drop")
     assert np.allclose(d, ref, atol=1e-5, equal_nan=True)
@@ -463,7 +464,7 @@ def test_blanket_map_equals_per_window_estimator_with_holes(w, eps, zs):
 def test_blanket_map_real_sar_window_and_step():
     vv, _ = fg.data.sentinel1_vv_db()
     z = vv[100:150, 200:240]
-    d = fg.fractal_transform(z, 11, method="blanket", step=2)
+    d = fg.fractal_transform(z, 11, method="blanket", step=2, z_scale=1.0)  # default is "auto"
     ref = per_window_estimator(z, 11, fg.blanket, step=2, epsilons=[1, 2, 3, 4])
     assert d.shape == (25, 20)
     assert np.allclose(d, ref, atol=1e-5, equal_nan=True)
@@ -514,9 +515,10 @@ def test_new_methods_threads_dask_xarray(method):
 def test_new_methods_plane_and_roughness():
     i, j = np.indices((80, 80))
     plane = 0.5 * i + 0.25 * j
-    assert np.allclose(fg.fractal_transform(plane, 9, method="blanket")[4:-4, 4:-4], 2.0, atol=1e-5)
-    rough = fg.fractal_transform(spectral_surface(128, 0.2, 1) * 30, 17, method="dbc")
-    smooth = fg.fractal_transform(spectral_surface(128, 0.8, 1) * 30, 17, method="dbc")
+    # z_scale=1 pinned: the default "auto" unit is the images' own step
+    assert np.allclose(fg.fractal_transform(plane, 9, method="blanket", z_scale=1.0)[4:-4, 4:-4], 2.0, atol=1e-5)
+    rough = fg.fractal_transform(spectral_surface(128, 0.2, 1) * 30, 17, method="dbc", z_scale=1.0)
+    smooth = fg.fractal_transform(spectral_surface(128, 0.8, 1) * 30, 17, method="dbc", z_scale=1.0)
     assert np.nanmean(rough) > np.nanmean(smooth) + 0.1
 
 

@@ -11,7 +11,7 @@ The package mirrors the Rust crate's domains: :mod:`fractalgeo_rs.dimension`
 """
 from fractalgeo_rs._core import __version__
 from fractalgeo_rs import data, io
-from fractalgeo_rs.fit import DimensionFit
+from fractalgeo_rs.fit import DimensionFit, FractalRangeWarning
 from fractalgeo_rs.dimension import (
     Lacunarity,
     blanket,
@@ -50,6 +50,7 @@ __all__ = [
     "data",
     "io",
     "DimensionFit",
+    "FractalRangeWarning",
     "Lacunarity",
     "blanket",
     "fbm_mle",

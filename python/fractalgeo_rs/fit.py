@@ -13,14 +13,82 @@ and the uncertainty; :class:`DimensionFit` holds the result and draws it.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+import warnings
+from dataclasses import dataclass, field, replace
 from typing import Any, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-__all__ = ["DimensionFit", "fit_loglog"]
+from fractalgeo_rs._scales import MIN_SEGMENT, find_break
+
+__all__ = ["DimensionFit", "FractalRangeWarning", "ScaleSegment", "fit_loglog", "mark_invalid"]
 
 ScaleRange = Union[None, str, Tuple[float, float]]
+
+SMOOTH_HURST = 0.85
+"""Of two regimes of a graph, one with ``H >= SMOOTH_HURST`` is the smooth
+range (not fractal), whatever the other."""
+
+SET_TOLERANCE = 0.02
+"""A set's box dimension this far outside ``[0, n]`` is still valid."""
+
+BREAK_MARGIN = 2.0
+"""The default fit of a fractal range starts this factor beyond the break."""
+
+
+class FractalRangeWarning(UserWarning):
+    """A dimension outside its valid domain, pinned at a bound of a search,
+    or fitted on part of the scales only (the data are not fractal over the
+    whole range).
+
+    The message names the cause and the remedy; the fit object carries the
+    same text in ``warning`` and the cause in ``flags``.
+
+    Attributes
+    ----------
+    args : tuple of str
+        The message.
+
+    References
+    ----------
+    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
+    dimension: assessing the roughness of time series and spatial data,
+    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+
+    Examples
+    --------
+    >>> import warnings, numpy as np, fractalgeo_rs as fg
+    >>> with warnings.catch_warnings(record=True) as rec:
+    ...     warnings.simplefilter("always")
+    ...     fit = fg.variogram(np.arange(100.0))  # a line: H = 1, smooth
+    >>> fit.valid, fit.flags, rec[0].category.__name__
+    (False, ('below_domain',), 'FractalRangeWarning')
+    """
+
+
+@dataclass(frozen=True)
+class ScaleSegment:
+    """One regime of a log-log relation (see :attr:`DimensionFit.ranges`).
+
+    Attributes
+    ----------
+    scale_range : tuple of float
+        Smallest and largest scale of the segment (the break scale is shared
+        by the two segments of a broken line).
+    dimension, slope : float
+        Dimension and log-log slope of the segment (continuous broken-line
+        fit).
+    n_scales : int
+        Measured scales inside the segment.
+    valid : bool
+        Whether the dimension lies in the estimator's valid domain.
+    """
+
+    scale_range: Tuple[float, float]
+    dimension: float
+    slope: float
+    n_scales: int
+    valid: bool
 
 
 @dataclass(frozen=True)
@@ -66,6 +134,32 @@ class DimensionFit:
         :meth:`from_model`, e.g. the Whittle likelihood): the fitted model's
         value of the measure at each scale, drawn by :meth:`plot` instead of
         a line. ``None`` for log-log regressions.
+    valid : bool
+        ``False`` when ``dimension`` lies outside the estimator's valid
+        domain (``domain``; e.g. ``H >= 1`` or ``H <= 0`` for a graph) or a
+        likelihood search stopped at its bound; ``stderr`` and ``ci95`` are
+        then NaN and a :class:`FractalRangeWarning` was issued.
+    flags : tuple of str
+        Causes: ``"below_domain"`` (smooth at the fitted scales),
+        ``"above_domain"`` (rougher than any graph: noise or speckle),
+        ``"pinned"`` (search bound), ``"range_restricted"`` (the default fit
+        dropped a regime outside the domain and fitted the fractal range).
+    warning : str
+        The warning's text ("" when none).
+    ranges : tuple of ScaleSegment
+        The regimes found among the fitted scales: one segment when the
+        log-log relation is straight, two when a broken line fits better by
+        BIC with at least ``MIN_SEGMENT`` (4) scales per segment (see
+        :mod:`fractalgeo_rs._scales`); empty with fewer than 8 scales. Of two
+        regimes of a graph, one with ``H >= SMOOTH_HURST`` (0.85) or a
+        dimension outside ``domain`` is not valid (smooth, or noise); the
+        default fit then uses the other regime from ``BREAK_MARGIN`` (2)
+        times the break scale on (the transition fades over about an
+        octave: on Gaussian-smoothed fBm profiles the dimension fitted from
+        the break itself reads 0.02-0.05 too smooth, from twice the break
+        within 0.025, ``tests/test_scales.py``).
+    domain : tuple of float or None
+        Valid interval of ``dimension`` (``None``: not checked).
 
     References
     ----------
@@ -106,6 +200,11 @@ class DimensionFit:
     y_label: str = "measure"
     extra: Mapping[str, Any] = field(default_factory=dict)
     model: Optional[np.ndarray] = None
+    valid: bool = True
+    flags: Tuple[str, ...] = ()
+    warning: str = ""
+    ranges: Tuple[ScaleSegment, ...] = ()
+    domain: Optional[Tuple[float, float]] = None
 
     @classmethod
     def from_model(
@@ -186,11 +285,17 @@ class DimensionFit:
         extra = ""
         if "hurst" in self.extra:
             extra = f", hurst={self.extra['hurst']:.4f}"
+        tail = ""
+        if len(self.ranges) > 1:
+            tail += ", ranges " + "; ".join(
+                f"{r.scale_range[0]:.4g}..{r.scale_range[1]:.4g}: D={r.dimension:.3f}" for r in self.ranges)
+        if self.flags:
+            tail += f", flags={self.flags!r}"
         return (
             f"DimensionFit(method={self.method!r}, dimension={self.dimension:.4f}{extra}, "
             f"ci95=({lo:.4f}, {hi:.4f}), r_squared={self.r_squared:.6f}, "
             f"scales {self.scale_range[0]:g}..{self.scale_range[1]:g} "
-            f"({self.n_used} of {len(self.scales)}, {self.range_selection}))"
+            f"({self.n_used} of {len(self.scales)}, {self.range_selection}){tail})"
         )
 
     def plot(self, ax=None, *, label: Optional[str] = None, color: Optional[str] = None):
@@ -233,6 +338,21 @@ class DimensionFit:
             xs = np.array(self.scale_range, dtype=float)
             ax.loglog(xs, np.exp(self.intercept + self.slope * np.log(xs)), "-", color=color,
                       label=f"D = {self.dimension:.3f} ± {1.96 * self.stderr:.3f}")
+        if len(self.ranges) > 1:
+            # the regimes: a broken line through the fitted points, and the
+            # break scale
+            ls = np.log(s[ok])
+            lm = np.log(m[ok])
+            for r in self.ranges:
+                a, b = r.scale_range
+                sel = (s[ok] >= a * (1 - 1e-9)) & (s[ok] <= b * (1 + 1e-9))
+                if not sel.any():
+                    continue
+                c = float(np.mean(lm[sel] - r.slope * ls[sel]))
+                xs = np.array([a, b])
+                ax.loglog(xs, np.exp(c + r.slope * np.log(xs)), "--", color=color, alpha=0.6,
+                          label=f"range {a:.4g}..{b:.4g}: D = {r.dimension:.3f}" + ("" if r.valid else " (invalid)"))
+            ax.axvline(self.ranges[0].scale_range[1], color=color, lw=0.8, ls=":")
         from matplotlib.ticker import NullFormatter
 
         ax.xaxis.set_minor_formatter(NullFormatter())
@@ -285,6 +405,10 @@ def fit_loglog(
     x_label: str = "scale",
     y_label: str = "measure",
     extra: Optional[Mapping[str, Any]] = None,
+    domain: Optional[Tuple[float, float]] = None,
+    open_domain: bool = False,
+    validate: bool = True,
+    restrict: bool = False,
 ) -> DimensionFit:
     """Fit ``log M = a + b log s`` and map the slope to a dimension.
 
@@ -296,8 +420,14 @@ def fit_loglog(
         Name recorded in the result.
     dim_offset, dim_factor : float
         ``D = dim_offset + dim_factor * slope``.
-    scale_range : None, "auto" or (float, float)
-        ``None`` fits every scale; a ``(low, high)`` pair fits the scales with
+    scale_range : None, "all", "auto" or (float, float)
+        ``None`` (default) fits every scale unless ``restrict`` and the scales show two
+        regimes (see ``DimensionFit.ranges``) of which one gives a dimension
+        outside ``domain`` (e.g. smooth below a few cells): then only the
+        valid regime, the fractal range, is fitted
+        (``range_selection == "fractal"``, flag ``"range_restricted"``, a
+        :class:`FractalRangeWarning`). ``"all"`` fits every scale whatever
+        the regimes. A ``(low, high)`` pair fits the scales with
         ``low <= s <= high``; ``"auto"`` picks the contiguous range of at least
         ``min_points`` scales whose slope has the smallest standard error (a
         long straight range beats a short one; curvature at either end raises
@@ -309,6 +439,26 @@ def fit_loglog(
         Fewest scales a fit may use. Estimators that by design fit two lags
         (variogram and madogram at lags 1 and 2, Gneiting et al. 2012) pass 2;
         such a fit is exact, its ``stderr`` and ``ci95`` are NaN.
+    domain : (float, float), optional
+        Valid interval of the dimension: ``[d, d + 1]`` for the graph of a
+        profile (``d = 1``) or surface (``d = 2``), ``[0, n]`` for a set in
+        ``n`` dimensions. A fit outside it has ``valid=False``, NaN
+        ``stderr`` and ``ci95``, a flag and a :class:`FractalRangeWarning`
+        naming the cause and the remedy.
+    open_domain : bool, default False
+        The bounds themselves are invalid (increment and spectral
+        estimators: ``D = d`` means ``H = 1``, a smooth surface beyond the
+        model, where the estimator saturates).
+    restrict : bool, default False
+        Let the default (``scale_range=None``) fit only the fractal range
+        when the scales show a smooth or noise regime next to it. The
+        increment estimators pass ``True`` (their scales are lags, whose
+        measure is an unbiased mean at every scale); estimators whose
+        large-scale measures are few and correlated (Higuchi, scale space,
+        box counts) only report ``ranges``.
+    validate : bool, default True
+        Check the domain and warn now; estimators that change ``dimension``
+        after the fit pass ``False`` and call :func:`check_domain`.
 
     Returns
     -------
@@ -325,12 +475,12 @@ def fit_loglog(
         raise ValueError(
             f"box_sizes: need at least {min_scales} scales with a positive measure for a fit, got {np.count_nonzero(valid)}"
         )
-    if scale_range is None:
+    if scale_range is None or (isinstance(scale_range, str) and scale_range == "all"):
         used = valid.copy()
         selection = "all"
     elif isinstance(scale_range, str):
         if scale_range != "auto":
-            raise ValueError(f"scale_range: expected None, 'auto' or (low, high), got {scale_range!r}")
+            raise ValueError(f"scale_range: expected None, 'all', 'auto' or (low, high), got {scale_range!r}")
         idx = np.flatnonzero(valid)
         n = len(idx)
         mp = max(3, math.ceil(n / 2)) if min_points is None else int(min_points)
@@ -344,7 +494,7 @@ def fit_loglog(
         try:
             lo, hi = (float(v) for v in scale_range)
         except (TypeError, ValueError):
-            raise ValueError(f"scale_range: expected None, 'auto' or (low, high), got {scale_range!r}") from None
+            raise ValueError(f"scale_range: expected None, 'all', 'auto' or (low, high), got {scale_range!r}") from None
         if not (lo <= hi):
             raise ValueError(f"scale_range: low must not exceed high, got ({lo}, {hi})")
         used = valid & (s >= lo) & (s <= hi)
@@ -353,6 +503,58 @@ def fit_loglog(
                 f"scale_range: ({lo:g}, {hi:g}) holds {np.count_nonzero(used)} usable scales, need at least {min_scales}"
             )
         selection = "user"
+    dom = None if domain is None else (float(domain[0]), float(domain[1]))
+    common = dict(scales=s, measures=m, method=method, dim_offset=float(dim_offset), dim_factor=float(dim_factor),
+                  x_label=x_label, y_label=y_label, extra=dict(extra or {}), domain=dom)
+    fit = _line_fit(used, selection, common)
+    ranges = _ranges(s, used, m, dim_offset, dim_factor, dom, open_domain)
+    fit = replace(fit, ranges=ranges)
+    # graphs only: the broken line of a set's box counts can overshoot
+    # [0, n] at the saturated ends without a second regime
+    if (scale_range is None and restrict and dom is not None and dom[1] - dom[0] == 1.0 and len(ranges) > 1
+            and any(r.valid for r in ranges) and not all(r.valid for r in ranges)):
+        good = max((r for r in ranges if r.valid), key=lambda r: r.n_scales)
+        bad = [r for r in ranges if not r.valid][0]
+        sub = used & (s >= good.scale_range[0]) & (s <= good.scale_range[1])
+        # the transition from the other regime fades over about an octave:
+        # fit from one octave beyond the break when 3 scales remain there
+        if good is ranges[1]:
+            far = sub & (s >= BREAK_MARGIN * good.scale_range[0])
+        else:
+            far = sub & (s <= good.scale_range[1] / BREAK_MARGIN)
+        if np.count_nonzero(far) >= 3:
+            sub = far
+        if np.count_nonzero(sub) >= max(min_scales, 3):
+            fit = replace(_line_fit(sub, "fractal", common), ranges=ranges)
+            cause = "smooth" if _below(bad.dimension, dom) else "rougher than a graph (noise)"
+            msg = (f"{method}: the data are {cause} over {x_label} {bad.scale_range[0]:g}..{bad.scale_range[1]:g} "
+                   f"(D = {bad.dimension:.3f}, outside [{dom[0]:g}, {dom[1]:g}]); fitted the fractal range "
+                   f"{good.scale_range[0]:g}..{good.scale_range[1]:g} only (D = {fit.dimension:.3f}); "
+                   f"pass scale_range='all' to fit every scale")
+            fit = replace(fit, flags=("range_restricted",), warning=msg)
+            warnings.warn(FractalRangeWarning(msg), stacklevel=3)
+    if validate:
+        fit = check_domain(fit, open_domain=open_domain)
+    return fit
+
+
+def _in_domain(d: float, dom: Tuple[float, float], open_domain: bool) -> bool:
+    if not np.isfinite(d):
+        return False
+    # sets (domain [0, n]): finite samplings read a few hundredths outside
+    tol = 1e-9 if dom[1] - dom[0] == 1.0 else SET_TOLERANCE
+    if open_domain:
+        return dom[0] + tol < d < dom[1] - tol
+    return dom[0] - tol <= d <= dom[1] + tol
+
+
+def _below(d: float, dom: Tuple[float, float]) -> bool:
+    return d <= 0.5 * (dom[0] + dom[1])
+
+
+def _line_fit(used: np.ndarray, selection: str, common: dict) -> DimensionFit:
+    s, m = common["scales"], common["measures"]
+    dim_offset, dim_factor = common["dim_offset"], common["dim_factor"]
     x, y = np.log(s[used]), np.log(m[used])
     slope, intercept, r2, se = _ols(x, y)
     dim = dim_offset + dim_factor * slope
@@ -372,15 +574,84 @@ def fit_loglog(
         r_squared=float(r2),
         stderr=float(dse),
         ci95=(float(dim - half), float(dim + half)),
-        scales=s,
-        measures=m,
         used=used,
         scale_range=(float(s[used][0]), float(s[used][-1])),
-        method=method,
         range_selection=selection,
-        dim_offset=float(dim_offset),
-        dim_factor=float(dim_factor),
-        x_label=x_label,
-        y_label=y_label,
-        extra=dict(extra or {}),
+        **common,
     )
+
+
+def _ranges(s, used, m, dim_offset, dim_factor, dom, open_domain) -> Tuple[ScaleSegment, ...]:
+    """One or two regimes among the used scales (see :mod:`fractalgeo_rs._scales`)."""
+    su = s[used]
+    if su.size < 2 * MIN_SEGMENT:
+        return ()
+    x, y = np.log(su), np.log(m[used])
+    brk = find_break(x, y, dim_factor=dim_factor)
+
+    graph = dom is not None and dom[1] - dom[0] == 1.0
+
+    def seg(a, b, slope, n, two):
+        d = float(dim_offset + dim_factor * slope)
+        ok = True if dom is None else _in_domain(d, dom, open_domain)
+        # one of two regimes of a graph with H >= SMOOTH_HURST is the smooth
+        # range (a broken line reaches the slope of H = 1 only at its end)
+        if ok and two and graph and d - dom[0] <= 1.0 - SMOOTH_HURST:
+            ok = False
+        return ScaleSegment((float(a), float(b)), d, float(slope), int(n), bool(ok))
+
+    if brk is None:
+        slope = _ols(x, y)[0]
+        return (seg(su[0], su[-1], slope, su.size, False),)
+    xb, below, above = brk
+    sb = float(np.exp(xb))
+    return (seg(su[0], sb, below, np.count_nonzero(x <= xb), True),
+            seg(sb, su[-1], above, np.count_nonzero(x >= xb), True))
+
+
+def mark_invalid(fit: DimensionFit, flag: str, message: str, *, stacklevel: int = 3) -> DimensionFit:
+    """``fit`` with ``valid=False``, ``flag`` added, NaN ``stderr`` and
+    ``ci95``, and ``message`` as its warning (issued as a
+    :class:`FractalRangeWarning`)."""
+    nan = float("nan")
+    out = replace(fit, valid=False, flags=tuple(fit.flags) + (flag,), stderr=nan, ci95=(nan, nan),
+                  warning=(fit.warning + " " + message).strip())
+    warnings.warn(FractalRangeWarning(message), stacklevel=stacklevel)
+    return out
+
+
+def check_domain(fit: DimensionFit, *, open_domain: bool = False, stacklevel: int = 4) -> DimensionFit:
+    """Flag and warn when ``fit.dimension`` lies outside ``fit.domain``.
+
+    Below the domain (``H >= 1`` for a graph): the data are smooth at the
+    fitted scales; the remedy is larger scales (or the fractal range of
+    ``fit.ranges`` when one was found). Above it (``H <= 0``): rougher than
+    any graph, e.g. white noise or speckle.
+    """
+    dom = fit.domain
+    if dom is None or _in_domain(fit.dimension, dom, open_domain):
+        return fit
+    a, b = fit.scale_range
+    where = f"{fit.x_label} {a:g}..{b:g}"
+    if not np.isfinite(fit.dimension):
+        return mark_invalid(fit, "undefined", f"{fit.method}: D is undefined over {where}", stacklevel=stacklevel)
+    good = [r for r in fit.ranges if r.valid]
+    hint = ""
+    if good:
+        g = max(good, key=lambda r: r.n_scales)
+        hint = (f"; the log-log relation breaks and D = {g.dimension:.3f} over "
+                f"{g.scale_range[0]:g}..{g.scale_range[1]:g}: use scale_range=({g.scale_range[0]:g}, "
+                f"{g.scale_range[1]:g})")
+    if dom[1] - dom[0] != 1.0:
+        msg = (f"{fit.method}: D = {fit.dimension:.3f} is outside [{dom[0]:g}, {dom[1]:g}] at {where}: not a "
+               f"dimension of a set (too few occupied boxes or a saturated range); choose the scales with "
+               f"scale_range{hint}")
+        return mark_invalid(fit, "below_domain" if _below(fit.dimension, dom) else "above_domain", msg,
+                            stacklevel=stacklevel)
+    if _below(fit.dimension, dom):
+        msg = (f"{fit.method}: D = {fit.dimension:.3f} is below {dom[0]:g} (H >= 1): the data are smooth at "
+               f"{where}; use larger scales (scale_range, lags, box_sizes or epsilons above {b:g}){hint}")
+        return mark_invalid(fit, "below_domain", msg, stacklevel=stacklevel)
+    msg = (f"{fit.method}: D = {fit.dimension:.3f} is above {dom[1]:g} (H <= 0): the data are rougher than "
+           f"a graph at {where} (white noise, speckle); use larger scales or smooth the data{hint}")
+    return mark_invalid(fit, "above_domain", msg, stacklevel=stacklevel)

@@ -14,8 +14,8 @@ method         data                                             function
 ``"mass"``     binary images, point sets, grayscale (P(m,L))    :func:`mass_dimension`
 ``"blanket"``  grayscale surfaces (Peleg covering blanket)      :func:`blanket`
 ``"spectral"`` profiles and surfaces (power spectrum)           :func:`spectral_dimension`
-``"variogram"`` profiles (p=2, first differences, lags 1, 2)    :func:`variogram`
-``"madogram"`` profiles (p=1, first differences, lags 1, 2)     :func:`madogram`
+``"variogram"`` profiles, surfaces (p=2, first differences)     :func:`variogram`
+``"madogram"`` profiles, surfaces (p=1, first differences)      :func:`madogram`
 ``"variation"`` profiles, power variation (p, order)            :func:`power_variation`
 ``"surface_variation"`` surfaces: square, first or transect     :func:`surface_variation`
 ``"wavelet"``  profiles and surfaces (Haar detail variance)     :func:`wavelet_dimension`
@@ -31,6 +31,8 @@ method         data                                             function
 from __future__ import annotations
 
 from typing import Callable, Dict
+
+import numpy as np
 
 from fractalgeo_rs.dimension.boxcount import (
     box_counting,
@@ -94,8 +96,25 @@ METHODS: Dict[str, Callable[..., DimensionFit]] = {
 }
 
 
+# methods defined for one dimensionality of a profile or surface only, and
+# what to use on the other
+_GRAPH_ONLY = {
+    "dbc": (2, "variogram', 'madogram', 'variation', 'higuchi', 'spectral' or 'whittle"),
+    "blanket": (2, "variogram', 'madogram', 'variation', 'higuchi', 'spectral' or 'whittle"),
+    "surface_variation": (2, "variation', 'variogram' or 'madogram"),
+    "variation": (1, "surface_variation', 'variogram' or 'madogram"),
+    "scale_space": (1, "wavelet', 'spectral', 'surface_variation' or 'whittle"),
+    "higuchi": (1, "surface_variation', 'dbc', 'wavelet' or 'whittle"),
+}
+
+
 def dimension(data, method: str = "box", **options) -> DimensionFit:
     """Estimate the fractal dimension of ``data`` with ``method``.
+
+    ``fit.method`` of the result is the key that produced it, so
+    ``dimension(data, method=fit.method)`` computes the same fit again. A
+    method defined for profiles only (or surfaces only) raises ValueError
+    naming the methods to use instead.
 
     Parameters
     ----------
@@ -131,4 +150,10 @@ def dimension(data, method: str = "box", **options) -> DimensionFit:
     """
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"method: expected one of {', '.join(map(repr, METHODS))}, got {method!r}")
+    if method in _GRAPH_ONLY:
+        nd, other = _GRAPH_ONLY[method]
+        have = np.ndim(data)
+        if have in (1, 2) and have != nd:
+            kind = {1: "1D profiles", 2: "2D surfaces"}[have]
+            raise ValueError(f"method: {method!r} is not defined for {kind}, use '{other}'")
     return METHODS[method](data, **options)

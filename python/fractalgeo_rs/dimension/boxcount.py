@@ -45,7 +45,7 @@ __all__ = [
 ]
 
 
-def _lattice_fit(method, sizes, counts, offset_reduce, scale_range, x_label, y_label, extra) -> DimensionFit:
+def _lattice_fit(method, sizes, counts, offset_reduce, scale_range, x_label, y_label, extra, domain) -> DimensionFit:
     """Fit ``D = -slope`` to lattice counts combined over the shifted lattices."""
     return fit_loglog(
         sizes,
@@ -55,7 +55,59 @@ def _lattice_fit(method, sizes, counts, offset_reduce, scale_range, x_label, y_l
         x_label=x_label,
         y_label=y_label,
         extra={"counts": counts, "offset_reduce": offset_reduce, **extra},
+        domain=domain,
     )
+
+
+_NEAR_POWER = math.log(1.05)  # extents within 5 % of a power of 2 or 3
+
+
+def _uneven(sizes) -> bool:
+    """Consecutive ratios of ``sizes`` neither all equal nor all <= 2."""
+    r = np.asarray(sizes, dtype=float)
+    if r.size < 3:
+        return False
+    q = r[1:] / r[:-1]
+    return not (np.allclose(q, q[0]) or np.all(q <= 2.0 + 1e-12))
+
+
+def _default_box_sizes(b: np.ndarray, bbox: bool) -> Optional[list]:
+    """Powers of 2 or of 3 up to a quarter of the set's extent (at least 3
+    sizes), the base whose powers come closest to the extent in log scale:
+    an exact fractal of side b^L, cropped, offset or padded, is then counted
+    on boxes of its own base (a carpet of side 729 on 1, 3, 9, ...; a
+    triangle cropped to 1000 on 1, 2, 4, ...). ``None`` leaves the choice to
+    the kernel (empty set, extent under 4)."""
+    if bbox:
+        ext = 0
+        for ax in range(b.ndim):
+            occ = np.flatnonzero(b.any(axis=tuple(a for a in range(b.ndim) if a != ax)))
+            if occ.size == 0:
+                return None
+            ext = max(ext, int(occ[-1] - occ[0] + 1))
+    else:
+        ext = max(b.shape)
+    if ext < 4:
+        return None
+
+    def powers(base):
+        out, v = [], 1
+        while v <= ext / 4:
+            out.append(v)
+            v *= base
+        return out
+
+    def misfit(base):
+        x = math.log(ext, base)
+        return abs(x - round(x)) * math.log(base)  # distance in natural-log units
+
+    best = min((2, 3), key=misfit)
+    if misfit(best) > _NEAR_POWER:  # not a set of side b^L: keep the kernel's sizes
+        return None
+    sizes = powers(best)
+    if len(sizes) < 3:
+        sizes = powers(2)
+    return sizes if len(sizes) >= 3 else None
 
 
 def _binary_bytes(data) -> Tuple[np.ndarray, bool]:
@@ -117,7 +169,11 @@ def box_counting(
     box_sizes : sequence of int, optional
         Box sides in samples; any positive integers (not only powers of two),
         at least three distinct, none larger than the longest axis. Default:
-        ``1, 2, 4, ...`` up to a quarter of the set's largest extent.
+        the divisors of the set's extent when they form an even chain (all
+        ratios equal, or all at most 2) or when the extent is not within 5 %
+        of a power of 2 or 3, else powers of that base up to a quarter of the
+        extent; ``docs/boxcounting.md`` has the error table on cropped,
+        offset and padded exact fractals.
     offsets : int, default 1
         Number of lattice shifts per axis (``offsets**ndim`` lattices). The
         shifts ``j * s_max / offsets`` are global (the same for every box
@@ -179,11 +235,19 @@ def box_counting(
     check_choice(anchor, "anchor", ("bbox", "array"))
     n_threads = check_n_threads(n_threads)
     s, counts, n_fg, lo, hi = _core.box_count_binary(b, sizes or [], offsets, anchor == "bbox", n_threads)
+    if sizes is None and _uneven(s):
+        # the kernel's default (divisors of the extent, else powers of 2)
+        # jumps unevenly on extents such as 1000 (8, 20, 40, 100): count
+        # again on powers of the base closest to the extent
+        alt = _default_box_sizes(b, anchor == "bbox")
+        if alt is not None:
+            s, counts, n_fg, lo, hi = _core.box_count_binary(b, alt, offsets, anchor == "bbox", n_threads)
     if transposed:
         lo, hi = lo[::-1], hi[::-1]
     return _lattice_fit(
         "box", s, counts, offset_reduce, scale_range, "box size s (samples)", "occupied boxes N(s)",
         {"n_foreground": int(n_fg), "bbox": (tuple(lo), tuple(hi)), "offsets": offsets, "anchor": anchor},
+        (0.0, float(b.ndim)),
     )
 
 
@@ -267,6 +331,7 @@ def box_counting_points(
     return _lattice_fit(
         "points", s, counts, offset_reduce, scale_range, "box size s", "occupied boxes N(s)",
         {"n_points": n, "offsets": offsets},
+        (0.0, float(pts.shape[1])),
     )
 
 
@@ -425,6 +490,7 @@ def differential_box_counting(
     return _lattice_fit(
         "dbc", s, counts, offset_reduce, scale_range, "box size s (pixels)", "box count N(s)",
         {"z_scale": z_unit, "z0": z0, "offsets": offsets, "edge_blocks": edge_blocks},
+        (2.0, 3.0),
     )
 
 
@@ -578,6 +644,7 @@ def self_affine_box_counting(
         s,
         covered,
         method="affine",
+        domain=(float(d), d + 1.0),
         dim_offset=d + 1.0,
         dim_factor=-1.0,
         scale_range=scale_range,

@@ -40,13 +40,14 @@ from __future__ import annotations
 
 import math
 import numbers
+from dataclasses import replace
 from typing import Dict, Optional, Tuple
 
 import numpy as np
 
 from fractalgeo_rs._validation import check_choice, check_positive_float
 from fractalgeo_rs.dimension.variation import _real_array, _with_nodata
-from fractalgeo_rs.fit import DimensionFit
+from fractalgeo_rs.fit import DimensionFit, mark_invalid
 
 __all__ = ["whittle", "fbm_mle"]
 
@@ -68,6 +69,8 @@ _FILTERS_2D: Dict[str, Dict[Tuple[int, ...], float]] = {
 # (a composite likelihood with a shared sigma^2)
 _POOLED = {"first": ("rows", "columns")}
 # shared with the Whittle map (fractalgeo_rs.transform._whittle):
+_H_LO, _H_HI = 0.001, 0.999  # bounds of the search of H
+_PIN_TOL = 1e-3  # an estimate this close to a bound is pinned there
 _MIN_FILTERED = 16  # fewest valid filtered samples of a fit
 _F_FLOOR = 1e-300  # expected periodogram floor, relative to its largest value
 _VANISH = 1e-24  # a filtered field whose mean power is below this times max |z|^2 vanishes
@@ -373,7 +376,7 @@ def _minimise(contrast):
     constant) over 0.001 < H < 0.999; standard error from its curvature."""
     from scipy.optimize import minimize_scalar
 
-    res = minimize_scalar(contrast, bounds=(0.001, 0.999), method="bounded",
+    res = minimize_scalar(contrast, bounds=(_H_LO, _H_HI), method="bounded",
                           options={"xatol": 1e-6, "maxiter": 200})
     h = float(res.x)
     # observed information: second difference of the profile contrast; the
@@ -456,7 +459,7 @@ def _assemble(h, se, nd, plot_data, method, extra):
     offset = 2.0 if nd == 1 else 3.0
     ex = {"hurst": h, "hurst_stderr": se, "sigma2": s2}
     ex.update(extra)
-    return DimensionFit.from_model(
+    fit = DimensionFit.from_model(
         dimension=offset - h,
         stderr=se,
         scales=freq,
@@ -468,6 +471,19 @@ def _assemble(h, se, nd, plot_data, method, extra):
         y_label="periodogram of the filtered field",
         extra=ex,
     )
+    fit = replace(fit, domain=(offset - 1.0, offset))
+    if not (_H_LO + _PIN_TOL < h < _H_HI - _PIN_TOL):
+        if h >= 0.5:
+            msg = (f"{method}: H = {h:.4f} is pinned at the search bound {_H_HI} (D = {offset - h:.3f}): the data "
+                   f"are smooth (H >= 1) at the finest scales, beyond the fBm model; no valid interval. Use an "
+                   f"estimator over larger scales (e.g. surface_variation with lags=(4, 8, 16, 32)) or the scale "
+                   f"ranges of spectral_dimension")
+        else:
+            msg = (f"{method}: H = {h:.4f} is pinned at the search bound {_H_LO} (D = {offset - h:.3f}): the data "
+                   f"are rougher than fBm (white noise, speckle); no valid interval")
+        fit = mark_invalid(fit, "pinned", msg, stacklevel=4)
+        fit.extra["hurst_stderr"] = float("nan")
+    return fit
 
 
 def fbm_mle(

@@ -158,6 +158,7 @@ def spectral_dimension(
         scale_range = (4.0 / min(z.shape), 0.25)
     fit = fit_loglog(f_mean, p_mean, method="spectral", dim_offset=offset, dim_factor=factor,
                      scale_range=scale_range, x_label="frequency (cycles per sample)",
+                     domain=(float(z.ndim), z.ndim + 1.0), open_domain=True,
                      y_label="power", extra={"window": window, "detrend": detrend})
     fit.extra["beta"] = -fit.slope
     fit.extra["hurst"] = hurst_of_beta(-fit.slope)

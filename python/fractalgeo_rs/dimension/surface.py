@@ -102,7 +102,7 @@ def minkowski(data, *, radii: Optional[Sequence[float]] = None, scale_range: Sca
     d = np.sort(dist.ravel())
     vol = np.searchsorted(d, r, side="right").astype(float)
     n = mask.ndim
-    return fit_loglog(r, vol, method="minkowski", dim_offset=float(n), dim_factor=-1.0, scale_range=scale_range,
+    return fit_loglog(r, vol, method="minkowski", domain=(0.0, float(mask.ndim)), dim_offset=float(n), dim_factor=-1.0, scale_range=scale_range,
                       x_label="radius r (samples)", y_label="sausage volume V(r)")
 
 
@@ -230,7 +230,8 @@ def mass_dimension(
         for L in sizes:
             m = tree.query_ball_point(pts, r=L / 2.0, p=np.inf, return_length=True)
             N.append(float(np.mean(1.0 / np.asarray(m, dtype=float))))
-    return fit_loglog(sizes, N, method="mass", dim_offset=0.0, dim_factor=-1.0, scale_range=scale_range,
+    dom = (2.0, 3.0) if kind == "grayscale" else (0.0, float(mask.ndim if kind == "binary" else pts.shape[1]))
+    return fit_loglog(sizes, N, method="mass", domain=dom, dim_offset=0.0, dim_factor=-1.0, scale_range=scale_range,
                       x_label="box side L", y_label="N(L) = sum P(m,L)/m", extra={"kind": kind})
 
 
@@ -309,6 +310,6 @@ def blanket(data, *, epsilons: Optional[Sequence[int]] = None, z_scale: float = 
         raise ValueError(f"epsilons: need at least 3 distinct thicknesses, got {eps}")
     areas, n_valid = _core.blanket_areas_image(np.ascontiguousarray(z, dtype=np.float64), eps[-1], zs,
                                                check_n_threads(n_threads))
-    return fit_loglog(eps, [float(areas[e - 1]) for e in eps], method="blanket", dim_offset=2.0, dim_factor=-1.0,
+    return fit_loglog(eps, [float(areas[e - 1]) for e in eps], method="blanket", domain=(2.0, 3.0), dim_offset=2.0, dim_factor=-1.0,
                       scale_range=scale_range, x_label="epsilon", y_label="blanket area A(epsilon)",
                       extra={"z_scale": z_scale, "n_valid": int(n_valid)})

@@ -24,12 +24,13 @@ dimension for two-dimensional surface data. *Statistica Sinica* 10, 343-376.
 """
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Optional, Sequence
 
 import numpy as np
 
 from fractalgeo_rs._validation import as_array, check_choice, check_integer_lags, check_nodata, check_positive_float
-from fractalgeo_rs.fit import DimensionFit, ScaleRange, fit_loglog
+from fractalgeo_rs.fit import DimensionFit, ScaleRange, check_domain, fit_loglog
 
 __all__ = ["power_variation", "variogram", "madogram", "surface_variation"]
 
@@ -192,23 +193,37 @@ def power_variation(
     meas = np.array([_mean_power(_increments(z, int(l), order, 0), p) for l in lg])
     if np.isnan(meas).any() or (meas == 0).all():
         raise ValueError("data: no valid increments at some lag (too many NaN) or a constant profile")
-    name = {(2.0, 1): "variogram", (1.0, 1): "madogram"}.get((p, order), "power_variation")
+    # the dispatcher key of the estimator, so that
+    # dimension(data, method=fit.method) computes the same fit again
+    name = {(2.0, 1): "variogram", (1.0, 1): "madogram"}.get((p, order), "variation")
     fit = fit_loglog(lg, meas, method=name, dim_offset=2.0, dim_factor=-1.0 / p, scale_range=scale_range,
                      min_scales=2, x_label="lag l (samples)", y_label=f"V_{p:g}(l)",
+                     domain=(1.0, 2.0), open_domain=True, restrict=True,
                      extra={"p": p, "order": order})
     fit.extra["hurst"] = fit.slope / p
     return fit
 
 
+def _first_order(data, p: float, name: str, lags, nodata, scale_range) -> DimensionFit:
+    if np.ndim(data) == 2:
+        fit = surface_variation(data, estimator="first", p=p, lags=lags, nodata=nodata, scale_range=scale_range)
+        return replace(fit, method=name)
+    return power_variation(data, p=p, order=1, lags=lags, nodata=nodata, scale_range=scale_range)
+
+
 def variogram(data, *, lags: Sequence[int] = (1, 2), nodata: Optional[float] = None,
               scale_range: ScaleRange = None) -> DimensionFit:
-    """Variogram estimator of a profile's dimension: :func:`power_variation`
-    with ``p=2, order=1`` (Gneiting et al. 2012). ``D = 2 - slope / 2``.
+    """Variogram estimator of the dimension of a profile or a surface.
+
+    Profiles: :func:`power_variation` with ``p=2, order=1`` (Gneiting et al.
+    2012), ``D = 2 - slope / 2``. Surfaces (2D input): the isotropic
+    variogram on the axes, :func:`surface_variation` with
+    ``estimator="first", p=2``, ``D = 3 - slope / 2``.
 
     Parameters
     ----------
-    data : array_like, shape (n,)
-        The profile, on a regular grid. NaN and ``nodata`` are skipped.
+    data : array_like, shape (n,) or (rows, cols)
+        The profile or surface, on a regular grid. NaN and ``nodata`` are skipped.
     lags : sequence of int, default (1, 2)
         Lags in samples; the default pair is the recommendation of Gneiting et
         al. (2012).
@@ -240,18 +255,21 @@ def variogram(data, *, lags: Sequence[int] = (1, 2), nodata: Optional[float] = N
     >>> round(fg.variogram(x).dimension, 1)
     1.7
     """
-    return power_variation(data, p=2.0, order=1, lags=lags, nodata=nodata, scale_range=scale_range)
+    return _first_order(data, 2.0, "variogram", lags, nodata, scale_range)
 
 
 def madogram(data, *, lags: Sequence[int] = (1, 2), nodata: Optional[float] = None,
              scale_range: ScaleRange = None) -> DimensionFit:
-    """Madogram estimator of a profile's dimension: :func:`power_variation`
-    with ``p=1, order=1`` (Gneiting et al. 2012). ``D = 2 - slope``.
+    """Madogram estimator of the dimension of a profile or a surface.
+
+    Profiles: :func:`power_variation` with ``p=1, order=1`` (Gneiting et al.
+    2012), ``D = 2 - slope``. Surfaces (2D input): :func:`surface_variation`
+    with ``estimator="first", p=1``, ``D = 3 - slope``.
 
     Parameters
     ----------
-    data : array_like, shape (n,)
-        The profile, on a regular grid. NaN and ``nodata`` are skipped.
+    data : array_like, shape (n,) or (rows, cols)
+        The profile or surface, on a regular grid. NaN and ``nodata`` are skipped.
     lags : sequence of int, default (1, 2)
         Lags in samples; the default pair is the recommendation of Gneiting et
         al. (2012).
@@ -282,7 +300,7 @@ def madogram(data, *, lags: Sequence[int] = (1, 2), nodata: Optional[float] = No
     >>> round(fg.madogram(x).dimension, 1)
     1.7
     """
-    return power_variation(data, p=1.0, order=1, lags=lags, nodata=nodata, scale_range=scale_range)
+    return _first_order(data, 1.0, "madogram", lags, nodata, scale_range)
 
 
 def surface_variation(
@@ -368,8 +386,9 @@ def surface_variation(
     meas = pooled(inc)
     if np.isnan(meas).any() or (meas == 0).all():
         raise ValueError("data: no valid increments at some lag (too many NaN) or a constant surface")
-    fit = fit_loglog(lg, meas, method=f"surface_{estimator}", dim_offset=3.0, dim_factor=-1.0 / p,
+    fit = fit_loglog(lg, meas, method="surface_variation", dim_offset=3.0, dim_factor=-1.0 / p,
                      scale_range=scale_range, min_scales=2, x_label="dilation u (pixels)",
+                     domain=(2.0, 3.0), open_domain=True, validate=False, restrict=True,
                      y_label=f"V_{p:g}(u)", extra={"p": p, "estimator": estimator})
     if estimator == "transect":
         used = fit.scales[fit.used].astype(int)
@@ -391,5 +410,6 @@ def surface_variation(
         object.__setattr__(fit, "stderr", se)
         object.__setattr__(fit, "ci95", (med - 1.96 * se, med + 1.96 * se))
         fit.extra["transect_dimensions"] = np.asarray(dims) + 1.0
+    fit = check_domain(fit, open_domain=True)
     fit.extra["hurst"] = 3.0 - fit.dimension
     return fit

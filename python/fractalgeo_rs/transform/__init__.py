@@ -38,9 +38,10 @@ from fractalgeo_rs._validation import (
     check_positive_int,
 )
 
+from fractalgeo_rs.transform._defaults import default_z_scale
 from fractalgeo_rs.transform.segment import segment
 
-__all__ = ["fractal_transform", "lacunarity_map", "segment", "TRANSFORM_METHODS"]
+__all__ = ["default_z_scale", "fractal_transform", "lacunarity_map", "segment", "TRANSFORM_METHODS"]
 
 TRANSFORM_METHODS = {
     # name: (power p, square increments); "mass", "dbc", "blanket" have their own kernels
@@ -132,7 +133,7 @@ def fractal_transform(
     lags: Sequence[int] = (1, 2),
     box_sizes: Optional[Sequence[int]] = None,
     epsilons: Optional[Sequence[int]] = None,
-    z_scale: float = 1.0,
+    z_scale: Union[float, str] = "auto",
     edge_blocks: str = "drop",
     step: int = 1,
     nodata: Optional[float] = None,
@@ -242,9 +243,13 @@ def fractal_transform(
     epsilons : sequence of int, optional
         ``"blanket"``: blanket thicknesses, at least three, default
         ``1, 2, 3, 4``.
-    z_scale : float, default 1
+    z_scale : float or "auto", default "auto"
         ``"mass"``, ``"dbc"``, ``"blanket"``: height units per pixel (e.g. 1
         grey level, 1 dB or 1 metre); the estimates depend on this unit.
+        ``"auto"``: :func:`default_z_scale` of the whole image, ``1.4826 *
+        median |lag-1 increment|`` (one typical step per box), recorded in
+        the xarray output's ``attrs["z_scale"]``; maps are comparable only
+        at equal ``z_scale``, so pass a fixed number across scenes.
     edge_blocks : {"drop", "count"}, default "drop"
         ``"dbc"``: leave out or count the partial blocks of the window's last
         row and column (counting them biases ``D`` low: a 33-pixel window has
@@ -320,7 +325,10 @@ def fractal_transform(
     check_choice(method, "method", tuple(TRANSFORM_METHODS))
     check_choice(edge_blocks, "edge_blocks", ("drop", "count"))
     nodata = check_nodata(nodata)
-    if method in ("mass", "dbc", "blanket"):
+    auto_z = isinstance(z_scale, str)
+    if auto_z and z_scale != "auto":
+        raise TypeError(f"z_scale: expected a positive number or 'auto', got {z_scale!r}")
+    if not auto_z and method in ("mass", "dbc", "blanket"):
         z_scale = check_positive_float(z_scale, "z_scale")
     n_threads = check_n_threads(n_threads)
     step = check_positive_int(step, "step")
@@ -334,6 +342,8 @@ def fractal_transform(
 
     arr, image = _select_band(image, band)
     w = _check_window(window_size, arr.shape)
+    if auto_z:
+        z_scale = default_z_scale(arr, nodata) if method in ("mass", "dbc", "blanket") else None
     opts = {"lags": lags, "z_scale": z_scale, "dilations": dilations, "anisotropy": bool(anisotropy)}
     half = w // 2
     if method == "mass":
@@ -387,6 +397,11 @@ def fractal_transform(
         names += ("anisotropy_angle", "anisotropy_ratio")
     out = run_raster(kernel, image, depth=half, n_out=len(names), step=step,
                      prepare=prepare if array_kind(arr) == "dask" else None, names=names)
+    if array_kind(image) == "xarray":  # record what makes maps comparable
+        for o in out:
+            o.attrs.update({"fractal_method": method, "window_size": w})
+            if method in ("mass", "dbc", "blanket"):
+                o.attrs["z_scale"] = float(z_scale)
     # gls with anisotropy: D[, se], angle, ratio
     out = tuple(out[:2] if return_fit else out[:1]) + tuple(out[2:])
     return out if len(out) > 1 else out[0]

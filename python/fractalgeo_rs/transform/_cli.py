@@ -20,8 +20,10 @@ def add_parsers(sub) -> None:
     p.add_argument("--window", type=int, default=33, help="odd window side in pixels (default 33)")
     p.add_argument("--method", default="mass", choices=["mass", "variogram", "madogram", "square", "dbc", "blanket", "whittle"],
                    help="estimator (default mass: Voss's P(m, L), the paper's method)")
-    p.add_argument("--z-scale", type=float, default=1.0,
-                   help="mass, dbc, blanket: height units per pixel (default 1, e.g. 1 dB or 1 grey level)")
+    p.add_argument("--z-scale", type=_z_scale, default="auto",
+                   help="mass, dbc, blanket: height units per pixel (e.g. 1 dB or 1 grey level); default auto: "
+                        "1.4826 x median |lag-1 increment| of the whole image, printed; pass a fixed value to "
+                        "compare maps across scenes")
     p.add_argument("--step", type=int, default=1,
                    help="compute every STEP-th row and column only (output cells STEP pixels wide, "
                         "centred on the input pixels they sample; default 1)")
@@ -30,6 +32,10 @@ def add_parsers(sub) -> None:
                    help="process with Dask in chunks of this side, with a progress bar (needs the dask extra)")
     add_n_threads(p)
     p.set_defaults(func=_run)
+
+
+def _z_scale(text: str):
+    return "auto" if text == "auto" else float(text)
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -71,6 +77,11 @@ def _run(args: argparse.Namespace) -> int:
         write_raster(args.output, dmap)
     finite = dmap[np.isfinite(dmap)]
     print(f"{args.input}: {data.shape}, window {args.window}, method {args.method}")
+    if args.method in ("mass", "dbc", "blanket"):
+        from fractalgeo_rs.transform import default_z_scale
+
+        zs = default_z_scale(data, nodata) if args.z_scale == "auto" else args.z_scale
+        print(f"z_scale: {zs:.6g} data units per box step")
     if finite.size:
         print(f"local dimension: mean {finite.mean():.3f}, 5-95 % {np.percentile(finite, 5):.3f}-"
               f"{np.percentile(finite, 95):.3f}, NaN pixels {dmap.size - finite.size}")
