@@ -23,7 +23,7 @@ Voss, R. F. (1986). Characterization and measurement of random fractals.
 """
 from __future__ import annotations
 
-from typing import Optional, Sequence
+from typing import Optional, Sequence, Union
 
 import numpy as np
 
