@@ -101,7 +101,7 @@ CASES = {
     "ifs_rasterize": (rng.random((300, 2)), lambda a: _core.ifs_rasterize(a, 16, 16)),
     "variation_transform_map": (IMG, lambda a: _core.variation_transform_map(a, 9, [1, 2], 2.0, False, 0.5, 2)),
     "gls_transform_map": (IMG, lambda a: __import__("fractalgeo_rs.dimension.gls", fromlist=["gls_grid"])
-                          .gls_grid(a, 9, 1, 0.5, 1, None)),
+                          .gls_grid(a, 17, 2, 0.5, 1, None)),
     "mass_transform_map": (IMG, lambda a: _core.mass_transform_map(a, 9, [3, 5, 7], 1.0, 0.5, 1)),
     "dbc_transform_map": (IMG, lambda a: _core.dbc_transform_map(a, 9, [2, 3, 4], 1.0, 0.0, False, 0.5, 1)),
     "blanket_transform_map": (IMG, lambda a: _core.blanket_transform_map(a, 9, [1, 2, 3], 1.0, 0.5, 1)),

@@ -193,3 +193,9 @@ def test_inf_is_missing_and_huge_values_never_give_garbage(field):
     ok = np.isfinite(big)
     ref = fg.fractal_transform(field, W, method="gls")
     np.testing.assert_allclose(big[ok], ref[ok], atol=1e-4)
+
+
+def test_small_window_is_a_value_error_naming_window_size():
+    z = np.random.default_rng(1).standard_normal((40, 40)).cumsum(0).cumsum(1)
+    with pytest.raises(ValueError, match="^window_size: the GLS filters"):
+        fg.fractal_transform(z, 9, method="gls", dilations=1)

@@ -97,7 +97,19 @@ def _overlap(n1: int, n2: int, lags: np.ndarray) -> np.ndarray:
 @lru_cache(maxsize=32)
 def tables(shape: Tuple[int, ...], dilations: int) -> dict:
     """GLS tables for grids of ``shape`` on :data:`H_GRID`: ``a``, ``da``,
-    ``g`` (each (nH, K)), ``se`` (nH,), ``counts`` (K,) full-grid anchors."""
+    ``g`` (each (nH, K)), ``se`` (nH,), ``counts`` (K,) full-grid anchors.
+
+    A grid too small for its filters (their covariance singular: e.g. a
+    window of 11 or fewer pixels) is a ``ValueError`` naming ``window_size``."""
+    try:
+        return _tables(tuple(shape), dilations)
+    except np.linalg.LinAlgError:
+        raise ValueError(f"window_size: the GLS filters with dilations={dilations} are degenerate on a "
+                         f"{' x '.join(map(str, shape))} grid (singular covariance); use a larger window "
+                         f"(13 or more pixels) or fewer dilations") from None
+
+
+def _tables(shape: Tuple[int, ...], dilations: int) -> dict:
     ndim = len(shape)
     fl = filters(ndim, dilations)
     K = len(fl)
