@@ -226,3 +226,22 @@ def test_docstring_examples_run():
 
     res = doctest.testmod(_resample, optionflags=doctest.ELLIPSIS)
     assert res.failed == 0 and res.attempted >= 4
+
+
+def test_dask_local_analysis_with_chunks_smaller_than_its_halo():
+    """The local analysis needs a halo of window // 2 + 2; chunks smaller
+    than that are merged first, so any chunking gives the in-memory result."""
+    da = pytest.importorskip("dask.array")
+    z = fg.fbm_surface((64, 64), 0.6, method="exact", seed=3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for chunks, window in [(10, 33), ((5, 7), 9), ((61, 4), 9)]:
+            ref = fg.fractal_resample(z, 2, seed=1, window=window)
+            got = fg.fractal_resample(da.from_array(z, chunks=chunks), 2, seed=1, window=window).compute()
+            np.testing.assert_array_equal(got, ref)
+
+
+def test_window_larger_than_twice_the_dem_is_a_value_error():
+    z = fg.fbm_surface((33, 33), 0.5, method="exact", seed=1)
+    with pytest.raises(ValueError, match="^window"):
+        fg.fractal_resample(z, 2, window=10**6 + 1)

@@ -555,3 +555,17 @@ def test_transform_xarray_outputs_named_and_keep_attrs():
     assert d.attrs["crs"] == "EPSG:32611"
     np.testing.assert_array_equal(d.y.values, np.arange(0.0, 64.0, 2.0))
     np.testing.assert_allclose(d.values, fg.fractal_transform(z, 9, method="variogram", step=2))
+
+
+def test_dask_halo_larger_than_an_image_side():
+    """A window wider than one side of the image (allowed: it is at most the
+    longer side) has a halo the Dask overlap cannot give; the dispatcher
+    pads that axis with NaN and still equals the in-memory map."""
+    da = pytest.importorskip("dask.array")
+    img = np.random.default_rng(0).random((10, 100))
+    for method, step in [("variogram", 1), ("mass", 3)]:
+        ref = fg.fractal_transform(img, 51, method=method, step=step)
+        got = fg.fractal_transform(da.from_array(img, chunks=(5, 30)), 51, method=method, step=step).compute()
+        np.testing.assert_allclose(got, ref, atol=1e-6, equal_nan=True)
+    np.testing.assert_allclose(fg.lacunarity_map(da.from_array(img, chunks=(5, 30)), 51).compute(),
+                               fg.lacunarity_map(img, 51), atol=1e-6, equal_nan=True)

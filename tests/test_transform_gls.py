@@ -199,3 +199,12 @@ def test_small_window_is_a_value_error_naming_window_size():
     z = np.random.default_rng(1).standard_normal((40, 40)).cumsum(0).cumsum(1)
     with pytest.raises(ValueError, match="^window_size: the GLS filters"):
         fg.fractal_transform(z, 9, method="gls", dilations=1)
+
+
+def test_design_and_anisotropy_checks_name_the_parameter():
+    z = np.random.default_rng(1).standard_normal((33, 33)).cumsum(0).cumsum(1)
+    for kw, exc, start in [({"design": 5}, TypeError, "design"), ({"design": ("a", "b")}, TypeError, "design"),
+                           ({"design": (1000, 1000)}, ValueError, "design"),
+                           ({"anisotropy": "yes"}, TypeError, "anisotropy")]:
+        with pytest.raises(exc, match=f"^{start}"):
+            fg.gls_dimension(z, **kw)

@@ -18,7 +18,7 @@ from typing import Callable, Dict, Optional, Sequence
 
 import numpy as np
 
-__all__ = ["run_raster", "array_kind", "require"]
+__all__ = ["run_raster", "halo_blocks", "array_kind", "require"]
 
 _EXTRAS = {"dask": "dask", "xarray": "dask", "rasterio": "geo", "matplotlib": "plot", "tqdm": "progress"}
 
@@ -62,19 +62,37 @@ def _run_numpy(kernel, arr, *, n_out, **_):
     return out
 
 
-def _run_dask(kernel, arr, *, depth: int, step: int, n_out: int, dtype):
+def halo_blocks(arr, depth: int, step: int = 1):
+    """``(padded, core)``: the dask array ``arr`` with a NaN halo of
+    ``depth`` pixels around every block, and the chunks of the blocks it
+    was cut into (before the halo).
+
+    Chunks smaller than the halo are merged into their neighbours (and with
+    a ``step`` every chunk but the last is a multiple of it); an axis
+    shorter than the halo is taken as one block padded with NaN, which is
+    what the halo of an edge block holds anyway."""
     import dask.array as da
 
-    # halo: what a window reaches, rounded up to the step so that every
-    # chunk's first output pixel sits on the step grid of its padded block
-    depth = -(-depth // step) * step
+    if depth == 0:
+        return arr, arr.chunks
+    if any(n <= depth for n in arr.shape):
+        one = arr.rechunk(arr.shape)
+        padded = da.pad(one, depth, mode="constant", constant_values=np.nan)
+        return padded.rechunk(tuple(n + 2 * depth for n in arr.shape)), one.chunks
     chunks = arr.chunks
     if step > 1 or min(min(c) for c in chunks) < depth:
         # every chunk must hold the halo its neighbours need, and with a
         # step every chunk but the last a multiple of it
         arr = arr.rechunk(tuple(_even_chunks(n, max(depth, max(c)), step, depth)
                                 for n, c in zip(arr.shape, chunks)))
-    padded = da.overlap.overlap(arr, depth=depth, boundary=np.nan) if depth else arr
+    return da.overlap.overlap(arr, depth=depth, boundary=np.nan), arr.chunks
+
+
+def _run_dask(kernel, arr, *, depth: int, step: int, n_out: int, dtype):
+    # halo: what a window reaches, rounded up to the step so that every
+    # chunk's first output pixel sits on the step grid of its padded block
+    depth = -(-depth // step) * step
+    padded, _ = halo_blocks(arr, depth, step)
     d0 = depth // step
 
     def block_fn(b):

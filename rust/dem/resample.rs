@@ -393,16 +393,62 @@ impl Partial {
 }
 
 /// Read-only view of a source grid for stencil lookups.
+/// A read-only view of a `rows x cols` grid. It holds a raw pointer, not a
+/// `&[f64]`, because during a parallel step other rows write cells of the
+/// other parity into the same buffer: a shared slice over memory being
+/// written would be undefined behaviour even if the written cells are never
+/// read through it.
 struct Grid<'a> {
-    v: &'a [f64],
+    v: *const f64,
     rows: usize,
     cols: usize,
     /// Point support: only old samples (even row and column) make holes;
     /// area support: no sample of the stencil makes a hole.
     point: bool,
+    _buffer: std::marker::PhantomData<&'a [f64]>,
 }
 
-impl Grid<'_> {
+// SAFETY: a Grid only reads, and only cells that no thread writes while it
+// exists (the parity rule of the steps; a grid built from a slice is not
+// written at all), so sharing it between threads is sound.
+unsafe impl Sync for Grid<'_> {}
+
+impl<'a> Grid<'a> {
+    /// A view of a slice that nothing writes while the view lives.
+    fn of(v: &'a [f64], rows: usize, cols: usize, point: bool) -> Self {
+        assert_eq!(v.len(), rows * cols);
+        Grid {
+            v: v.as_ptr(),
+            rows,
+            cols,
+            point,
+            _buffer: std::marker::PhantomData,
+        }
+    }
+
+    /// A view of `rows * cols` values at `v`.
+    ///
+    /// # Safety
+    /// `v` must be valid for reads of `rows * cols` values for `'a`, and the
+    /// cells the view reads must not be written while it lives.
+    unsafe fn from_raw(v: *const f64, rows: usize, cols: usize, point: bool) -> Self {
+        Grid {
+            v,
+            rows,
+            cols,
+            point,
+            _buffer: std::marker::PhantomData,
+        }
+    }
+
+    #[inline]
+    fn at(&self, k: usize) -> f64 {
+        assert!(k < self.rows * self.cols);
+        // SAFETY: k is inside the grid (asserted), which the constructors
+        // guarantee readable, and the cell is not being written.
+        unsafe { self.v.add(k).read() }
+    }
+
     /// Mask of present (inside and finite) samples and whether one of the
     /// inner 4 is present but not finite (the result is then NaN).
     #[inline]
@@ -412,7 +458,7 @@ impl Grid<'_> {
         for (k, &(dr, dc)) in st.offsets.iter().enumerate() {
             let (ii, jj) = (i as isize + dr, j as isize + dc);
             if ii >= 0 && jj >= 0 && (ii as usize) < self.rows && (jj as usize) < self.cols {
-                let x = self.v[ii as usize * self.cols + jj as usize];
+                let x = self.at(ii as usize * self.cols + jj as usize);
                 if x.is_finite() {
                     m |= 1 << k;
                 } else if self.point && ii % 2 == 0 && jj % 2 == 0 && st.inner.contains(&k) {
@@ -594,12 +640,7 @@ fn level_point(
             }
         };
         let partial = {
-            let g = Grid {
-                v: &fine,
-                rows: fr,
-                cols: fc,
-                point: true,
-            };
+            let g = Grid::of(&fine, fr, fc, true);
             Partial::build(st, step, collect_masks(&g, st, fr, 3, any_nan, targets))
         };
         let ptr = Shared(fine.as_mut_ptr());
@@ -617,13 +658,10 @@ fn level_point(
                 // the stencils) and the cell has the read parity.
                 unsafe { *base.add(k) }
             };
-            let g = Grid {
-                // SAFETY: used only for reads of cells of the read parity.
-                v: unsafe { std::slice::from_raw_parts(base as *const f64, len) },
-                rows: fr,
-                cols: fc,
-                point: true,
-            };
+            // SAFETY: `base` points to the fr x fc buffer `fine`, alive for
+            // the loop; the view reads only cells of the read parity, which
+            // no row writes in this step.
+            let g = unsafe { Grid::from_raw(base as *const f64, fr, fc, true) };
             let mut last_h = f64::NAN;
             let mut cache = ([0.0; NS], 0.0);
             for j in targets(i) {
@@ -707,12 +745,7 @@ fn level_area(
         .as_slice()
         .ok_or_else(|| CoreError::Internal("coarse grid not contiguous".into()))?;
     let any_nan = cs.iter().any(|x| !x.is_finite());
-    let g = Grid {
-        v: cs,
-        rows: r,
-        cols: c,
-        point: false,
-    };
+    let g = Grid::of(cs, r, c, false);
     let shift = l + 1;
     let gmul = 1u64 << shift;
     let (g0, g1) = (p.origin.0 * gmul, p.origin.1 * gmul);

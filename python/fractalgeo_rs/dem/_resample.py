@@ -2,14 +2,13 @@
 from __future__ import annotations
 
 import numbers
-import os
 import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from fractalgeo_rs import _core
-from fractalgeo_rs._validation import as_array, check_choice, check_n_threads, check_nodata
+from fractalgeo_rs._validation import as_array, check_choice, check_memory, check_n_threads, check_nodata
 from fractalgeo_rs.synth._common import resolve_seed
 
 __all__ = ["fractal_resample", "resample_analysis", "ResampleAnalysis", "HURST_RANGE"]
@@ -137,11 +136,14 @@ def _finish(hraw, var1, valid):
     return hurst, sigma, (n_clip / n_ok if n_ok else 0.0)
 
 
-def _check_window(window):
+def _check_window(window, shape=None):
     if isinstance(window, bool) or not isinstance(window, numbers.Integral):
         raise TypeError(f"window: expected an odd int >= 5, got {window!r}")
     if window < 5 or window % 2 == 0:
         raise ValueError(f"window: expected an odd int >= 5, got {window}")
+    if shape is not None and window > 2 * max(shape) + 1:
+        raise ValueError(f"window: {window} is more than twice the DEM's side {max(shape)}; "
+                         f"a window of at most {2 * max(shape) + 1} already covers it")
     return int(window)
 
 
@@ -181,9 +183,9 @@ def resample_analysis(dem, *, window=33, support="point", block=2, nodata=None):
     >>> 0.45 < float(a.hurst[64, 64]) < 0.75
     True
     """
-    window = _check_window(window)
     check_choice(support, "support", ("point", "area"))
     z = _as_float(dem, nodata)
+    window = _check_window(window, z.shape)
     half = window // 2
     t = half + 2
     zp = np.pad(z, t, constant_values=np.nan)
@@ -275,14 +277,10 @@ def _detail(levels, cell, min_scale):
 
 
 def _check_memory(shape, f):
-    nbytes = 8.0 * shape[0] * shape[1] * f * f * 1.5  # output + last level's input
-    try:
-        avail = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-    except (ValueError, OSError, AttributeError):  # pragma: no cover
-        return
-    if nbytes > avail:
-        raise MemoryError(f"factor: the output needs about {nbytes / 2**30:.1f} GiB, "
-                          f"{avail / 2**30:.1f} GiB available; use a dask array (chunks)")
+    """The package's memory policy (``check_memory``: MemoryLimitError naming
+    ``factor``): the output and the last level's input, in float64."""
+    nbytes = 8.0 * shape[0] * shape[1] * f * f * 1.5
+    check_memory(nbytes, "factor", what=f"a {f}x finer grid of {shape[0]} x {shape[1]} (use a dask array)")
 
 
 def _is_xarray(a):
@@ -415,7 +413,7 @@ def fractal_resample(dem, factor=2, *, hurst="local", sigma="local", window=33, 
     local_h = isinstance(hurst, str) and hurst == "local"
     local_s = isinstance(sigma, str) and sigma == "local"
     if local_h or local_s:
-        window = _check_window(window)
+        window = _check_window(window, np.shape(dem))
     if _is_xarray(dem):
         return _run_xarray(dem, f, levels, hurst, sigma, window, detail, support, cell, nodata,
                            seed, n_threads, return_analysis)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from fractalgeo_rs import _core
+from fractalgeo_rs._backend import halo_blocks
 from fractalgeo_rs.dem import _resample as R
 
 
@@ -32,9 +33,9 @@ def _analysis_maps(dem, hurst, sigma, window, support, nodata):
             return np.stack([h, s])
 
         z = dem.map_blocks(R._as_float, nodata, dtype=np.float64)
-        padded = da.overlap.overlap(z, depth=t, boundary=np.nan)
+        padded, core = halo_blocks(z, t)
         hs = padded.map_blocks(block, dtype=np.float64, new_axis=0,
-                               chunks=((2,),) + dem.chunks)
+                               chunks=((2,),) + core)
         h_map, s_map = hs[0], hs[1]
     shape = dem.shape
     h = h_map if local_h else da.from_array(

@@ -232,9 +232,14 @@ def _design(shape, design) -> Tuple[int, ...]:
     if design is None:
         cap = DESIGN_CAP[len(shape)]
         return tuple(min(int(n), cap) for n in shape)
-    design = tuple(int(v) for v in design)
-    if len(design) != len(shape) or min(design) < 1:
+    if isinstance(design, (str, bytes)) or np.ndim(design) != 1:
+        raise TypeError(f"design: expected a sequence of {len(shape)} positive ints, got {design!r}")
+    if len(design) != len(shape):
         raise ValueError(f"design: expected {len(shape)} positive ints, got {design!r}")
+    design = tuple(check_positive_int(v, "design") for v in design)
+    cap = DESIGN_CAP[len(shape)]
+    if max(design) > cap:
+        raise ValueError(f"design: at most {cap} per side (the tables grow as its square), got {design}")
     return design
 
 
@@ -309,6 +314,8 @@ def gls_dimension(
     True
     """
     z = _with_nodata(_real_array(data, (1, 2)), data, nodata)
+    if not isinstance(anisotropy, (bool, np.bool_)):
+        raise TypeError(f"anisotropy: expected True or False, got {anisotropy!r}")
     k = _check_dilations(dilations)
     shape = _design(z.shape, design)
     t = tables(shape, k)
