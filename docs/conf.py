@@ -65,7 +65,7 @@ sphinx_gallery_conf = {
     "examples_dirs": str(HERE.parent / "examples"),
     "gallery_dirs": "auto_examples",
     "filename_pattern": r"/plot_",
-    "ignore_pattern": r"(__init__|urban_segmentation)\.py",
+    "ignore_pattern": r"(__init__|urban_segmentation|fractal_resampling)\.py",
     "download_all_examples": False,
     "remove_config_comments": True,
     "abort_on_example_error": True,

@@ -1,18 +1,21 @@
 """Raster input/output: ``.npy``, 8/16-bit PNG, float EXR and GeoTIFF.
 
-=========== ================================= ===================================
-format      read                              write
-=========== ================================= ===================================
-``.npy``    ``numpy.load`` (no pickles)       any array
-``.png``    Rust ``image`` crate (grey; colour 2D uint8 / uint16 (grey); a
-            needs ``band=``)                  ``transform`` goes to a world file
-                                              (``.pgw``), a ``crs`` to ``.prj``
-``.exr``    Rust ``exr`` crate, channel "Y"   2D real array, stored as float32
-``.tif``    rasterio (keeps CRS, transform,   2D array with ``profile`` / ``crs``
-``.tiff``   nodata); without rasterio 8/16-   / ``transform`` / ``nodata``
-            bit TIFF via the ``image`` crate  (needs rasterio: the ``geo`` extra)
-other       rasterio (any GDAL format)        --
-=========== ================================= ===================================
+``.npy``
+    read with ``numpy.load`` (no pickles); any array is written.
+``.png``
+    read with the Rust ``image`` crate (grey; colour needs ``band=``);
+    2D uint8 / uint16 (grey) written, a ``transform`` to a world file
+    (``.pgw``) and a ``crs`` to ``.prj``.
+``.exr``
+    the Rust ``exr`` crate, channel "Y"; a 2D real array is stored as
+    float32.
+``.tif``, ``.tiff``
+    rasterio (keeps CRS, transform, nodata; without rasterio 8/16-bit TIFF
+    is read by the ``image`` crate); a 2D array is written with
+    ``profile`` / ``crs`` / ``transform`` / ``nodata`` (needs rasterio, the
+    ``geo`` extra).
+other extensions
+    read through rasterio (any GDAL format); not written.
 
 Every write is atomic: the file is written beside the target under a
 temporary name and renamed over it, so it appears whole or not at all.

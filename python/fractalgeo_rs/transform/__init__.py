@@ -215,7 +215,7 @@ def fractal_transform(
         ``fractalgeo_rs.dimension.gls``), ``D = 3 - H``: exactly
         :func:`fractalgeo_rs.gls_dimension` of the clipped window with
         ``design=(window_size, window_size)``. Unbiased on exact fBm
-        (|bias| <= 0.001) with a spread 1.0-1.2 times the Cramér-Rao bound
+        (absolute bias at most 0.001) with a spread 1.0-1.2 times the Cramér-Rao bound
         at windows 33 and 65 (docs/transform.md), every window statistic a
         window sum of a filtered image (summed-area tables: cost flat in the
         window). Scale free (no ``z_scale``). With ``return_fit`` the second
