@@ -604,7 +604,7 @@ fn level_point(
         .as_slice()
         .ok_or_else(|| CoreError::Internal("coarse grid not contiguous".into()))?;
     let any_nan = cs.iter().any(|x| !x.is_finite());
-    let mut fine = crate::buffers::zeroed(fr * fc);
+    let mut fine = crate::buffers::try_zeroed(fr * fc, "factor")?;
     // Old samples.
     fine.par_chunks_mut(fc).enumerate().for_each(|(i, row)| {
         if i % 2 == 0 {
@@ -764,7 +764,7 @@ fn level_area(
             collect_masks(&g, st, r, 2, any_nan, |_| (0..c).collect()),
         ));
     }
-    let mut fine = crate::buffers::zeroed(fr * fc);
+    let mut fine = crate::buffers::try_zeroed(fr * fc, "factor")?;
     let corr = (4.0f64 / 3.0).sqrt();
     fine.par_chunks_mut(2 * fc)
         .enumerate()

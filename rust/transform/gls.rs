@@ -338,19 +338,13 @@ pub fn gls_transform<T: Sample>(
     let h = w / 2;
     let ob = (band_rows(w) / step).max(1);
     let n_out = orows * ocols;
+    let nan_map =
+        |on: bool| crate::buffers::try_filled(if on { n_out } else { 0 }, f32::NAN, "image");
     let mut maps = GlsMaps {
-        hurst: vec![f32::NAN; n_out],
-        se: vec![f32::NAN; n_out],
-        angle: if opt.anisotropy {
-            vec![f32::NAN; n_out]
-        } else {
-            vec![]
-        },
-        ratio: if opt.anisotropy {
-            vec![f32::NAN; n_out]
-        } else {
-            vec![]
-        },
+        hurst: nan_map(true)?,
+        se: nan_map(true)?,
+        angle: nan_map(opt.anisotropy)?,
+        ratio: nan_map(opt.anisotropy)?,
     };
     let full = (w * w) as f64;
     let polys = tab.step_polys(nf);
