@@ -208,3 +208,17 @@ def test_design_and_anisotropy_checks_name_the_parameter():
                            ({"anisotropy": "yes"}, TypeError, "anisotropy")]:
         with pytest.raises(exc, match=f"^{start}"):
             fg.gls_dimension(z, **kw)
+
+
+def test_pinned_estimates_are_flagged_and_warned():
+    """Real scenes smoother than fBm at dilations 1-2 (the bundled Sentinel-1
+    dB scene) drive H to the end of the grid: the whole-image fit is flagged
+    invalid with no interval, and the map warns with the pinned fraction."""
+    vv, _ = fg.data.sentinel1_vv_db()
+    with pytest.warns(fg.FractalRangeWarning, match="pinned at the upper end"):
+        fit = fg.gls_dimension(vv.astype(float))
+    assert not fit.valid and "pinned" in fit.flags and np.isnan(fit.ci95[0])
+    with pytest.warns(fg.FractalRangeWarning, match=r"% of the windows are pinned"):
+        fg.fractal_transform(vv, 33, method="gls", step=8)
+    with pytest.warns(fg.FractalRangeWarning, match="lower end"):
+        fg.gls_dimension(np.random.default_rng(0).standard_normal((128, 128)))

@@ -335,12 +335,53 @@ def gls_dimension(
             raise ValueError("anisotropy: defined for surfaces (2D) only")
         extra["anisotropy_angle"], extra["anisotropy_ratio"] = anisotropy_from_variations(V, labels, H)
     log_s2 = float(np.mean(np.log(V) - a))
-    return DimensionFit.from_model(
+    fit = DimensionFit.from_model(
         dimension=off - H, stderr=se, scales=[lab[2] for lab in labels], measures=V,
         model=np.exp(a + log_s2), method="gls", dim_offset=off, x_label="dilation",
         y_label="quadratic variation",
         extra=extra,
     )
+    msg = _pinned_message(H, off)
+    if msg:
+        from fractalgeo_rs.fit import mark_invalid
+
+        fit = mark_invalid(fit, "pinned", f"gls: {msg}", stacklevel=3)
+    return fit
+
+
+def _pinned_message(H: float, off: float) -> str:
+    """Why an estimate at an end of :data:`H_GRID` is not a valid one ('' if
+    it is inside)."""
+    lo, hi = float(H_GRID[0]), float(H_GRID[-1])
+    if H >= hi - 1e-6:
+        return (f"H = {H:.3f} is pinned at the upper end of the H grid (D = {off - H:.3f}): the data are "
+                f"smoother than fBm at dilations 1-2 (H >= 1 there), beyond the model; no valid interval. Use "
+                f"an estimator over larger scales (e.g. variogram or surface_variation with larger lags)")
+    if H <= lo + 1e-6:
+        return (f"H = {H:.3f} is pinned at the lower end of the H grid (D = {off - H:.3f}): the data are "
+                f"rougher than fBm (white noise, speckle); no valid interval")
+    return ""
+
+
+def warn_pinned_map(d: np.ndarray, off: float = 3.0) -> None:
+    """One ``FractalRangeWarning`` giving the fraction of a GLS map's
+    windows pinned at an end of the H grid, when there are any."""
+    import warnings
+
+    from fractalgeo_rs.fit import FractalRangeWarning
+
+    v = d[np.isfinite(d)]
+    if v.size == 0:
+        return
+    hi = np.mean(v <= off - float(H_GRID[-1]) + 1e-4)
+    lo = np.mean(v >= off - float(H_GRID[0]) - 1e-4)
+    for frac, end, what in [(hi, "upper", "smoother than fBm at dilations 1-2 (use a larger-scale method)"),
+                            (lo, "lower", "rougher than fBm (white noise, speckle)")]:
+        if frac > 0:
+            warnings.warn(f"gls: {100 * frac:.1f} % of the windows are pinned at the {end} end of the H grid "
+                          f"(D = {off - (float(H_GRID[-1]) if end == 'upper' else float(H_GRID[0])):.2f}): "
+                          f"the data there are {what}; those values are bounds, not estimates",
+                          FractalRangeWarning, stacklevel=4)
 
 
 def anisotropy_from_variations(V: np.ndarray, labels: Sequence[tuple], hurst: float) -> Tuple[float, float]:

@@ -397,6 +397,10 @@ def fractal_transform(
         names += ("anisotropy_angle", "anisotropy_ratio")
     out = run_raster(kernel, image, depth=half, n_out=len(names), step=step,
                      prepare=prepare if array_kind(arr) == "dask" else None, names=names)
+    if method == "gls" and array_kind(arr) != "dask":  # (a lazy map is not read here)
+        from fractalgeo_rs.dimension.gls import warn_pinned_map
+
+        warn_pinned_map(np.asarray(out[0]))
     if array_kind(image) == "xarray":  # record what makes maps comparable
         for o in out:
             o.attrs.update({"fractal_method": method, "window_size": w})
