@@ -115,6 +115,7 @@ def check_n_threads(n_threads) -> Optional[int]:
         return None
     if isinstance(n_threads, bool) or not isinstance(n_threads, numbers.Integral):
         raise TypeError(f"n_threads: expected a positive int or None, got {n_threads!r}")
+    n_threads = int(n_threads)
     if n_threads < 1:
         raise ValueError(f"n_threads: expected a positive int or None, got {n_threads}")
     cap = max_threads()
@@ -191,9 +192,10 @@ def resolve_max_memory(max_memory=None) -> int:
         return default_max_memory()
     if isinstance(max_memory, bool) or not isinstance(max_memory, numbers.Real):
         raise TypeError(f"max_memory: expected a number of bytes or None, got {max_memory!r}")
-    if not (max_memory > 0 and math.isfinite(max_memory)):
+    limit = float(max_memory)
+    if not (limit > 0 and math.isfinite(limit)):
         raise ValueError(f"max_memory: expected a positive number of bytes, got {max_memory}")
-    return int(max_memory)
+    return int(limit)
 
 
 def _gib(n: float) -> str:

@@ -12,6 +12,7 @@ motion. *IEEE Trans. Information Theory* 38(2), 910-917.
 """
 from __future__ import annotations
 
+import numbers
 from typing import Optional, Sequence
 
 import numpy as np
@@ -185,7 +186,7 @@ def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, sample_spacin
     """
     z = _with_nodata(_real_array(data, (1,)), data, nodata)
     _gap_free(z, "scale space")
-    if isinstance(sample_spacing, bool) or not np.isscalar(sample_spacing) or not sample_spacing >= 0:
+    if isinstance(sample_spacing, bool) or not isinstance(sample_spacing, numbers.Real) or not sample_spacing >= 0:
         raise ValueError(f"sample_spacing: expected a number >= 0, got {sample_spacing!r}")
     dx = float(sample_spacing)
     if sigmas is None:
@@ -265,7 +266,7 @@ def wavelet_dimension(data, *, levels: Optional[Sequence[int]] = None, nodata: O
     min_n = 8 if z.ndim == 1 else 48
     js = np.arange(1, len(det) + 1)
     if levels is None:
-        sel = [j for j in js if det[j - 1].size >= min_n]
+        sel = [int(j) for j in js if det[j - 1].size >= min_n]
     else:
         sel = sorted(set(int(j) for j in levels))
         if not sel or sel[0] < 1 or sel[-1] > len(det):

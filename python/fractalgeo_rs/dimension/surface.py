@@ -222,6 +222,7 @@ def mass_dimension(
         # Rust kernel (shared with the fractal transform): box masses per pixel
         from fractalgeo_rs import _core
 
+        assert z_scale is not None  # set above for grayscale data
         N = _core.mass_curve_image(np.ascontiguousarray(z - zmin), sizes, z_scale, None).tolist()
     else:
         from scipy.spatial import cKDTree
