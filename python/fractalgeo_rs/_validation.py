@@ -254,6 +254,13 @@ def check_positive_int(value, name: str) -> int:
     return int(value)
 
 
+def check_fraction(value, name: str) -> float:
+    """A number in [0, 1] (e.g. ``min_valid``), as a float."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not (0.0 <= float(value) <= 1.0):
+        raise ValueError(f"{name}: expected a fraction in [0, 1], got {value!r}")
+    return float(value)
+
+
 def check_positive_float(value, name: str) -> float:
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise TypeError(f"{name}: expected a positive number, got {value!r}")

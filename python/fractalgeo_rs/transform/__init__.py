@@ -23,7 +23,7 @@ Voss, R. F. (1986). Characterization and measurement of random fractals.
 """
 from __future__ import annotations
 
-from typing import Optional, Sequence, Union
+from typing import Any, Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -32,6 +32,7 @@ from fractalgeo_rs._backend import array_kind, run_raster
 from fractalgeo_rs._validation import (
     as_array,
     check_choice,
+    check_fraction,
     check_n_threads,
     check_nodata,
     check_positive_float,
@@ -43,7 +44,7 @@ from fractalgeo_rs.transform.segment import segment
 
 __all__ = ["default_z_scale", "fractal_transform", "lacunarity_map", "segment", "TRANSFORM_METHODS"]
 
-TRANSFORM_METHODS = {
+TRANSFORM_METHODS: Dict[str, Tuple[Optional[float], Optional[bool]]] = {
     # name: (power p, square increments); "mass", "dbc", "blanket" have their own kernels
     "mass": (None, None),
     "dbc": (None, None),
@@ -122,6 +123,7 @@ def _grid(z: np.ndarray, w: int, method: str, opts: dict, min_valid: float, step
     if method == "mass":
         return _core.mass_transform_map(z, w, opts["sizes"], opts["z_scale"], min_valid, step, n_threads)
     p, square = TRANSFORM_METHODS[method]
+    assert p is not None and square is not None  # the increment methods
     return _core.variation_transform_map(z, w, opts["lags"], p, square, min_valid, step, n_threads)
 
 
@@ -332,9 +334,7 @@ def fractal_transform(
         z_scale = check_positive_float(z_scale, "z_scale")
     n_threads = check_n_threads(n_threads)
     step = check_positive_int(step, "step")
-    if isinstance(min_valid, bool) or not np.isscalar(min_valid) or not (0.0 <= float(min_valid) <= 1.0):
-        raise ValueError(f"min_valid: expected a fraction in [0, 1], got {min_valid!r}")
-    min_valid = float(min_valid)
+    min_valid = check_fraction(min_valid, "min_valid")
     try:
         lags = sorted(set(int(v) for v in lags))
     except (TypeError, ValueError):
@@ -342,9 +342,10 @@ def fractal_transform(
 
     arr, image = _select_band(image, band)
     w = _check_window(window_size, arr.shape)
-    if auto_z:
-        z_scale = default_z_scale(arr, nodata) if method in ("mass", "dbc", "blanket") else None
-    opts = {"lags": lags, "z_scale": z_scale, "dilations": dilations, "anisotropy": bool(anisotropy)}
+    z_used: Optional[float] = None  # the height unit of the box and mass methods
+    if method in ("mass", "dbc", "blanket"):
+        z_used = default_z_scale(arr, nodata) if auto_z else float(z_scale)
+    opts: Dict[str, Any] = {"lags": lags, "z_scale": z_used, "dilations": dilations, "anisotropy": bool(anisotropy)}
     half = w // 2
     if method == "mass":
         if box_sizes is None:
@@ -392,7 +393,7 @@ def fractal_transform(
         return np.stack(_grid(z, w, method, opts, min_valid, step, n_threads))
 
     image = _prepared(image, arr, prepare)
-    names = ("fractal_dimension", "r_squared" if method not in ("whittle", "gls") else "standard_error")
+    names: Tuple[str, ...] = ("fractal_dimension", "r_squared" if method not in ("whittle", "gls") else "standard_error")
     if method == "gls" and opts["anisotropy"]:
         names += ("anisotropy_angle", "anisotropy_ratio")
     out = run_raster(kernel, image, depth=half, n_out=len(names), step=step,
@@ -405,7 +406,7 @@ def fractal_transform(
         for o in out:
             o.attrs.update({"fractal_method": method, "window_size": w})
             if method in ("mass", "dbc", "blanket"):
-                o.attrs["z_scale"] = float(z_scale)
+                o.attrs["z_scale"] = z_used
     # gls with anisotropy: D[, se], angle, ratio
     out = tuple(out[:2] if return_fit else out[:1]) + tuple(out[2:])
     return out if len(out) > 1 else out[0]
@@ -516,9 +517,7 @@ def lacunarity_map(
             raise TypeError(f"box_sizes: expected a sequence of ints, got {box_sizes!r}") from None
         if not sizes or any(r < 1 or r > w for r in sizes):
             raise ValueError(f"box_sizes: box sides must be in [1, {w}], got {sizes}")
-    if isinstance(min_valid, bool) or not np.isscalar(min_valid) or not (0.0 <= float(min_valid) <= 1.0):
-        raise ValueError(f"min_valid: expected a fraction in [0, 1], got {min_valid!r}")
-    min_valid = float(min_valid)
+    min_valid = check_fraction(min_valid, "min_valid")
     n_threads = check_n_threads(n_threads)
 
     def prepare(block):
