@@ -29,6 +29,7 @@ import numpy as np
 
 from fractalgeo_rs import _core
 from fractalgeo_rs._backend import array_kind, run_raster
+from fractalgeo_rs._compat import keyword_only_since
 from fractalgeo_rs._validation import (
     as_array,
     check_choice,
@@ -268,7 +269,9 @@ def fractal_transform(
         Output NaN where fewer than this fraction of the window's pixels are
         valid.
     band : int, optional
-        0-based band index for a 3D (bands, rows, cols) input.
+        1-based band number for a 3D (bands, rows, cols) input, as in
+        rasterio, GDAL and :func:`~fractalgeo_rs.read_raster` (0-based
+        before 0.2.0: ``band=0`` now raises ValueError saying so).
     n_threads : int, optional
         Threads (default all cores); results are identical for any value.
         For ``"whittle"`` these are the FFT workers; its matrix products run
@@ -415,17 +418,22 @@ def fractal_transform(
 def _select_band(image, band):
     """``(array, image)``: the 2D array to check (numpy or dask) and the
     object to compute on (the same, or the xarray DataArray), with ``band``
-    (0-based) taken from a 3D input."""
+    (1-based, as in rasterio and GDAL) taken from a 3D input."""
     kind = array_kind(image)
     data = image.data if kind == "xarray" else image
     arr = data if array_kind(data) == "dask" else as_array(data, "image")
     if arr.ndim == 3:
         if band is None:
-            raise ValueError(f"band: a 3D input of shape {arr.shape} needs band= (0-based band index)")
-        if isinstance(band, bool) or not isinstance(band, (int, np.integer)) or not (0 <= band < arr.shape[0]):
-            raise ValueError(f"band: expected an index in [0, {arr.shape[0]}), got {band!r}")
-        arr = arr[int(band)]
-        image = image[int(band)] if kind == "xarray" else arr
+            raise ValueError(f"band: a 3D input of shape {arr.shape} needs band= (1-based band number)")
+        if isinstance(band, bool) or not isinstance(band, (int, np.integer)):
+            raise TypeError(f"band: expected a 1-based band number, got {band!r}")
+        if band == 0:
+            raise ValueError("band: band numbers are 1-based, as in rasterio and GDAL (0-based before 0.2.0): "
+                             "band=1 is the first band")
+        if not (1 <= band <= arr.shape[0]):
+            raise ValueError(f"band: expected a band number in [1, {arr.shape[0]}], got {band!r}")
+        arr = arr[int(band) - 1]
+        image = image[int(band) - 1] if kind == "xarray" else arr
     elif kind != "xarray":
         image = arr
     if arr.ndim != 2:
@@ -451,11 +459,12 @@ def _prepared(image, arr, prepare):
     return image.copy(data=z) if array_kind(image) == "xarray" else z
 
 
+@keyword_only_since(["box_sizes"], since="0.2.0")
 def lacunarity_map(
     image,
     window_size: int,
-    box_sizes: Optional[Sequence[int]] = None,
     *,
+    box_sizes: Optional[Sequence[int]] = None,
     nodata: Optional[float] = None,
     min_valid: float = 0.5,
     n_threads: Optional[int] = None,
