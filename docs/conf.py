@@ -53,7 +53,9 @@ autosummary_imported_members = True
 # module pages list what the module's __all__ exports, nothing it imports
 autosummary_ignore_module_all = False
 templates_path = ["_templates"]
-autodoc_default_options = {"members": False}
+# no default options: with Sphinx 9 a default "members": False also turns off
+# the :members: the class template asks for
+autodoc_default_options: dict = {}
 # module pages link a member to its page: fractalgeo_rs.<name> for the names
 # of the top-level __all__, fractalgeo_rs.<module>.<name> for the others
 autosummary_context = {"toplevel": [n for n in fractalgeo_rs.__all__ if n != "__version__"]}
@@ -111,13 +113,14 @@ html_show_sourcelink = False
 # The extension module ``fractalgeo_rs._core`` is private and has no pages; an
 # annotation naming one of its types (``LString(core: _core.ModuleString)``)
 # is left out of the rendered signature instead of linking nowhere.
-_PRIVATE_ANNOTATION = re.compile(r"\s*:\s*['\"]?(?:fractalgeo_rs\.)?_core\.\w+['\"]?")
+_PRIVATE_TYPE = r"['\"]?~?(?:fractalgeo_rs\.)?_core\.\w+['\"]?"
+_PRIVATE_ANNOTATION = re.compile(r"\s*:\s*" + _PRIVATE_TYPE)
 
 
 def _drop_private_annotations(app, what, name, obj, options, signature, return_annotation):
     if signature:
         signature = _PRIVATE_ANNOTATION.sub("", signature)
-    if return_annotation and re.fullmatch(r"['\"]?(?:fractalgeo_rs\.)?_core\.\w+['\"]?", return_annotation):
+    if return_annotation and re.fullmatch(_PRIVATE_TYPE, return_annotation):
         return_annotation = None
     return signature, return_annotation
 

@@ -180,6 +180,10 @@ class LSystem:
     max_length : int
         Largest allowed number of modules; a longer derivation raises
         ``ValueError`` instead of exhausting memory.
+    defaults : mapping of str to str, optional
+        Settings for the caller (``n``, ``angle``, ``step``, ...; the
+        ``key: value`` lines of the text format), kept as the dict attribute
+        ``defaults``; the L-system itself does not read them.
 
     Notes
     -----
@@ -242,7 +246,7 @@ class LSystem:
 
         ``#`` starts a comment; ``axiom: ...`` and ``ignore: ...`` lines set
         those; any other ``key: value`` line (``n``, ``angle``, ``step``,
-        ``width``, ...) is kept in :attr:`defaults` for the caller; every
+        ``width``, ...) is kept in the dict ``defaults`` for the caller; every
         line with ``->`` is a production. A ``seed: k`` line is used when
         ``seed`` is None.
 
