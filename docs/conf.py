@@ -20,6 +20,8 @@ matplotlib.use("Agg")
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
+import re  # noqa: E402
+
 import fractalgeo_rs  # noqa: E402
 import _apigen  # noqa: E402
 
@@ -51,7 +53,12 @@ autosummary_imported_members = True
 # module pages list what the module's __all__ exports, nothing it imports
 autosummary_ignore_module_all = False
 templates_path = ["_templates"]
-autodoc_default_options = {"members": False}
+# no default options: with Sphinx 9 a default "members": False also turns off
+# the :members: the class template asks for
+autodoc_default_options: dict = {}
+# module pages link a member to its page: fractalgeo_rs.<name> for the names
+# of the top-level __all__, fractalgeo_rs.<module>.<name> for the others
+autosummary_context = {"toplevel": [n for n in fractalgeo_rs.__all__ if n != "__version__"]}
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
 numpydoc_xref_param_type = False
@@ -100,3 +107,23 @@ html_theme_options = {
 html_show_sourcelink = False
 # Formulas are rendered by the copy of MathJax that sphinx-mathjax-offline
 # places in _static: the site loads nothing from the network.
+
+
+# -- Signatures ------------------------------------------------------------------
+# The extension module ``fractalgeo_rs._core`` is private and has no pages; an
+# annotation naming one of its types (``LString(core: _core.ModuleString)``)
+# is left out of the rendered signature instead of linking nowhere.
+_PRIVATE_TYPE = r"['\"]?~?(?:fractalgeo_rs\.)?_core\.\w+['\"]?"
+_PRIVATE_ANNOTATION = re.compile(r"\s*:\s*" + _PRIVATE_TYPE)
+
+
+def _drop_private_annotations(app, what, name, obj, options, signature, return_annotation):
+    if signature:
+        signature = _PRIVATE_ANNOTATION.sub("", signature)
+    if return_annotation and re.fullmatch(_PRIVATE_TYPE, return_annotation):
+        return_annotation = None
+    return signature, return_annotation
+
+
+def setup(app):
+    app.connect("autodoc-process-signature", _drop_private_annotations)

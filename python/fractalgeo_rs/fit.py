@@ -7,8 +7,8 @@ of the ordinary least-squares line through ``(log s, log M(s))``:
     D = dim_offset + dim_factor * slope
 
 (box counting: ``D = -slope``; Minkowski sausage in the plane:
-``D = 2 - slope``). :func:`fit_loglog` does the fit, the choice of scale range
-and the uncertainty; :class:`DimensionFit` holds the result and draws it.
+``D = 2 - slope``). :func:`~fractalgeo_rs.fit.fit_loglog` does the fit, the choice of scale range
+and the uncertainty; :class:`~fractalgeo_rs.DimensionFit` holds the result and draws it.
 """
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike
 
 from fractalgeo_rs._scales import MIN_SEGMENT, find_break
 
-__all__ = ["DimensionFit", "FractalRangeWarning", "ScaleSegment", "fit_loglog", "mark_invalid"]
+__all__ = ["DimensionFit", "FractalRangeWarning", "ScaleSegment", "fit_loglog"]
 
 ScaleRange = Union[None, str, Tuple[float, float]]
 
@@ -69,20 +69,47 @@ class FractalRangeWarning(UserWarning):
 
 @dataclass(frozen=True)
 class ScaleSegment:
-    """One regime of a log-log relation (see :attr:`DimensionFit.ranges`).
+    """One regime of a log-log relation: an element of
+    :attr:`fractalgeo_rs.DimensionFit.ranges`.
+
+    When a continuous broken line (two least-squares segments meeting at a
+    break scale) fits ``(log s, log M)`` better than one line by the
+    Bayesian information criterion, with at least 4 scales on each side,
+    the fit reports the two segments; otherwise one segment over the fitted
+    scales.
 
     Attributes
     ----------
     scale_range : tuple of float
         Smallest and largest scale of the segment (the break scale is shared
-        by the two segments of a broken line).
+        by the two segments of a broken line), in the units of the scales.
     dimension, slope : float
-        Dimension and log-log slope of the segment (continuous broken-line
-        fit).
+        Dimension (``dim_offset + dim_factor * slope``) and log-log slope of
+        the segment (continuous broken-line fit).
     n_scales : int
         Measured scales inside the segment.
     valid : bool
         Whether the dimension lies in the estimator's valid domain.
+
+    References
+    ----------
+    G. Schwarz, Estimating the dimension of a model, *Annals of Statistics*
+    6(2) (1978) 461-464, doi:10.1214/aos/1176344136.
+
+    Examples
+    --------
+    A power law whose exponent changes from -2 to -1.2 at scale 16 (box
+    counts of a set that is 2-dimensional below 16 and 1.2-dimensional
+    above):
+
+    >>> import numpy as np
+    >>> from fractalgeo_rs.fit import fit_loglog
+    >>> s = 2.0 ** np.arange(12)
+    >>> m = np.where(s <= 16, s ** -2.0, 16.0 ** -2.0 * (s / 16) ** -1.2)
+    >>> fit = fit_loglog(s, m, method="broken")
+    >>> [(round(r.scale_range[0], 3), round(r.scale_range[1], 3), round(r.dimension, 6), r.n_scales)
+    ...  for r in fit.ranges]
+    [(1.0, 16.0, 2.0, 4), (16.0, 2048.0, 1.2, 8)]
     """
 
     scale_range: Tuple[float, float]
@@ -126,20 +153,20 @@ class DimensionFit:
         Name of the estimator.
     range_selection : str
         ``"all"``, ``"user"`` or ``"auto"`` (the most linear range, see
-        :func:`fit_loglog`).
+        :func:`~fractalgeo_rs.fit.fit_loglog`).
     extra : mapping
         Method-specific results (e.g. ``hurst`` for self-affine counting, the
         counts of every lattice offset).
     model : ndarray or None
         Model-based estimates only (``range_selection == "model"``, built by
-        :meth:`from_model`, e.g. the Whittle likelihood): the fitted model's
-        value of the measure at each scale, drawn by :meth:`plot` instead of
+        :meth:`~fractalgeo_rs.DimensionFit.from_model`, e.g. the Whittle likelihood): the fitted model's
+        value of the measure at each scale, drawn by :meth:`~fractalgeo_rs.DimensionFit.plot` instead of
         a line. ``None`` for log-log regressions.
     valid : bool
         ``False`` when ``dimension`` lies outside the estimator's valid
         domain (``domain``; e.g. ``H >= 1`` or ``H <= 0`` for a graph) or a
         likelihood search stopped at its bound; ``stderr`` and ``ci95`` are
-        then NaN and a :class:`FractalRangeWarning` was issued.
+        then NaN and a :class:`~fractalgeo_rs.FractalRangeWarning` was issued.
     flags : tuple of str
         Causes: ``"below_domain"`` (smooth at the fitted scales),
         ``"above_domain"`` (rougher than any graph: noise or speckle),
@@ -150,8 +177,9 @@ class DimensionFit:
     ranges : tuple of ScaleSegment
         The regimes found among the fitted scales: one segment when the
         log-log relation is straight, two when a broken line fits better by
-        BIC with at least ``MIN_SEGMENT`` (4) scales per segment (see
-        :mod:`fractalgeo_rs._scales`); empty with fewer than 8 scales. Of two
+        BIC (a continuous two-segment least-squares line, its break searched
+        between the scales) with at least 4 scales per segment; empty with
+        fewer than 8 scales. Of two
         regimes of a graph, one with ``H >= SMOOTH_HURST`` (0.85) or a
         dimension outside ``domain`` is not valid (smooth, or noise); the
         default fit then uses the other regime from ``BREAK_MARGIN`` (2)
@@ -226,7 +254,7 @@ class DimensionFit:
 
         Likelihood estimators (e.g. :func:`fractalgeo_rs.whittle`) estimate
         ``D`` directly; there is no regression line. Their fit object keeps
-        the log-log data for :meth:`plot` (``scales``, ``measures`` and the
+        the log-log data for :meth:`~fractalgeo_rs.DimensionFit.plot` (``scales``, ``measures`` and the
         fitted ``model`` at the same scales), ``slope`` and ``intercept``
         are NaN, ``r_squared`` is the coefficient of determination of
         ``log measures`` by ``log model``, ``ci95`` is
@@ -245,7 +273,7 @@ class DimensionFit:
             Recorded as ``dim_offset`` (e.g. 3 for ``D = 3 - H``); the
             ``dim_factor`` is -1.
         x_label, y_label : str
-            Axis labels of :meth:`plot`.
+            Axis labels of :meth:`~fractalgeo_rs.DimensionFit.plot`.
         extra : mapping, optional
             Method-specific results.
 
@@ -427,7 +455,7 @@ def fit_loglog(
         outside ``domain`` (e.g. smooth below a few cells): then only the
         valid regime, the fractal range, is fitted
         (``range_selection == "fractal"``, flag ``"range_restricted"``, a
-        :class:`FractalRangeWarning`). ``"all"`` fits every scale whatever
+        :class:`~fractalgeo_rs.FractalRangeWarning`). ``"all"`` fits every scale whatever
         the regimes. A ``(low, high)`` pair fits the scales with
         ``low <= s <= high``; ``"auto"`` picks the contiguous range of at least
         ``min_points`` scales whose slope has the smallest standard error (a
@@ -444,7 +472,7 @@ def fit_loglog(
         Valid interval of the dimension: ``[d, d + 1]`` for the graph of a
         profile (``d = 1``) or surface (``d = 2``), ``[0, n]`` for a set in
         ``n`` dimensions. A fit outside it has ``valid=False``, NaN
-        ``stderr`` and ``ci95``, a flag and a :class:`FractalRangeWarning`
+        ``stderr`` and ``ci95``, a flag and a :class:`~fractalgeo_rs.FractalRangeWarning`
         naming the cause and the remedy.
     open_domain : bool, default False
         The bounds themselves are invalid (increment and spectral
@@ -459,11 +487,47 @@ def fit_loglog(
         box counts) only report ``ranges``.
     validate : bool, default True
         Check the domain and warn now; estimators that change ``dimension``
-        after the fit pass ``False`` and call :func:`check_domain`.
+        after the fit pass ``False`` and call ``fractalgeo_rs.fit.check_domain``.
+    x_label, y_label : str
+        Axis labels of :meth:`~fractalgeo_rs.DimensionFit.plot` (e.g. ``"box
+        size (pixels)"``, ``"occupied boxes"``).
+    extra : mapping, optional
+        Method-specific results, kept in ``DimensionFit.extra``.
 
     Returns
     -------
     DimensionFit
+        The dimension, the line (``slope``, ``intercept`` in natural
+        logarithms, ``r_squared``), its uncertainty (``stderr``, ``ci95``)
+        and the scales used.
+
+    Notes
+    -----
+    The line is the ordinary least-squares fit over the scales used; the
+    standard error of ``D`` is ``|dim_factor|`` times that of the slope and
+    ``ci95`` uses Student's t with ``n_used - 2`` degrees of freedom.
+
+    References
+    ----------
+    K. Falconer, *Fractal Geometry: Mathematical Foundations and
+    Applications*, Wiley, 1990, chapter 3 (box-counting dimension).
+
+    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
+    dimension: assessing the roughness of time series and spatial data,
+    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+
+    Examples
+    --------
+    Box counts ``N(s) = 5 s^-1.5`` give ``D = -slope = 1.5``:
+
+    >>> import numpy as np
+    >>> from fractalgeo_rs.fit import fit_loglog
+    >>> s = 2.0 ** np.arange(6)
+    >>> fit = fit_loglog(s, 5.0 * s ** -1.5, method="box counts", domain=(0.0, 2.0))
+    >>> round(fit.dimension, 12), round(float(np.exp(fit.intercept)), 12), fit.r_squared
+    (1.5, 5.0, 1.0)
+    >>> fit.scale_range, fit.range_selection, fit.valid
+    ((1.0, 32.0), 'all', True)
     """
     s = np.asarray(scales, dtype=float)
     m = np.asarray(measures, dtype=float)
@@ -583,7 +647,7 @@ def _line_fit(used: np.ndarray, selection: str, common: dict) -> DimensionFit:
 
 
 def _ranges(s, used, m, dim_offset, dim_factor, dom, open_domain) -> Tuple[ScaleSegment, ...]:
-    """One or two regimes among the used scales (see :mod:`fractalgeo_rs._scales`)."""
+    """One or two regimes among the used scales (see ``fractalgeo_rs._scales``)."""
     su = s[used]
     if su.size < 2 * MIN_SEGMENT:
         return ()
@@ -613,7 +677,7 @@ def _ranges(s, used, m, dim_offset, dim_factor, dom, open_domain) -> Tuple[Scale
 def mark_invalid(fit: DimensionFit, flag: str, message: str, *, stacklevel: int = 3) -> DimensionFit:
     """``fit`` with ``valid=False``, ``flag`` added, NaN ``stderr`` and
     ``ci95``, and ``message`` as its warning (issued as a
-    :class:`FractalRangeWarning`)."""
+    ``FractalRangeWarning``)."""
     nan = float("nan")
     out = replace(fit, valid=False, flags=tuple(fit.flags) + (flag,), stderr=nan, ci95=(nan, nan),
                   warning=(fit.warning + " " + message).strip())

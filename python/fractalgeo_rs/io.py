@@ -40,16 +40,50 @@ __all__ = ["read_raster", "write_raster", "is_binary_mask"]
 
 
 def is_binary_mask(data) -> bool:
-    """True for a binary mask: a bool array, or an integer array whose values
-    are 0 and at most one other value (0/1, 0/255 as 1-bit and 8-bit mask
-    PNGs and TIFFs store them). The nonzero value is the foreground."""
+    """Whether an array is a binary mask.
+
+    True for a bool array, or an integer array whose values are 0 and at
+    most one other value (0/1 or 0/255, as 1-bit and 8-bit mask PNGs and
+    TIFFs store them); the nonzero value is the foreground. Float arrays are
+    never masks (a 0/1 float image is a grey-level image). The ``fractalgeo
+    dimension`` command uses it to choose between box counting of a set and
+    of a surface.
+
+    Parameters
+    ----------
+    data : array_like
+        Any array, e.g. the output of :func:`fractalgeo_rs.read_raster`.
+
+    Returns
+    -------
+    bool
+        True for a binary mask; False for an empty array.
+
+    References
+    ----------
+    W3C (2003). *Portable Network Graphics (PNG) Specification (Second
+    Edition)*, section 6 (bit depths 1-16 of greyscale images),
+    https://www.w3.org/TR/png/.
+    Adobe (1992). *TIFF Revision 6.0*, section 3 (bilevel images).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fractalgeo_rs.io import is_binary_mask
+    >>> is_binary_mask(np.array([[0, 255], [255, 0]], np.uint8)), is_binary_mask(np.zeros((2, 2), bool))
+    (True, True)
+    >>> is_binary_mask(np.array([[0, 1, 2]], np.uint8)), is_binary_mask(np.array([[3, 5]], np.uint8))
+    (False, False)
+    >>> is_binary_mask(np.array([[0.0, 1.0]]))
+    False
+    """
     a = np.asarray(data)
     if a.dtype == bool:
         return True
     if a.dtype.kind not in "iu" or a.size == 0:
         return False
     values = np.unique(a)
-    return values.size <= 2 and values[0] == 0
+    return bool(values.size <= 2 and values[0] == 0)
 
 
 def _ext(path) -> str:

@@ -190,7 +190,7 @@ def sentinel1_vv_db() -> Tuple[np.ndarray, Dict[str, Any]]:
 
 
 def sentinel1_vh_db() -> Tuple[np.ndarray, Dict[str, Any]]:
-    """Sentinel-1 sigma0 VH in dB, the same scene and grid as :func:`sentinel1_vv_db`.
+    """Sentinel-1 sigma0 VH in dB, the same scene and grid as :func:`~fractalgeo_rs.data.sentinel1_vv_db`.
 
     Returns
     -------

@@ -14,14 +14,44 @@ __all__ = ["hillshade", "shade_to_byte", "metres_per_degree"]
 def metres_per_degree(latitude):
     """Metres per degree of latitude and of longitude on the WGS84 ellipsoid.
 
-    Series for the meridian and parallel arc lengths (e.g. the USGS/NGA
-    expansions): ``111132.92 - 559.82 cos 2p + 1.175 cos 4p`` and
-    ``111412.84 cos p - 93.5 cos 3p``, ``p`` the latitude.
+    Series for the meridian and parallel arc lengths of one degree, ``p``
+    the latitude:
+
+    * latitude: ``111132.92 - 559.82 cos 2p + 1.175 cos 4p``;
+    * longitude: ``111412.84 cos p - 93.5 cos 3p``.
+
+    They agree with the closed forms on the WGS84 ellipsoid
+    (``pi / 180 * a (1 - e^2) / (1 - e^2 sin^2 p)^(3/2)`` and
+    ``pi / 180 * a cos p / sqrt(1 - e^2 sin^2 p)``, ``a = 6378137 m``,
+    ``f = 1 / 298.257223563``) within 0.07 m and 0.16 m per degree at every
+    latitude. :func:`fractalgeo_rs.hillshade` uses them to turn a cell size
+    in degrees into metres.
+
+    Parameters
+    ----------
+    latitude : float or array_like
+        Geodetic latitude in degrees, in ``[-90, 90]``.
 
     Returns
     -------
     (ndarray, ndarray)
-        ``(m_per_deg_lat, m_per_deg_lon)``, same shape as ``latitude``.
+        ``(m_per_deg_lat, m_per_deg_lon)``, metres per degree, float64, same
+        shape as ``latitude`` (0-d arrays for a scalar).
+
+    References
+    ----------
+    National Imagery and Mapping Agency (2000). *Department of Defense World
+    Geodetic System 1984: its definition and relationships with local
+    geodetic systems*. Technical Report TR8350.2, 3rd edition.
+
+    Examples
+    --------
+    >>> import fractalgeo_rs as fg
+    >>> m_lat, m_lon = fg.dem.metres_per_degree([0.0, 45.0, 60.0])
+    >>> m_lat.round(1).tolist()
+    [110574.3, 111131.7, 111412.2]
+    >>> m_lon.round(1).tolist()
+    [111319.3, 78846.9, 55799.9]
     """
     p = np.deg2rad(np.asarray(latitude, dtype=np.float64))
     lat = 111132.92 - 559.82 * np.cos(2 * p) + 1.175 * np.cos(4 * p)
@@ -63,7 +93,7 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
             + \cos A\,\partial_y z)}{\sqrt{1 + \zeta^2 |\nabla z|^2}}\right)
 
     with ``zeta = z_factor``. ``gdaldem hillshade`` writes ``1 + 254 L``
-    (see :func:`shade_to_byte`). The default azimuth 315 (light from the
+    (see :func:`~fractalgeo_rs.dem.shade_to_byte`). The default azimuth 315 (light from the
     north-west) keeps relief from looking inverted; the seed paper's figure 4
     is lit from the south-east: ``azimuth=135``. ``multidirectional`` is
     GDAL's combination of azimuths 225, 270, 315 and 360 weighted by
@@ -98,11 +128,11 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
     latitude : float, array_like of shape (rows,), or None
         For geographic grids: latitude in degrees of the grid (scalar) or of
         each row's centre. ``cell_size`` is then in degrees and converted to
-        metres per row with :func:`metres_per_degree` (WGS84).
+        metres per row with :func:`~fractalgeo_rs.dem.metres_per_degree` (WGS84).
     byte : bool
         Return GDAL's 8-bit encoding instead: ``1 + 254 L``, 0 at nodata,
         computed as ``gdaldem hillshade -compute_edges`` does (float32 heights);
-        with ``latitude`` it is :func:`shade_to_byte` of the reflectance.
+        with ``latitude`` it is :func:`~fractalgeo_rs.dem.shade_to_byte` of the reflectance.
     n_threads : int or None
         Threads of the Rust kernel.
 
@@ -114,7 +144,8 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
 
     References
     ----------
-    Horn, B. K. P. (1981). Hill shading and the reflectance map. Proc. IEEE 69(1), 14-47.
+    Horn, B. K. P. (1981). Hill shading and the reflectance map. Proc. IEEE 69(1), 14-47,
+    doi:10.1109/PROC.1981.11918.
     Mark, R. K. (1992). Multidirectional, oblique-weighted, shaded-relief image of
     the Island of Hawaii. USGS Open-File Report 92-422.
 
@@ -167,8 +198,39 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
 
 
 def shade_to_byte(shade):
-    """GDAL's byte encoding of a reflectance: ``round(1 + 254 L)`` (halves away
-    from zero, as GDAL's float-to-byte copy), 0 for nodata (NaN)."""
+    """GDAL's 8-bit encoding of a shaded-relief reflectance.
+
+    ``round(1 + 254 L)`` for a reflectance ``L`` in [0, 1] (halves rounded
+    away from zero, as GDAL's float-to-byte copy), so that 0 stays free for
+    nodata: a NaN reflectance becomes 0. This is the encoding ``gdaldem
+    hillshade`` writes, and the output of :func:`fractalgeo_rs.hillshade`
+    with ``byte=True``.
+
+    Parameters
+    ----------
+    shade : array_like, shape (rows, cols)
+        Reflectance in [0, 1] (dimensionless), NaN at nodata, e.g. the output
+        of :func:`fractalgeo_rs.hillshade`. Read as float32. Not modified.
+
+    Returns
+    -------
+    ndarray of uint8, shape (rows, cols)
+        1 (black) to 255 (fully lit), 0 at nodata.
+
+    References
+    ----------
+    GDAL documentation, *gdaldem*, section "hillshade":
+    https://gdal.org/programs/gdaldem.html.
+    Horn, B. K. P. (1981). Hill shading and the reflectance map. *Proc.
+    IEEE* 69(1), 14-47, doi:10.1109/PROC.1981.11918.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> fg.dem.shade_to_byte(np.array([[0.0, 0.5, 1.0], [np.nan, 0.7071, 0.002]]))
+    array([[  1, 128, 255],
+           [  0, 181,   2]], dtype=uint8)
+    """
     s = as_array(shade, "shade")
     if s.ndim != 2:
         raise ValueError(f"shade: expected a 2D array, got shape {s.shape}")

@@ -13,7 +13,8 @@ __all__ = ["Lakes", "lakes"]
 
 @dataclass
 class Lakes:
-    """Result of :func:`lakes`.
+    """Lakes and coastlines of a surface flooded to a level: the result of
+    :func:`fractalgeo_rs.lakes`.
 
     Attributes
     ----------
@@ -24,8 +25,31 @@ class Lakes:
         interpolated), closed ones with the first point repeated at the end;
         empty when not asked for.
     level : float
+        The water level, in the height units of the DEM.
     n_lakes : int
         Connected flooded regions (4-connectivity) in ``mask``.
+
+    References
+    ----------
+    B. B. Mandelbrot, How long is the coast of Britain? Statistical self-
+    similarity and fractional dimension, *Science* 156 (1967) 636-638,
+    doi:10.1126/science.156.3775.636.
+
+    Examples
+    --------
+    Two pits of depth 4 and 3 below a plateau at 5, flooded to 3: the shore
+    crosses each edge from a pit to the plateau where the linear
+    interpolation reaches 3, at 2/4 and 1/3 of a cell from the pit.
+
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> z = np.array([[5, 5, 5, 5, 5], [5, 1, 5, 2, 5], [5, 5, 5, 5, 5]], dtype=float)
+    >>> r = fg.lakes(z, 3.0)
+    >>> r.n_lakes, r.level, r.mask.astype(int).tolist()
+    (2, 3.0, [[0, 0, 0, 0, 0], [0, 1, 0, 1, 0], [0, 0, 0, 0, 0]])
+    >>> r.coastlines[0].tolist()
+    [[1.0, 1.5], [0.5, 1.0], [1.0, 0.5], [1.5, 1.0], [1.0, 1.5]]
+    >>> r.coastlines[1].round(4).tolist()
+    [[1.0, 3.3333], [0.6667, 3.0], [1.0, 2.6667], [1.3333, 3.0], [1.0, 3.3333]]
     """
 
     mask: np.ndarray

@@ -287,7 +287,8 @@ def gls_dimension(
         also for windows clipped by the image border.
     anisotropy : bool, default False
         Surfaces: also estimate the direction and ratio of geometric
-        anisotropy (:func:`anisotropy_from_variations`), in ``extra["anisotropy_angle"]``
+        anisotropy (a least-squares fit of ``sigma^2 |A h|^(2H)`` to the
+        four first-order directional variations), in ``extra["anisotropy_angle"]``
         (degrees) and ``extra["anisotropy_ratio"]``.
 
     Returns

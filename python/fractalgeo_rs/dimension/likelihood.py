@@ -299,14 +299,14 @@ def whittle(
     Returns
     -------
     DimensionFit
-        A model-based fit (see :meth:`DimensionFit.from_model`):
+        A model-based fit (see :meth:`~fractalgeo_rs.DimensionFit.from_model`):
         ``dimension``, ``stderr`` from the observed Fisher information (the
         curvature of the profile contrast, halved because the periodogram of
         real data is symmetric), ``ci95 = dimension +- 1.96 stderr``;
         ``scales`` are radial frequencies (cycles per unit of
         ``cell_size``), ``measures`` the radially averaged periodogram of
         the filtered field and ``model`` its fitted expectation, which
-        :meth:`DimensionFit.plot` draws. ``extra`` holds ``hurst``,
+        :meth:`~fractalgeo_rs.DimensionFit.plot` draws. ``extra`` holds ``hurst``,
         ``hurst_stderr``, ``sigma2``, ``filter``, ``taper``, ``n_valid`` and
         ``contrast`` (the minimised profile contrast).
 

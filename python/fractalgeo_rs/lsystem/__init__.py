@@ -1,13 +1,21 @@
 """L-systems, turtle geometry and iterated function systems.
 
-* :class:`LSystem` - DOL, bracketed, stochastic, context-sensitive and
-  parametric rewriting in Rust, loadable from a small text format;
-* :func:`turtle_2d`, :func:`turtle_3d`, :func:`plant_mesh` - turtle
-  interpretation to polylines, segments and triangle meshes;
-* :func:`write_obj`, :func:`write_ply`, :func:`write_svg`, :func:`write_png`;
-* :class:`IFS`, :func:`ifs_preset`, :func:`moran_dimension` - iterated
-  function systems;
-* :func:`plants_on_terrain` - a scene of plants on a DEM.
+* :class:`~fractalgeo_rs.LSystem` - DOL, bracketed, stochastic,
+  context-sensitive and parametric rewriting in Rust, loadable from a small
+  text format;
+* :func:`~fractalgeo_rs.lsystem.turtle_2d`,
+  :func:`~fractalgeo_rs.lsystem.turtle_3d`,
+  :func:`~fractalgeo_rs.lsystem.plant_mesh` - turtle interpretation to
+  polylines, segments and triangle meshes;
+* :func:`~fractalgeo_rs.lsystem.write_obj`,
+  :func:`~fractalgeo_rs.lsystem.write_ply`,
+  :func:`~fractalgeo_rs.lsystem.write_svg`,
+  :func:`~fractalgeo_rs.lsystem.write_png`;
+* :class:`~fractalgeo_rs.IFS`, :func:`~fractalgeo_rs.lsystem.ifs_preset`,
+  :func:`~fractalgeo_rs.lsystem.moran_dimension` - iterated function
+  systems;
+* :func:`~fractalgeo_rs.lsystem.plants_on_terrain` - a scene of plants on a
+  DEM.
 
 References
 ----------

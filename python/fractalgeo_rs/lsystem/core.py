@@ -77,15 +77,15 @@ def _rule_lines(rules: RulesLike) -> list:
 class LString:
     """A string of modules: symbols with optional real parameters.
 
-    Returned by :meth:`LSystem.derive`; also built from text with
-    :meth:`LString.parse`. ``str(s)`` gives the text form (``A(1,2.5)B``),
+    Returned by :meth:`~fractalgeo_rs.LSystem.derive`; also built from text with
+    :meth:`~fractalgeo_rs.LString.parse`. ``str(s)`` gives the text form (``A(1,2.5)B``),
     ``len(s)`` the number of modules.
 
     Parameters
     ----------
-    core : _core.ModuleString
+    core : ``_core.ModuleString``
         The Rust string of modules; build an ``LString`` with
-        :meth:`LString.parse` or :meth:`LSystem.derive` rather than directly.
+        :meth:`~fractalgeo_rs.LString.parse` or :meth:`~fractalgeo_rs.LSystem.derive` rather than directly.
 
     References
     ----------
@@ -174,12 +174,16 @@ class LSystem:
     ignore : str, optional
         Symbols skipped when matching contexts (ABOP's ``#ignore``).
     seed : int, optional
-        Seed of the stochastic choices; None draws one (see :attr:`seed`).
+        Seed of the stochastic choices; None draws one (see :attr:`~fractalgeo_rs.LSystem.seed`).
         Choices come from a hash of (seed, step, position), so the same seed
         gives the same strings on any number of threads.
     max_length : int
         Largest allowed number of modules; a longer derivation raises
         ``ValueError`` instead of exhausting memory.
+    defaults : mapping of str to str, optional
+        Settings for the caller (``n``, ``angle``, ``step``, ...; the
+        ``key: value`` lines of the text format), kept as the dict attribute
+        ``defaults``; the L-system itself does not read them.
 
     Notes
     -----
@@ -242,7 +246,7 @@ class LSystem:
 
         ``#`` starts a comment; ``axiom: ...`` and ``ignore: ...`` lines set
         those; any other ``key: value`` line (``n``, ``angle``, ``step``,
-        ``width``, ...) is kept in :attr:`defaults` for the caller; every
+        ``width``, ...) is kept in the dict ``defaults`` for the caller; every
         line with ``->`` is a production. A ``seed: k`` line is used when
         ``seed`` is None.
 

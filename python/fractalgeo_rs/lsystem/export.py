@@ -35,11 +35,41 @@ def _mesh_arrays(mesh: Mesh) -> tuple:
 
 
 def write_obj(mesh: Mesh, path: PathLike) -> None:
-    """Write a mesh as Wavefront OBJ.
+    """Write a mesh as Wavefront OBJ (text).
 
     Vertices ``v``, texture coordinates ``vt``, normals ``vn`` and faces
     ``f v/vt/vn`` (1-based), branches and leaves in groups ``branches`` and
-    ``leaves``.
+    ``leaves``. The file is written atomically (under a temporary name,
+    then renamed).
+
+    Parameters
+    ----------
+    mesh : Mesh
+        E.g. from :func:`~fractalgeo_rs.lsystem.plant_mesh`.
+    path : str or os.PathLike
+        Output file.
+
+    Returns
+    -------
+    None
+
+    References
+    ----------
+    Wavefront Technologies, *Object Files (.obj)*, Appendix B1 of the
+    Advanced Visualizer manual; mirrored at
+    https://paulbourke.net/dataformats/obj/.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from fractalgeo_rs.lsystem import plant_mesh, write_obj
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     write_obj(plant_mesh("F", sides=3), os.path.join(d, "stem.obj"))
+    ...     lines = open(os.path.join(d, "stem.obj")).read().splitlines()
+    >>> [sum(ln.startswith(k + " ") for ln in lines) for k in ("v", "vt", "vn", "f")]
+    [8, 8, 8, 6]
+    >>> [ln for ln in lines if ln.startswith(("g ", "f "))][:3]
+    ['g branches', 'f 1/1/1 2/2/2 6/6/6', 'f 1/1/1 6/6/6 5/5/5']
     """
     _core.write_mesh(os.fspath(path), "obj", *_mesh_arrays(mesh))
 
@@ -49,7 +79,35 @@ def write_ply(mesh: Mesh, path: PathLike) -> None:
 
     Vertex properties ``x y z nx ny nz s t`` (float32); face properties
     ``vertex_indices`` (uchar count, uint32 indices), ``part_id``, ``kind``
-    (uchar), ``color`` and ``instance`` (uint32).
+    (uchar), ``color`` and ``instance`` (uint32): 32 bytes per vertex and
+    26 per triangle after the text header. The file is written atomically.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        E.g. from :func:`~fractalgeo_rs.lsystem.plant_mesh`.
+    path : str or os.PathLike
+        Output file.
+
+    Returns
+    -------
+    None
+
+    References
+    ----------
+    G. Turk, *The PLY polygon file format*, Stanford University, 1994;
+    https://paulbourke.net/dataformats/ply/.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from fractalgeo_rs.lsystem import plant_mesh, write_ply
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     write_ply(plant_mesh("F", sides=3), os.path.join(d, "stem.ply"))
+    ...     data = open(os.path.join(d, "stem.ply"), "rb").read()
+    >>> header, body = data.split(b"end_header" + bytes([10]))  # the header ends with a newline
+    >>> header.splitlines()[:2], len(body) == 8 * 32 + 6 * 26
+    ([b'ply', b'format binary_little_endian 1.0'], True)
     """
     _core.write_mesh(os.fspath(path), "ply", *_mesh_arrays(mesh))
 
@@ -59,6 +117,45 @@ def write_svg(drawing: Polylines, path: PathLike, *, size: float = 800.0, stroke
     """Write a 2D turtle drawing as SVG (y up, scaled to fit ``size`` pixels).
 
     Polylines become ``<polyline>`` elements, leaf polygons ``<polygon>``.
+    The longer side of the drawing spans ``size - 2 margin`` pixels. The
+    file is written atomically.
+
+    Parameters
+    ----------
+    drawing : Polylines
+        From :func:`~fractalgeo_rs.lsystem.turtle_2d`.
+    path : str or os.PathLike
+        Output file.
+    size : float, default 800.0
+        Width or height of the picture (the larger of the two), pixels.
+    stroke_width : float, default 1.0
+        Line width, pixels.
+    margin : float, default 10.0
+        Empty border, pixels.
+    stroke, fill : str
+        SVG colours of the lines and of the leaf polygons.
+
+    Returns
+    -------
+    None
+
+    References
+    ----------
+    W3C (2011). *Scalable Vector Graphics (SVG) 1.1 (Second Edition)*, W3C
+    Recommendation, https://www.w3.org/TR/SVG11/.
+
+    Examples
+    --------
+    A unit square drawn in a 100-pixel picture with a 10-pixel margin (y
+    points down in SVG):
+
+    >>> import os, tempfile
+    >>> from fractalgeo_rs.lsystem import turtle_2d, write_svg
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     write_svg(turtle_2d("F+F+F+F"), os.path.join(d, "square.svg"), size=100)
+    ...     svg = open(os.path.join(d, "square.svg")).read()
+    >>> svg.splitlines()[1].split('"')[1]
+    '90.000,90.000 90.000,10.000 10.000,10.000 10.000,90.000 90.000,90.000'
     """
     if not isinstance(drawing, Polylines):
         raise TypeError(f"drawing: expected Polylines (from turtle_2d), got {type(drawing).__name__}")
@@ -96,7 +193,43 @@ def write_png(geometry: Union[Polylines, Segments, Mesh], path: PathLike, *, siz
     ``Polylines`` are drawn as lines; ``Segments`` and ``Mesh`` are projected
     orthographically: ``view="side"`` onto the x-z plane, ``"top"`` onto x-y.
     Segments are drawn with line widths proportional to their widths; a mesh
-    as its triangles, leaves in green and branches in brown.
+    as its triangles, leaves in green and branches in brown, on a white
+    background. The file is written atomically.
+
+    Parameters
+    ----------
+    geometry : Polylines, Segments or Mesh
+        From :func:`~fractalgeo_rs.lsystem.turtle_2d`,
+        :func:`~fractalgeo_rs.lsystem.turtle_3d` or
+        :func:`~fractalgeo_rs.lsystem.plant_mesh`.
+    path : str or os.PathLike
+        Output file.
+    size : int, default 800
+        Side of the square picture, pixels.
+    view : {"side", "top"}, default "side"
+        Projection of 3D geometry.
+
+    Returns
+    -------
+    None
+
+    References
+    ----------
+    W3C (2003). *Portable Network Graphics (PNG) Specification (Second
+    Edition)*, https://www.w3.org/TR/png/.
+    J. D. Hunter, Matplotlib: a 2D graphics environment, *Computing in
+    Science & Engineering* 9(3) (2007) 90-95, doi:10.1109/MCSE.2007.55.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import matplotlib.image
+    >>> from fractalgeo_rs.lsystem import turtle_3d, write_png
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     write_png(turtle_3d("F&F"), os.path.join(d, "preview.png"), size=64)
+    ...     image = matplotlib.image.imread(os.path.join(d, "preview.png"))
+    >>> image.shape
+    (64, 64, 4)
     """
     size = check_positive_int(size, "size")
     if view not in ("side", "top"):

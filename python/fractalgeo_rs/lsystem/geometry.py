@@ -1,7 +1,7 @@
 """Turtle interpretation of L-strings in 2D and 3D and triangle meshes.
 
 Conventions of Prusinkiewicz and Lindenmayer (1990), sections 1.2, 1.5, 2.3
-and 5.1; see :func:`turtle_3d` for the symbol table.
+and 5.1; see :func:`~fractalgeo_rs.lsystem.turtle_3d` for the symbol table.
 """
 from __future__ import annotations
 
@@ -75,8 +75,39 @@ def _split(points: np.ndarray, offsets: np.ndarray) -> list:
 
 @dataclass(frozen=True)
 class Polylines:
-    """2D drawing: ``xy`` (N, 2) vertices, polyline ``k`` is
-    ``xy[offsets[k]:offsets[k+1]]``; ``polygons`` are the filled leaves."""
+    """A 2D turtle drawing: the result of :func:`~fractalgeo_rs.lsystem.turtle_2d`.
+
+    Attributes
+    ----------
+    xy : ndarray of float64, shape (N, 2)
+        Vertices of every polyline, one after the other, in turtle units
+        (``step`` is one unit unless set otherwise).
+    offsets : ndarray of uint64, shape (n_lines + 1,)
+        Polyline ``k`` is ``xy[offsets[k]:offsets[k+1]]``.
+    polygons : list of ndarray, each (m, 2)
+        Filled polygons (leaves, ``{ . }``), vertices in order.
+    lines : list of ndarray
+        The polylines as a list of (n_k, 2) arrays.
+    n_segments : int
+        Number of drawn segments (vertices minus polylines).
+
+    References
+    ----------
+    P. Prusinkiewicz and A. Lindenmayer, *The Algorithmic Beauty of Plants*,
+    Springer, 1990, section 1.2, doi:10.1007/978-1-4613-8476-2.
+
+    Examples
+    --------
+    A branch ``[...]`` ends the current polyline; the turtle comes back to
+    the branching point and starts a new one:
+
+    >>> from fractalgeo_rs.lsystem import turtle_2d
+    >>> d = turtle_2d("F[+F]F")
+    >>> (d.xy.round(12) + 0.0).tolist()
+    [[0.0, 0.0], [0.0, 1.0], [-1.0, 1.0], [0.0, 1.0], [0.0, 2.0]]
+    >>> d.offsets.tolist(), d.n_segments, [len(line) for line in d.lines]
+    ([0, 3, 5], 3, [3, 2])
+    """
 
     xy: np.ndarray
     offsets: np.ndarray
@@ -89,13 +120,44 @@ class Polylines:
 
     @property
     def n_segments(self) -> int:
+        """Number of drawn segments (vertices minus polylines)."""
         return int(len(self.xy) - (len(self.offsets) - 1))
 
 
 @dataclass(frozen=True)
 class Segments:
-    """3D segments: ``starts``/``ends`` (N, 3), ``widths`` (N,) diameters,
-    ``colors`` (N,) colour indices; ``polygons`` is a list of (m, 3) leaves."""
+    """The segments drawn by the 3D turtle: the result of
+    :func:`~fractalgeo_rs.lsystem.turtle_3d`. ``len(segments)`` is the
+    number of segments.
+
+    Attributes
+    ----------
+    starts, ends : ndarray of float64, shape (N, 3)
+        End points of each segment, in turtle units.
+    widths : ndarray of float64, shape (N,)
+        Diameter of each segment (set by ``!``), in turtle units.
+    colors : ndarray of uint32, shape (N,)
+        Colour index of each segment (set by ``'``).
+    polygons : list of ndarray, each (m, 3)
+        Leaf polygons (``{ . }``), vertices in order.
+
+    References
+    ----------
+    P. Prusinkiewicz and A. Lindenmayer, *The Algorithmic Beauty of Plants*,
+    Springer, 1990, sections 1.5 and 2.3, doi:10.1007/978-1-4613-8476-2.
+
+    Examples
+    --------
+    ``!`` multiplies the width by ``width_factor``, ``'`` adds 1 to the
+    colour index:
+
+    >>> from fractalgeo_rs.lsystem import turtle_3d
+    >>> seg = turtle_3d("F!F'F", width=2.0, width_factor=0.5)
+    >>> len(seg), seg.widths.tolist(), seg.colors.tolist()
+    (3, [2.0, 1.0, 1.0], [0, 0, 1])
+    >>> seg.ends.tolist()
+    [[0.0, 0.0, 1.0], [0.0, 0.0, 2.0], [0.0, 0.0, 3.0]]
+    """
 
     starts: np.ndarray
     ends: np.ndarray
@@ -128,6 +190,26 @@ class Mesh:
         Colour index set by ``'``.
     instances : (T,) uint32
         Plant number in a scene (0 for a single plant).
+
+    References
+    ----------
+    P. Prusinkiewicz and A. Lindenmayer, *The Algorithmic Beauty of Plants*,
+    Springer, 1990, section 5.1, doi:10.1007/978-1-4613-8476-2.
+
+    J. Bloomenthal, Modeling the mighty maple, *Computer Graphics
+    (SIGGRAPH '85 Proceedings)* 19(3) (1985) 305-311.
+
+    Examples
+    --------
+    One segment as a tube of 3 sides: two rings of 3 + 1 vertices (the last
+    repeats the first for the texture seam) and 2 triangles per side:
+
+    >>> from fractalgeo_rs.lsystem import plant_mesh
+    >>> m = plant_mesh("F", sides=3)
+    >>> m.vertices.shape, m.faces.shape, m.vertices.dtype, m.faces.dtype
+    ((8, 3), (6, 3), dtype('float32'), dtype('uint32'))
+    >>> m.vertices[:, 2].tolist(), m.kinds.tolist()
+    ([0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0], [0, 0, 0, 0, 0, 0])
     """
 
     vertices: np.ndarray
@@ -162,9 +244,22 @@ def turtle_2d(lstring: Union[LString, str], *, angle: float = 90.0, step: float 
 
     The turtle starts at the origin heading +y; ``+`` turns left
     (counter-clockwise) by ``angle`` degrees, ``-`` right; see
-    :func:`turtle_3d` for all symbols. Symbols in ``draw`` move forward and
+    :func:`~fractalgeo_rs.lsystem.turtle_3d` for all symbols. Symbols in ``draw`` move forward and
     draw, those in ``move`` move without drawing (e.g. ``draw="FLR"`` for
     the ``F_l``/``F_r`` edge-rewriting curves of ABOP section 1.4).
+
+    Parameters
+    ----------
+    lstring : LString or str
+        The string to draw, e.g. from :meth:`fractalgeo_rs.LSystem.derive`
+        (a str is parsed with :meth:`fractalgeo_rs.LString.parse`).
+    angle : float, default 90.0
+        Turning angle of ``+`` and ``-``, degrees (a module's parameter,
+        ``+(30)``, overrides it).
+    step : float, default 1.0
+        Length of a step, in drawing units (``F(2)`` overrides it).
+    draw, move : str, default "FG", "fg"
+        Symbols that move forward with and without drawing.
 
     Returns
     -------
@@ -215,9 +310,31 @@ def turtle_3d(lstring: Union[LString, str], *, angle: float = 90.0, step: float 
     Tropism (ABOP section 2.3.2): after each drawn step the frame turns about
     ``H x T`` by ``elasticity * |H x T|``.
 
+    Parameters
+    ----------
+    lstring : LString or str
+        The string to draw, e.g. from :meth:`fractalgeo_rs.LSystem.derive`
+        (a str is parsed with :meth:`fractalgeo_rs.LString.parse`).
+    angle : float, default 90.0
+        Angle of the turns, pitches and rolls, degrees.
+    step : float, default 1.0
+        Length of a step, in drawing units.
+    width : float, default 1.0
+        Initial segment diameter, in drawing units.
+    width_factor : float, default 0.7
+        Factor applied to the width by ``!`` without a parameter.
+    tropism : sequence of 3 float, default (0, 0, 0)
+        Tropism vector ``T`` (e.g. ``(0, 0, -1)`` for gravity).
+    elasticity : float, default 0.0
+        Susceptibility to tropism (radians per unit of ``|H x T|``).
+    draw, move : str, default "FG", "fg"
+        Symbols that move forward with and without drawing.
+
     Returns
     -------
     Segments
+        One segment per drawing step, with its width and colour index, and
+        the leaf polygons.
 
     References
     ----------
@@ -250,12 +367,26 @@ def plant_mesh(lstring: Union[LString, str], *, sides: int = 6, angle: float = 9
     (a ring of ``sides + 1`` vertices, the last repeating the first for the
     texture seam); a branch ``[`` starts a new tube. Leaves (``{ . }``) are
     fan-triangulated with their Newell normal. Turtle options as in
-    :func:`turtle_3d`; the triangles are written by ``n_threads`` threads
+    :func:`~fractalgeo_rs.lsystem.turtle_3d`; the triangles are written by ``n_threads`` threads
     (all cores when None), with the same result for any number.
+
+    Parameters
+    ----------
+    lstring : LString or str
+        The string to draw, e.g. from :meth:`fractalgeo_rs.LSystem.derive`
+        (a str is parsed with :meth:`fractalgeo_rs.LString.parse`).
+    sides : int, default 6
+        Sides of each branch tube, 3 to 64.
+    angle, step, width, width_factor, tropism, elasticity, draw, move
+        Turtle options, as in :func:`~fractalgeo_rs.lsystem.turtle_3d`.
+    n_threads : int, optional
+        Threads writing the triangles (all cores when None).
 
     Returns
     -------
     Mesh
+        Vertices, normals and texture coordinates (float32), triangles
+        (uint32) and per-triangle part, kind, colour and instance ids.
 
     References
     ----------

@@ -14,7 +14,7 @@ from fractalgeo_rs.lsystem.core import _check_seed
 
 __all__ = ["IFS", "IFS_PRESETS", "ifs_preset", "moran_dimension", "rasterize_points"]
 
-#: Names accepted by :func:`ifs_preset`.
+#: Names accepted by :func:`~fractalgeo_rs.lsystem.ifs_preset`.
 IFS_PRESETS = ("sierpinski_triangle", "sierpinski_carpet", "barnsley_fern", "koch_curve", "dragon", "vicsek")
 
 
@@ -25,7 +25,12 @@ def moran_dimension(ratios: Sequence[float]) -> float:
     Parameters
     ----------
     ratios : sequence of float
-        Contraction ratios in (0, 1).
+        Contraction ratios in (0, 1), one per map (dimensionless).
+
+    Returns
+    -------
+    float
+        The similarity dimension ``s >= 0``.
 
     Notes
     -----
@@ -35,14 +40,19 @@ def moran_dimension(ratios: Sequence[float]) -> float:
     References
     ----------
     P. A. P. Moran, Additive functions of intervals and Hausdorff measure,
-    *Proc. Camb. Phil. Soc.* 42 (1946) 15-23. J. E. Hutchinson, Fractals and
-    self-similarity, *Indiana Univ. Math. J.* 30 (1981) 713-747.
+    *Proc. Camb. Phil. Soc.* 42 (1946) 15-23, doi:10.1017/S0305004100022684.
+
+    J. E. Hutchinson, Fractals and self-similarity, *Indiana Univ. Math. J.*
+    30 (1981) 713-747, doi:10.1512/iumj.1981.30.30055.
 
     Examples
     --------
+    >>> import math
     >>> from fractalgeo_rs.lsystem import moran_dimension
-    >>> round(moran_dimension([1/3] * 4), 6)   # Koch curve: log 4 / log 3
-    1.26186
+    >>> round(moran_dimension([1/3] * 4), 6), round(math.log(4) / math.log(3), 6)  # Koch curve
+    (1.26186, 1.26186)
+    >>> round(moran_dimension([0.5, 0.25, 0.25]), 12)  # 0.5 + 0.25 + 0.25 = 1: s = 1
+    1.0
     """
     r = np.asarray(ratios, dtype=float).ravel()
     return float(_core.moran_dimension(r.tolist()))
@@ -61,17 +71,42 @@ def _check_shape(shape) -> Tuple[int, int]:
 def rasterize_points(points, shape, *, bounds: Optional[Sequence[float]] = None) -> np.ndarray:
     """Binary raster of a 2D point set.
 
+    The extent is divided into ``rows x cols`` equal cells; a cell is 1 when
+    at least one point falls in it (points on ``xmax`` or ``ymin`` go to
+    the last column or row). Box counting of the raster
+    (:func:`fractalgeo_rs.box_counting`) estimates the dimension of the set.
+
     Parameters
     ----------
-    points : (N, 2) array
+    points : array_like, shape (N, 2)
+        ``(x, y)`` coordinates, e.g. from :meth:`fractalgeo_rs.IFS.chaos_game`.
     shape : int or (rows, cols)
+        Raster size in cells (an int gives a square raster).
     bounds : (xmin, xmax, ymin, ymax), optional
-        The extent covered by the raster; the points' bounding box if None.
-        Row 0 is at ``ymax``. Points outside are dropped.
+        The extent covered by the raster, in the points' units; the points'
+        bounding box if None. Row 0 is at ``ymax``. Points outside are
+        dropped.
 
     Returns
     -------
-    (rows, cols) uint8 array of 0 and 1.
+    ndarray of uint8, shape (rows, cols)
+        1 in the cells holding a point, 0 elsewhere.
+
+    References
+    ----------
+    M. Barnsley, *Fractals Everywhere*, Academic Press, 1988 (attractors
+    drawn by the random iteration algorithm on a grid of pixels).
+
+    Examples
+    --------
+    Three points on the diagonal ``y = x``; row 0 is at the top:
+
+    >>> import numpy as np
+    >>> from fractalgeo_rs.lsystem import rasterize_points
+    >>> rasterize_points(np.array([[0.0, 0.0], [0.5, 0.5], [1.0, 1.0]]), 3)
+    array([[0, 0, 1],
+           [0, 1, 0],
+           [1, 0, 0]], dtype=uint8)
     """
     pts = np.ascontiguousarray(points, dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 2:
@@ -136,8 +171,8 @@ class IFS:
 
     @classmethod
     def preset(cls, name: str) -> "IFS":
-        """A classic IFS (see :data:`IFS_PRESETS`); its exact dimension is in
-        :attr:`dimension` (None for the fern)."""
+        """A classic IFS (see ``IFS_PRESETS``); its exact dimension is in
+        ``dimension`` (None for the fern)."""
         maps, probs, dim = _core.ifs_preset(name)
         obj = cls(maps, probs)
         obj.dimension = dim
@@ -171,7 +206,7 @@ class IFS:
 
         Uses deterministic iteration to ``depth`` when given, else the chaos
         game with ``n_points`` (default: 20 points per pixel, at most 2**27). See
-        :func:`rasterize_points` for ``bounds``.
+        :func:`~fractalgeo_rs.lsystem.rasterize_points` for ``bounds``.
         """
         rows, cols = _check_shape(shape)
         if depth is not None and n_points is not None:
@@ -186,5 +221,37 @@ class IFS:
 
 
 def ifs_preset(name: str) -> IFS:
-    """Shorthand for :meth:`IFS.preset`."""
+    """A classic iterated function system by name: the same as
+    :meth:`fractalgeo_rs.IFS.preset`.
+
+    Parameters
+    ----------
+    name : str
+        One of ``fractalgeo_rs.lsystem.IFS_PRESETS``:
+        ``"sierpinski_triangle"``, ``"sierpinski_carpet"``,
+        ``"barnsley_fern"``, ``"koch_curve"``, ``"dragon"``, ``"vicsek"``.
+
+    Returns
+    -------
+    IFS
+        The maps and chaos-game weights; its ``dimension`` attribute is the
+        exact dimension of the attractor (None for the fern, whose maps are
+        not similarities).
+
+    References
+    ----------
+    M. Barnsley, *Fractals Everywhere*, Academic Press, 1988 (the fern).
+    J. E. Hutchinson, Fractals and self-similarity, *Indiana Univ. Math. J.*
+    30 (1981) 713-747, doi:10.1512/iumj.1981.30.30055.
+
+    Examples
+    --------
+    >>> import math
+    >>> from fractalgeo_rs.lsystem import ifs_preset
+    >>> koch = ifs_preset("koch_curve")
+    >>> len(koch.maps), round(koch.dimension, 12) == round(math.log(4) / math.log(3), 12)
+    (4, True)
+    >>> ifs_preset("sierpinski_carpet").dimension == math.log(8) / math.log(3), ifs_preset("barnsley_fern").dimension
+    (True, None)
+    """
     return IFS.preset(name)

@@ -20,6 +20,44 @@ def expected_relief_std(shape, hurst, cell_size=1.0, sigma=1.0):
     :math:`\frac{1}{2N^2}\sum_{x,y}\sigma^2|x-y|^{2H}`, summed here over the
     lag counts ``(rows - |i|)(cols - |j|)`` (on a strided lag lattice for
     grids above 512 cells, relative error below 1e-3).
+    :func:`fractalgeo_rs.synthetic_dem` divides by it to give a DEM the
+    relief asked for.
+
+    Parameters
+    ----------
+    shape : (int, int)
+        Grid size ``(rows, cols)``, each at least 2.
+    hurst : float
+        Hurst exponent ``H`` in (0, 1) (``D = 3 - H``).
+    cell_size : float, default 1.0
+        Grid spacing, in the length unit of the variogram (e.g. metres).
+    sigma : float, default 1.0
+        Standard deviation of the increments at unit distance, in height
+        units (e.g. metres).
+
+    Returns
+    -------
+    float
+        The expected standard deviation of the heights about their mean over
+        the grid, in the units of ``sigma``.
+
+    References
+    ----------
+    B. B. Mandelbrot and J. W. Van Ness, Fractional Brownian motions,
+    fractional noises and applications, *SIAM Review* 10(4) (1968) 422-437,
+    doi:10.1137/1010093.
+
+    Examples
+    --------
+    On a 2 x 2 grid the ordered pairs are 8 at distance 1 and 4 at distance
+    ``sqrt(2)``: with ``H = 1/2`` the variance is ``(8 + 4 sqrt(2)) / (2 *
+    16) = 0.4268``.
+
+    >>> from fractalgeo_rs.synth import expected_relief_std
+    >>> round(expected_relief_std((2, 2), 0.5), 12), round(((8 + 4 * 2 ** 0.5) / 32) ** 0.5, 12)
+    (0.653281482438, 0.653281482438)
+    >>> round(expected_relief_std((512, 512), 0.7, cell_size=30.0), 1)  # 30 m cells, sigma 1 m at 1 m
+    394.2
     """
     rows, cols = c.check_shape(shape)
     h = c.check_hurst(hurst)
@@ -56,7 +94,7 @@ def synthetic_dem(shape, hurst, *, cell_size, relief, relief_lag=None, mean_elev
     relief : float
         Relief in metres: with ``relief_lag=None`` the expected standard
         deviation of the heights over the whole grid (see
-        :func:`expected_relief_std`); otherwise the standard deviation of
+        :func:`~fractalgeo_rs.synth.expected_relief_std`); otherwise the standard deviation of
         height differences between points ``relief_lag`` metres apart,
         :math:`\sqrt{\operatorname{Var}[Z(x+h)-Z(x)]}` at ``|h| = relief_lag``.
     relief_lag : float or None

@@ -40,7 +40,10 @@ class SurfaceReport:
         Of the lag-one increments, divided by their standard deviation
         (both 0 for Gaussian increments).
     crease_ratio : float
-        The larger of the per-axis crease ratios (see :func:`crease_ratio`).
+        The larger of the per-axis crease ratios: ``max / min`` over ``p``
+        of the variance of the second differences centred on the lines
+        ``i`` with ``i mod 16 == p``. Midpoint displacement leaves seams on
+        the coarse grid lines (ratios well above 1); 1.0 means no seams.
     crease_ratio_axes : (float, float)
     periodicity_ratio : float
         Mean squared wrap-around difference (last row/column against the
@@ -49,7 +52,9 @@ class SurfaceReport:
     coastline_dimension : float
         Box-counting dimension of the level lines at the 30th-70th
         percentile heights (``2 - H`` expected for fBm), NaN when not
-        computed (see :func:`coastline_dimension`).
+        computed (the level line is the set of pixels where ``z < level``
+        changes between 4-neighbours, counted in boxes from 8 pixels to an
+        eighth of the smaller side).
 
     References
     ----------

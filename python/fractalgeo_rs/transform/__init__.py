@@ -249,7 +249,7 @@ def fractal_transform(
     z_scale : float or "auto", default "auto"
         ``"mass"``, ``"dbc"``, ``"blanket"``: height units per pixel (e.g. 1
         grey level, 1 dB or 1 metre); the estimates depend on this unit.
-        ``"auto"``: :func:`default_z_scale` of the whole image, ``1.4826 *
+        ``"auto"``: :func:`~fractalgeo_rs.transform.default_z_scale` of the whole image, ``1.4826 *
         median |lag-1 increment|`` (one typical step per box), recorded in
         the xarray output's ``attrs["z_scale"]``; maps are comparable only
         at equal ``z_scale``, so pass a fixed number across scenes.
@@ -289,7 +289,7 @@ def fractal_transform(
         ``[0, 180)`` from the column axis towards the row axis, the
         direction of fastest variation) and ratio (``>= 1``) of geometric
         anisotropy, fitted to the window's first-order directional
-        variations (:func:`fractalgeo_rs.dimension.gls.anisotropy_from_variations`),
+        variations (the model of :func:`fractalgeo_rs.gls_dimension`),
         after the dimension (and standard-error) maps.
 
     Returns

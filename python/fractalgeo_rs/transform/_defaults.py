@@ -64,6 +64,12 @@ def default_z_scale(image, nodata: Optional[float] = None) -> float:
         the increments (the same scale for Gaussian increments); 1.0 for a
         constant image.
 
+    References
+    ----------
+    P. J. Rousseeuw and C. Croux, Alternatives to the median absolute
+    deviation, *Journal of the American Statistical Association* 88(424)
+    (1993) 1273-1283, doi:10.1080/01621459.1993.10476408.
+
     Examples
     --------
     >>> import numpy as np
