@@ -10,12 +10,17 @@ The package mirrors the Rust crate's domains: :mod:`fractalgeo_rs.dimension`
 :mod:`fractalgeo_rs.lsystem`.
 """
 from fractalgeo_rs._core import __version__
-from fractalgeo_rs import data, io
+from fractalgeo_rs import data, io, tin
 from fractalgeo_rs.fit import DimensionFit, FractalRangeWarning
 from fractalgeo_rs.dimension import (
     Lacunarity,
     blanket,
+    box_counting,
+    box_counting_points,
+    differential_box_counting,
+    dimension,
     fbm_mle,
+    gls_dimension,
     higuchi,
     lacunarity,
     madogram,
@@ -23,76 +28,37 @@ from fractalgeo_rs.dimension import (
     minkowski,
     power_variation,
     scale_space,
+    self_affine_box_counting,
     spectral_dimension,
     surface_variation,
     variogram,
     wavelet_dimension,
     whittle,
-    gls_dimension,
-    box_counting,
-    box_counting_points,
-    differential_box_counting,
-    dimension,
-    self_affine_box_counting,
 )
-
-# -- domain exports: each issue adds its own line below --
 from fractalgeo_rs.lsystem import IFS, LString, LSystem
 from fractalgeo_rs.transform import fractal_transform, lacunarity_map, segment
-from fractalgeo_rs.synth import fbm, fbm_surface, validate_surface, SurfaceReport, synthetic_dem  # noqa: E402
-from fractalgeo_rs.dem import fractal_resample, hillshade, lakes  # noqa: E402
-from fractalgeo_rs.io import read_raster, write_raster  # noqa: E402
-from fractalgeo_rs import tin  # noqa: E402
-from fractalgeo_rs.tin import TIN, delaunay, grid_from_points, tin_from_dem  # noqa: E402
+from fractalgeo_rs.synth import SurfaceReport, fbm, fbm_surface, synthetic_dem, validate_surface
+from fractalgeo_rs.dem import fractal_resample, hillshade, lakes
+from fractalgeo_rs.io import read_raster, write_raster
+from fractalgeo_rs.tin import TIN, delaunay, grid_from_points, tin_from_dem
 
-__all__ = [
-    "__version__",
-    "data",
-    "io",
-    "DimensionFit",
-    "FractalRangeWarning",
-    "Lacunarity",
-    "blanket",
-    "fbm_mle",
-    "higuchi",
-    "lacunarity",
-    "madogram",
-    "mass_dimension",
-    "minkowski",
-    "power_variation",
-    "scale_space",
-    "spectral_dimension",
-    "surface_variation",
-    "variogram",
-    "wavelet_dimension",
-    "whittle",
-    "gls_dimension",
-    "box_counting",
-    "box_counting_points",
-    "differential_box_counting",
-    "dimension",
-    "self_affine_box_counting",
-    "IFS",
-    "LString",
-    "LSystem",
-    "fractal_transform",
-    "lacunarity_map",
-    "segment",
-    # synth / dem / io
-    "fbm",
-    "fbm_surface",
-    "validate_surface",
-    "SurfaceReport",
-    "synthetic_dem",
-    "hillshade",
-    "lakes",
-    "fractal_resample",
-    "read_raster",
-    "write_raster",
-    # tin
-    "tin",
-    "TIN",
-    "delaunay",
-    "grid_from_points",
-    "tin_from_dem",
-]
+
+def _exports():
+    """The imports above are the one list of the top-level API: ``__all__`` is
+    every public name they bind (classes and functions of this package, and
+    the subpackages ``data``, ``io`` and ``tin``), in the order imported."""
+    import types
+
+    names = ["__version__"]
+    for name, obj in list(globals().items()):
+        if name.startswith("_"):
+            continue
+        if isinstance(obj, types.ModuleType):
+            if name in ("data", "io", "tin"):
+                names.append(name)
+        elif getattr(obj, "__module__", "").startswith("fractalgeo_rs."):
+            names.append(name)
+    return names
+
+
+__all__ = _exports()
