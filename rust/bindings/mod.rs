@@ -3,7 +3,9 @@
 //! kernel (`py.detach`), runs it in a pool of `n_threads` and maps the error.
 //! Nothing else lives here.
 use crate::error::CoreError;
-use pyo3::exceptions::{PyMemoryError, PyOSError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{
+    PyFileNotFoundError, PyMemoryError, PyOSError, PyRuntimeError, PyValueError,
+};
 use pyo3::prelude::*;
 
 pub mod convert;
@@ -20,6 +22,7 @@ impl From<CoreError> for PyErr {
         match e {
             CoreError::InvalidArgument { .. } => PyValueError::new_err(e.to_string()),
             CoreError::Io(_) | CoreError::System(_) => PyOSError::new_err(e.to_string()),
+            CoreError::NotFound(_) => PyFileNotFoundError::new_err(e.to_string()),
             CoreError::OutOfMemory { .. } => PyMemoryError::new_err(e.to_string()),
             CoreError::Internal(_) => PyRuntimeError::new_err(e.to_string()),
         }

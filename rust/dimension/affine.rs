@@ -45,7 +45,9 @@ pub fn column_ranges(
                 format!("box size {s} leaves no complete column in data of shape ({rows}, {cols})"),
             ));
         }
-        let (sum, n) = (0..nr)
+        // per block row in parallel, summed in row order: a float reduce
+        // in rayon's order would depend on the thread count and scheduling
+        let per_row: Vec<(f64, u64)> = (0..nr)
             .into_par_iter()
             .map(|bi| {
                 let (r0, r1) = if profile {
@@ -73,7 +75,8 @@ pub fn column_ranges(
                 }
                 (sum, n)
             })
-            .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+            .collect();
+        let (sum, n) = per_row.iter().fold((0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
         if n == 0 {
             return Err(CoreError::invalid(
                 "data",

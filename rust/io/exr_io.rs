@@ -37,7 +37,12 @@ pub fn read_exr_gray(path: &Path) -> CoreResult<(Vec<f32>, usize, usize)> {
         .first_valid_layer()
         .all_attributes()
         .from_file(path)
-        .map_err(|e| CoreError::Io(format!("cannot read {}: {e}", path.display())))?;
+        .map_err(|e| match e {
+            exr::error::Error::Io(io) => {
+                CoreError::from_io(format_args!("cannot read {}", path.display()), &io)
+            }
+            other => CoreError::Io(format!("cannot read {}: {other}", path.display())),
+        })?;
     let layer = &image.layer_data;
     let size = layer.size;
     let list = &layer.channel_data.list;

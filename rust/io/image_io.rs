@@ -26,9 +26,9 @@ pub struct Raster {
 /// Read a PNG or TIFF file, keeping its bit depth and channels.
 pub fn read_image(path: &Path) -> CoreResult<Raster> {
     let reader = ImageReader::open(path)
-        .map_err(|e| CoreError::Io(format!("cannot open {}: {e}", path.display())))?
+        .map_err(|e| CoreError::from_io(format_args!("cannot open {}", path.display()), &e))?
         .with_guessed_format()
-        .map_err(|e| CoreError::Io(format!("cannot read {}: {e}", path.display())))?;
+        .map_err(|e| CoreError::from_io(format_args!("cannot read {}", path.display()), &e))?;
     let img = reader
         .decode()
         .map_err(|e| CoreError::Io(format!("cannot decode {}: {e}", path.display())))?;

@@ -11,7 +11,7 @@ use std::io::{BufWriter, Write};
 use std::path::Path;
 
 fn io_err(path: &Path, e: std::io::Error) -> CoreError {
-    CoreError::Io(format!("{}: {e}", path.display()))
+    CoreError::from_io(path.display(), &e)
 }
 
 fn atomic<F: FnOnce(&mut BufWriter<File>) -> std::io::Result<()>>(
@@ -20,7 +20,7 @@ fn atomic<F: FnOnce(&mut BufWriter<File>) -> std::io::Result<()>>(
 ) -> CoreResult<()> {
     if let Some(dir) = path.parent() {
         if !dir.as_os_str().is_empty() && !dir.is_dir() {
-            return Err(CoreError::Io(format!(
+            return Err(CoreError::NotFound(format!(
                 "{}: folder does not exist",
                 path.display()
             )));
