@@ -37,9 +37,9 @@ def test_synth_writes_cell_size_crs_and_tags(tmp_path, capsys):
         assert ds.crs.to_epsg() == 32633
         assert ds.transform == from_origin(0.0, 40 * 25.0, 25.0, 25.0)
         assert ds.tags()["CELL_SIZE"] == "25.0" and ds.tags()["HURST"] == "0.7"
-    wld = [float(v) for v in open(tmp_path / "s.pgw").read().split()]
+    wld = [float(v) for v in (tmp_path / "s.pgw").read_text().split()]
     assert wld == [25.0, 0.0, 0.0, -25.0, 12.5, 1000.0 - 12.5]
-    assert "32633" in open(tmp_path / "s.prj").read() or "UTM zone 33N" in open(tmp_path / "s.prj").read()
+    assert "32633" in (tmp_path / "s.prj").read_text() or "UTM zone 33N" in (tmp_path / "s.prj").read_text()
 
 
 @pytest.mark.parametrize("ext", [".tif", ".png"])
@@ -55,7 +55,7 @@ def test_hillshade_keeps_georeferencing(tmp_path, dem_tif, ext, capsys):
         with rasterio.open(out) as ds:  # GDAL reads the world file
             assert ds.transform == T
             b = ds.read(1)
-        assert rasterio.crs.CRS.from_wkt(open(tmp_path / "h.prj").read()).to_epsg() == 32611
+        assert rasterio.crs.CRS.from_wkt((tmp_path / "h.prj").read_text()).to_epsg() == 32611
     assert b[5, 7] == 0 and (b[np.arange(128) != 5] > 0).all()
 
 

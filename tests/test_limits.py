@@ -78,6 +78,7 @@ def _run_child(calls):
     return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="RLIMIT_AS semantics are Linux's")
 def test_no_abort_under_an_address_space_limit():
     # The default limit follows RLIMIT_AS; with max_memory raised past it the

@@ -228,6 +228,7 @@ def test_docstring_examples_run():
     assert res.failed == 0 and res.attempted >= 4
 
 
+@pytest.mark.slow
 def test_dask_local_analysis_with_chunks_smaller_than_its_halo():
     """The local analysis needs a halo of window // 2 + 2; chunks smaller
     than that are merged first, so any chunking gives the in-memory result."""

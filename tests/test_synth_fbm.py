@@ -227,6 +227,7 @@ def test_spectral_periodic_option():
     assert fg.validate_surface(zp, 0.6, coastline=False).periodicity_ratio < 1.5
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("h", [0.5, 0.8])
 def test_exact_surface_coastline_dimension_is_2_minus_h(h):
     # The target: within 0.07 averaged over seeds. Measured over 12

@@ -21,6 +21,7 @@ def holed_fbm(shape, hurst, seed):
     return z
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("w, hurst", [(9, 0.3), (17, 0.7)])
 def test_map_equals_whittle_on_every_window(w, hurst):
     """All windows of a small image with holes: interior, edge, corner and
@@ -82,6 +83,7 @@ def test_step_threads_input_untouched():
     assert np.array_equal(z, before, equal_nan=True)
 
 
+@pytest.mark.slow
 def test_dask_equals_in_memory():
     da = pytest.importorskip("dask.array")
     z = holed_fbm((70, 64), 0.6, 2)

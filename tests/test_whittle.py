@@ -113,6 +113,7 @@ def test_whittle_surface_mean_within_four_standard_errors(hurst):
     assert 0.64 < np.mean(se) / sd < 1.36, (np.mean(se), sd)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("hurst", [0.2, 0.5, 0.8])
 def test_mle_surface_mean_within_four_standard_errors(hurst):
     fits = [fg.fbm_mle(fg.fbm_surface((12, 12), hurst, method="exact", seed=s)) for s in range(30)]
@@ -188,6 +189,7 @@ def test_cell_size_sets_the_units_of_sigma2_not_h():
     assert b.extra["sigma2"] == pytest.approx(a.extra["sigma2"] * 30.0 ** (-2 * a.extra["hurst"]), rel=1e-4)
 
 
+@pytest.mark.slow
 def test_gaps_are_modelled_not_filled():
     # a NaN hole and a nodata border: the mask enters the expected
     # periodogram; the mean over seeds stays within 4 standard errors
