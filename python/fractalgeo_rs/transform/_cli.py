@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import argparse
 
-from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads
+from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads, add_progress
 
 
 def add_parsers(sub) -> None:
@@ -13,7 +13,8 @@ def add_parsers(sub) -> None:
         description="Moving-window fractal transform of a raster (paper section 4.2). Reads GeoTIFF "
                     "(rasterio) or any format read_raster knows; writes a float32 GeoTIFF with the input's "
                     "CRS and transform (or .npy). With --chunks the scene is processed by Dask in blocks "
-                    "with a progress bar, for scenes larger than memory.",
+                    "for scenes larger than memory. A progress bar is drawn when stderr is a terminal "
+                    "(--progress / --no-progress).",
     )
     p.add_argument("input", help="input raster")
     p.add_argument("output", help="output map (.tif or .npy)")
@@ -31,6 +32,7 @@ def add_parsers(sub) -> None:
     p.add_argument("--chunks", type=int, default=None,
                    help="process with Dask in chunks of this side, with a progress bar (needs the dask extra)")
     add_n_threads(p)
+    add_progress(p)
     p.set_defaults(func=_run)
 
 
@@ -41,6 +43,8 @@ def _z_scale(text: str):
 def _run(args: argparse.Namespace) -> int:
     import numpy as np
 
+    from fractalgeo_rs import _progress
+    from fractalgeo_rs._backend import require
     from fractalgeo_rs.io import read_raster, write_raster
     from fractalgeo_rs.transform import fractal_transform
 
@@ -48,18 +52,18 @@ def _run(args: argparse.Namespace) -> int:
         raise ValueError(f"--chunks: expected a positive chunk side in pixels, got {args.chunks}")
     data, profile = read_raster(args.input, band=args.band)
     nodata = (profile or {}).get("nodata")
+    show = _progress.resolve(args.progress, cli=True)
     if args.chunks is not None:
-        import dask.array as da
-        from dask.diagnostics import ProgressBar
+        da = require("dask.array")
 
         arr = da.from_array(data, chunks=args.chunks)
         lazy = fractal_transform(arr, args.window, method=args.method, nodata=nodata, n_threads=args.n_threads,
                                  z_scale=args.z_scale, step=args.step)
-        with ProgressBar():
+        with _progress.dask_bar(show):
             dmap = lazy.compute(scheduler="threads", num_workers=1)
     else:
         dmap = fractal_transform(data, args.window, method=args.method, nodata=nodata, n_threads=args.n_threads,
-                                 z_scale=args.z_scale, step=args.step)
+                                 z_scale=args.z_scale, step=args.step, progress=show)
     dmap = np.asarray(dmap, dtype=np.float32)
     if args.output.lower().endswith((".tif", ".tiff")):
         transform = (profile or {}).get("transform")
