@@ -23,8 +23,9 @@ def add_parsers(sub) -> None:
                    help="estimator (default mass: Voss's P(m, L), the paper's method)")
     p.add_argument("--z-scale", type=_z_scale, default="auto",
                    help="mass, dbc, blanket: height units per pixel (e.g. 1 dB or 1 grey level); default auto: "
-                        "1.4826 x median |lag-1 increment| of the whole image, printed; pass a fixed value to "
-                        "compare maps across scenes")
+                        "1.4826 x median |lag-1 increment| of the whole image, printed; 'cell': the file's cell "
+                        "size (cubic boxes for a DEM whose heights and cells share a unit); pass a fixed value "
+                        "to compare maps across scenes")
     p.add_argument("--step", type=int, default=1,
                    help="compute every STEP-th row and column only (output cells STEP pixels wide, "
                         "centred on the input pixels they sample; default 1)")
@@ -37,7 +38,7 @@ def add_parsers(sub) -> None:
 
 
 def _z_scale(text: str):
-    return "auto" if text == "auto" else float(text)
+    return text if text in ("auto", "cell") else float(text)
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -52,6 +53,11 @@ def _run(args: argparse.Namespace) -> int:
         raise ValueError(f"--chunks: expected a positive chunk side in pixels, got {args.chunks}")
     data, profile = read_raster(args.input, band=args.band)
     nodata = (profile or {}).get("nodata")
+    cell = abs((profile or {}).get("transform").a) if (profile or {}).get("transform") is not None else None
+    if args.z_scale == "cell":
+        if cell is None:
+            raise ValueError("--z-scale: 'cell' needs a georeferenced input (a cell size in its transform)")
+        args.z_scale = cell
     show = _progress.resolve(args.progress, cli=True)
     if args.chunks is not None:
         da = require("dask.array")
@@ -76,7 +82,16 @@ def _run(args: argparse.Namespace) -> int:
             # pixels wide with its corner shifted by (1 - step) / 2 pixels
             cell = Affine(args.step, 0.0, shift, 0.0, args.step, shift)
             transform = transform @ cell if hasattr(transform, "__matmul__") else transform * cell
-        write_raster(args.output, dmap, crs=(profile or {}).get("crs"), transform=transform, nodata=float("nan"))
+        tags = {"FRACTAL_METHOD": args.method, "WINDOW_SIZE": str(args.window)}
+        if args.method in ("mass", "dbc", "blanket"):
+            from fractalgeo_rs.transform import default_z_scale
+
+            zs = default_z_scale(data, nodata) if args.z_scale == "auto" else args.z_scale
+            tags["Z_SCALE"] = f"{zs:.9g}"  # data units per box step
+        if cell is not None:
+            tags["INPUT_CELL_SIZE"] = f"{cell:.9g}"
+        write_raster(args.output, dmap, crs=(profile or {}).get("crs"), transform=transform, nodata=float("nan"),
+                     tags=tags)
     else:
         write_raster(args.output, dmap)
     finite = dmap[np.isfinite(dmap)]
