@@ -45,7 +45,6 @@ def _run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from fractalgeo_rs import _progress
-    from fractalgeo_rs._backend import require
     from fractalgeo_rs.io import read_raster, write_raster
     from fractalgeo_rs.transform import fractal_transform
 
@@ -60,7 +59,7 @@ def _run(args: argparse.Namespace) -> int:
         args.z_scale = cell
     show = _progress.resolve(args.progress, cli=True)
     if args.chunks is not None:
-        da = require("dask.array")
+        import dask.array as da  # the CLI turns a missing module into one line naming the extra
 
         arr = da.from_array(data, chunks=args.chunks)
         lazy = fractal_transform(arr, args.window, method=args.method, nodata=nodata, n_threads=args.n_threads,
