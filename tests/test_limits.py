@@ -160,6 +160,7 @@ def test_grid_from_points_output_is_estimated():
     assert grid_from_points(pts, np.arange(4.0), (3, 3)).shape == (3, 3)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="RLIMIT_AS semantics are Linux's")
 def test_lsystem_and_readers_under_an_address_space_limit(tmp_path):
     # A doubling L-system with max_length out of the way outgrows the 3 GiB
