@@ -105,3 +105,76 @@ def test_n_threads_is_bounded():
     # the Rust layer enforces the same cap for direct callers of _core
     with pytest.raises(ValueError, match="n_threads"):
         fg._core.normal_noise(10, 1, 0, 0, cap + 1)
+
+
+def _huge_npy(path, shape=(10**6, 10**6)):
+    # a header announcing 8 TB of float64 and no data behind it
+    with open(path, "wb") as fh:
+        np.lib.format.write_array_header_1_0(fh, {"descr": "<f8", "fortran_order": False, "shape": shape})
+
+
+def _png_claiming(path, width, height):
+    # a valid 4 x 4 PNG whose IHDR is rewritten to announce width x height
+    fg.write_raster(path, np.zeros((4, 4), dtype=np.uint8))
+    raw = bytearray(open(path, "rb").read())
+    raw[16:20] = width.to_bytes(4, "big")
+    raw[20:24] = height.to_bytes(4, "big")
+    open(path, "wb").write(bytes(raw))
+
+
+def test_readers_estimate_bytes_from_the_header(tmp_path):
+    from fractalgeo_rs.io import RasterMemoryError
+
+    npy = tmp_path / "huge.npy"
+    _huge_npy(npy)
+    with pytest.raises(RasterMemoryError, match=r"path: .*huge\.npy.*1000000 x 1000000 float64") as info:
+        fg.read_raster(npy)
+    assert isinstance(info.value, OSError) and isinstance(info.value, MemoryError)
+    png = tmp_path / "huge.png"
+    _png_claiming(png, 200000, 150000)
+    with pytest.raises(RasterMemoryError, match=r"huge\.png.*150000 x 200000"):
+        fg.read_raster(png)
+
+
+def test_readers_follow_the_memory_limit(tmp_path, monkeypatch):
+    rasterio = pytest.importorskip("rasterio")
+    z = np.zeros((300, 200), dtype=np.float32)
+    tif, npy = tmp_path / "a.tif", tmp_path / "a.npy"
+    with rasterio.open(tif, "w", driver="GTiff", width=200, height=300, count=1, dtype="float32") as dst:
+        dst.write(z, 1)
+    np.save(npy, z)
+    monkeypatch.setenv(v.MAX_MEMORY_ENV, str(z.nbytes - 1))
+    for p in (tif, npy):
+        with pytest.raises(MemoryError, match="path: .*300 x 200"):
+            fg.read_raster(p)
+    monkeypatch.setenv(v.MAX_MEMORY_ENV, str(z.nbytes))
+    for p in (tif, npy):
+        assert fg.read_raster(p)[0].shape == (300, 200)
+
+
+def test_grid_from_points_output_is_estimated():
+    from fractalgeo_rs.tin import grid_from_points
+
+    pts = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
+    with pytest.raises(MemoryError, match=r"shape: .*1000000 x 1000000 float64 grid"):
+        grid_from_points(pts, np.arange(4.0), (10**6, 10**6))
+    assert grid_from_points(pts, np.arange(4.0), (3, 3)).shape == (3, 3)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="RLIMIT_AS semantics are Linux's")
+def test_lsystem_and_readers_under_an_address_space_limit(tmp_path):
+    # A doubling L-system with max_length out of the way outgrows the 3 GiB
+    # address space: the derived string's buffer is allocated fallibly
+    # (MemoryError naming max_length), never an abort; a file announcing
+    # 8 TB is refused from its header.
+    npy = tmp_path / "huge.npy"
+    _huge_npy(npy)
+    calls = ["fg.lsystem.LSystem('A', {'A': 'AA'}, max_length=2**62).derive(40)",
+             "fg.lsystem.LSystem('A', {'A': 'AB', 'B': 'A'}, max_length=2**62).derive(80)",
+             f"fg.read_raster({str(npy)!r})"]
+    r = _run_child(calls)
+    assert r.returncode == 0, (r.returncode, r.stdout[-2000:], r.stderr[-2000:])
+    assert r.stdout.count("ok ") == len(calls)
+    lines = [ln for ln in r.stdout.splitlines() if ln.startswith("ok ")]
+    assert all("MemoryError" in ln for ln in lines), r.stdout

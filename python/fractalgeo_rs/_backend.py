@@ -10,7 +10,15 @@ with the input's coords, subsampled by ``step``, and attrs), in the manner of
 xarray-spatial's ``ArrayTypeFunctionMapping``.
 
 The NaN halo is the edge policy of the windowed kernels (the image is taken
-as NaN-padded), so a chunked result equals the in-memory one.
+as NaN-padded), so a chunked result equals the in-memory one. A kernel with
+its own rule at the raster's edges (hillshade's GDAL extrapolation) is run
+with ``boundary="none"``: blocks at the raster's edges get no halo there and
+the kernel applies its rule to the true edges only, chunk borders keep their
+real neighbours.
+
+With ``progress`` an in-memory image is computed in strips of rows, each
+with the kernel's halo of real rows (none beyond the raster's edges), and a
+bar ticks per strip: the result is the one of a single call, bit for bit.
 """
 from __future__ import annotations
 
@@ -56,8 +64,37 @@ def _even_chunks(n: int, size: int, step: int, depth: int) -> tuple:
     return tuple(out)
 
 
-def _run_numpy(kernel, arr, *, n_out, **_):
-    out = kernel(arr)
+#: Strips of an in-memory image computed with progress (about this many).
+PROGRESS_STRIPS = 32
+
+
+def _call(kernel, block, origin, locate):
+    return kernel(block, origin) if locate else kernel(block)
+
+
+def _run_numpy(kernel, arr, *, n_out, depth, step, dtype, locate=False, progress=False, desc="", **_):
+    rows = arr.shape[0]
+    if not progress:
+        out = _call(kernel, arr, (0, 0), locate)
+        assert out.shape[0] == n_out
+        return out
+    from fractalgeo_rs._progress import bar
+
+    # strips of a multiple of step rows, each read with a halo of real rows
+    # rounded up to the step (so its first output row stays on the grid)
+    halo = -(-depth // step) * step
+    height = max(step, -(-(-(-rows // PROGRESS_STRIPS)) // step) * step)
+    starts = list(range(0, rows, height))
+    parts = []
+    with bar(len(starts), desc, True) as b:
+        for r0 in starts:
+            r1 = min(rows, r0 + height)
+            a0, a1 = max(0, r0 - halo), min(rows, r1 + halo)
+            res = _call(kernel, arr[a0:a1], (a0, 0), locate)
+            k0 = (r0 - a0) // step
+            parts.append(res[:, k0:k0 + -(-(r1 - r0) // step)])
+            b.update(1)
+    out = np.concatenate(parts, axis=1) if len(parts) > 1 else parts[0]
     assert out.shape[0] == n_out
     return out
 
@@ -88,15 +125,52 @@ def halo_blocks(arr, depth: int, step: int = 1):
     return da.overlap.overlap(arr, depth=depth, boundary=np.nan), arr.chunks
 
 
-def _run_dask(kernel, arr, *, depth: int, step: int, n_out: int, dtype):
+def _run_dask_own_edges(kernel, arr, *, depth: int, n_out: int, dtype, locate=False):
+    """Blocks with a halo of real neighbours inside the raster and none
+    beyond its edges (``boundary="none"``), step 1."""
+    import dask.array as da
+
+    if depth == 0 or any(n <= depth for n in arr.shape):
+        arr = arr.rechunk(arr.shape) if depth else arr
+        return arr.map_blocks(lambda b, block_info=None: _call(
+            kernel, b, tuple(lo for lo, _ in block_info[0]["array-location"]), locate).astype(dtype, copy=False),
+            new_axis=0, chunks=((n_out,),) + arr.chunks, dtype=dtype, meta=np.empty((0, 0, 0), dtype))
+    if min(min(c) for c in arr.chunks) < depth:
+        arr = arr.rechunk(tuple(_even_chunks(n, max(depth, max(c)), 1, depth)
+                                for n, c in zip(arr.shape, arr.chunks)))
+    core = arr.chunks
+    padded = da.overlap.overlap(arr, depth=depth, boundary="none")
+    starts = [np.concatenate([[0], np.cumsum(c)[:-1]]) for c in core]
+
+    def block_fn(b, block_info=None):
+        loc = block_info[0]["chunk-location"]
+        lo = [depth if k > 0 else 0 for k in loc]
+        origin = tuple(int(starts[ax][loc[ax]]) - lo[ax] for ax in range(2))
+        res = _call(kernel, b, origin, locate)
+        n0, n1 = core[0][loc[0]], core[1][loc[1]]
+        return res[:, lo[0]:lo[0] + n0, lo[1]:lo[1] + n1].astype(dtype, copy=False)
+
+    return padded.map_blocks(block_fn, new_axis=0, chunks=((n_out,),) + core, dtype=dtype,
+                             meta=np.empty((0, 0, 0), dtype))
+
+
+def _run_dask(kernel, arr, *, depth: int, step: int, n_out: int, dtype, boundary="nan", locate=False, **_):
+    if boundary == "none":
+        assert step == 1
+        return _run_dask_own_edges(kernel, arr, depth=depth, n_out=n_out, dtype=dtype, locate=locate)
     # halo: what a window reaches, rounded up to the step so that every
     # chunk's first output pixel sits on the step grid of its padded block
     depth = -(-depth // step) * step
     padded, _ = halo_blocks(arr, depth, step)
     d0 = depth // step
 
-    def block_fn(b):
-        res = kernel(b)
+    def block_fn(b, block_info=None):
+        origin = (0, 0)
+        if locate:  # global position of the padded block's first pixel
+            loc = block_info[0]["chunk-location"]
+            origin = tuple(lo - depth * (2 * k + 1)
+                           for (lo, _), k in zip(block_info[0]["array-location"], loc))
+        res = _call(kernel, b, origin, locate)
         n0 = -(-(b.shape[0] - 2 * depth) // step)
         n1 = -(-(b.shape[1] - 2 * depth) // step)
         return res[:, d0:d0 + n0, d0:d0 + n1].astype(dtype, copy=False)
@@ -121,6 +195,10 @@ def run_raster(
     names: Optional[Sequence[str]] = None,
     stack_dim: Optional[tuple] = None,
     attrs: Optional[dict] = None,
+    boundary: str = "nan",
+    locate: bool = False,
+    progress: bool = False,
+    desc: str = "",
 ):
     """Run ``kernel`` on ``image`` of any array type; returns ``k`` outputs.
 
@@ -147,6 +225,19 @@ def run_raster(
         arrays; for xarray, the new leading dimension's name and coords.
     attrs : dict, optional
         xarray: attributes added to the outputs' (merged over the input's).
+    boundary : {"nan", "none"}
+        Beyond the raster's edges: ``"nan"``, the image is taken as
+        NaN-padded (the Dask halo there is NaN); ``"none"``, no halo there,
+        the kernel applies its own edge rule to the true edges (step 1).
+    locate : bool
+        Call ``kernel(block, (row, col))`` with the global index of the
+        block's first pixel (halo included; negative in a NaN halo).
+    progress : bool
+        In memory: compute in row strips (with the halo, bit-identical to
+        one call) and tick a bar per strip (tqdm if installed). Dask work
+        is lazy: wrap its ``compute`` in ``_progress.dask_bar``.
+    desc : str
+        The bar's label.
 
     Returns
     -------
@@ -157,8 +248,16 @@ def run_raster(
     data = image.data if xr_obj is not None else image
     inner = "dask" if array_kind(data) == "dask" else "numpy"
     prep = prepare or (lambda b: b)
-    stacked = _RUNNERS[inner](lambda b: kernel(prep(b)), data, depth=depth, step=step, n_out=n_out,
-                              dtype=dtype)
+    if boundary not in ("nan", "none"):
+        raise ValueError(f"boundary: expected 'nan' or 'none', got {boundary!r}")
+    if locate:
+        def run(b, origin):
+            return kernel(prep(b), origin)
+    else:
+        def run(b):
+            return kernel(prep(b))
+    stacked = _RUNNERS[inner](run, data, depth=depth, step=step, n_out=n_out, dtype=dtype,
+                              boundary=boundary, locate=locate, progress=progress, desc=desc)
     if xr_obj is None:
         return stacked if stack_dim is not None else [stacked[k] for k in range(n_out)]
     dims = xr_obj.dims

@@ -26,3 +26,11 @@ def georeference_of_grid(rows: int, cell_size: float):
     as the 6 affine coefficients ``(a, b, c, d, e, f)`` (``rasterio.Affine``
     order; no rasterio needed)."""
     return (float(cell_size), 0.0, 0.0, 0.0, -float(cell_size), rows * float(cell_size))
+
+
+def add_progress(parser: argparse.ArgumentParser) -> None:
+    """``--progress`` / ``--no-progress`` (default: a bar when stderr is a
+    terminal; tqdm draws it, Dask's own bar with ``--chunks``)."""
+    parser.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                        help="progress bar on stderr (None: on when stderr is a terminal; needs tqdm, "
+                             "pip install \"fractalgeo_rs[progress]\", except with --chunks)")

@@ -61,7 +61,7 @@ def _real_policy(arr: np.ndarray, name: str) -> np.ndarray:
                         f"pass a real array such as np.abs({name}) or {name}.real")
     if arr.dtype.kind not in "biuf":
         raise TypeError(f"{name}: expected a real numeric or boolean array, got dtype {arr.dtype}")
-    if arr.dtype.kind == "f" and arr.size:
+    if arr.dtype.kind == "f" and arr.size and not _surely_no_inf(arr):
         inf = np.isinf(arr)
         count = int(np.count_nonzero(inf))
         if count:
@@ -69,6 +69,15 @@ def _real_policy(arr: np.ndarray, name: str) -> np.ndarray:
                           RuntimeWarning, stacklevel=4)
             arr = np.where(inf, np.asarray(np.nan, dtype=arr.dtype), arr)
     return arr
+
+
+def _surely_no_inf(arr: np.ndarray) -> bool:
+    """True when the float array holds no ±inf, decided from its extremes
+    (two passes without a temporary array); False when unsure (NaN makes
+    the extremes NaN) or when there is an infinity."""
+    with np.errstate(invalid="ignore"):
+        lo, hi = np.min(arr), np.max(arr)
+    return bool(np.isfinite(lo) and np.isfinite(hi))
 
 
 def check_real_array(data, name: str = "data") -> np.ndarray:

@@ -327,6 +327,28 @@ class DimensionFit:
             f"({self.n_used} of {len(self.scales)}, {self.range_selection}){tail})"
         )
 
+    def interval_label(self) -> str:
+        """``"D = 1.234, 95 % CI [1.200, 1.268]"``: the dimension and the
+        interval ``ci95`` (the one printed by the demo and the CLI), or
+        ``"D = 1.234 (no interval)"`` when ``ci95`` is undefined (an exact
+        two-scale fit, or an invalid one).
+
+        Returns
+        -------
+        str
+
+        Examples
+        --------
+        >>> from fractalgeo_rs.fit import fit_loglog
+        >>> fit = fit_loglog([1, 2, 4, 8], [100, 26, 6, 1.6], method="demo")
+        >>> fit.interval_label() == f"D = {fit.dimension:.3f}, 95 % CI [{fit.ci95[0]:.3f}, {fit.ci95[1]:.3f}]"
+        True
+        """
+        lo, hi = self.ci95
+        if not (np.isfinite(lo) and np.isfinite(hi)):
+            return f"D = {self.dimension:.3f} (no interval)"
+        return f"D = {self.dimension:.3f}, 95 % CI [{lo:.3f}, {hi:.3f}]"
+
     def plot(self, ax=None, *, label: Optional[str] = None, color: Optional[str] = None):
         """Draw the log-log points and the fitted line.
 
@@ -361,12 +383,11 @@ class DimensionFit:
         if np.any(~u & ok):
             ax.loglog(s[~u & ok], m[~u & ok], "o", mfc="none", color=color, label="not fitted")
         if self.model is not None:
-            ax.loglog(s[u], self.model[u], "-", color=color,
-                      label=f"D = {self.dimension:.3f} ± {1.96 * self.stderr:.3f} (model)")
+            ax.loglog(s[u], self.model[u], "-", color=color, label=self.interval_label() + " (model)")
         else:
             xs = np.array(self.scale_range, dtype=float)
             ax.loglog(xs, np.exp(self.intercept + self.slope * np.log(xs)), "-", color=color,
-                      label=f"D = {self.dimension:.3f} ± {1.96 * self.stderr:.3f}")
+                      label=self.interval_label())
         if len(self.ranges) > 1:
             # the regimes: a broken line through the fitted points, and the
             # break scale

@@ -24,7 +24,12 @@ Values are never rescaled; complex data is refused (write ``np.abs(z)`` or
 
 Every reader error is an ``OSError`` (``FileNotFoundError`` for a missing
 file) whose message names the path and the cause, so a corrupt, truncated or
-empty file never surfaces as a decoder's internal exception.
+empty file never surfaces as a decoder's internal exception. The size of
+the array is estimated from the file's header (``.npy``, ``.png``, rasterio
+formats) before anything is read: above the memory limit of
+``_validation.check_memory`` (``$FRACTALGEO_MAX_MEMORY``, default half the
+available memory) the reader raises :class:`RasterMemoryError`, an
+``OSError`` and a ``MemoryError``.
 """
 from __future__ import annotations
 
@@ -34,9 +39,57 @@ from typing import Any, Dict, Optional, Tuple
 import numpy as np
 
 from fractalgeo_rs import _core
-from fractalgeo_rs._validation import atomic_write_path
+from fractalgeo_rs._validation import MemoryLimitError, atomic_write_path, check_memory
 
-__all__ = ["read_raster", "write_raster", "is_binary_mask"]
+__all__ = ["read_raster", "write_raster", "is_binary_mask", "RasterMemoryError"]
+
+
+class RasterMemoryError(OSError, MemoryError):
+    """A raster whose header announces more data than the memory limit
+    allows (nothing was read)."""
+
+
+def _check_raster_bytes(p, n_bytes, what: str) -> None:
+    """:class:`RasterMemoryError` naming the path when reading ``n_bytes``
+    would exceed the memory limit."""
+    try:
+        check_memory(n_bytes, "path", what=what)
+    except MemoryLimitError as exc:
+        raise RasterMemoryError(f"path: {p!r} holds {what}: {str(exc)[len('path: '):]}") from None
+
+
+def _npy_header(p):
+    """``(shape, dtype)`` from a ``.npy`` header, or None when it cannot be
+    parsed (``numpy.load`` then reports the problem)."""
+    fmt = np.lib.format
+    try:
+        with open(p, "rb") as fh:
+            version = fmt.read_magic(fh)
+            read = {(1, 0): fmt.read_array_header_1_0, (2, 0): fmt.read_array_header_2_0}.get(version)
+            if read is None:
+                return None
+            shape, _, dtype = read(fh)
+    except Exception:  # numpy's header parser raises many kinds
+        return None
+    return tuple(int(n) for n in shape), np.dtype(dtype)
+
+
+#: PNG colour type -> channels as decoded (palette images expand to RGBA at most)
+_PNG_CHANNELS = {0: 1, 2: 3, 3: 4, 4: 2, 6: 4}
+
+
+def _png_header(p):
+    """``(width, height, channels, bytes per sample)`` from the PNG's IHDR
+    chunk, or None when the file does not start like a PNG."""
+    try:
+        with open(p, "rb") as fh:
+            head = fh.read(26)
+    except OSError:
+        return None
+    if len(head) < 26 or head[:8] != b"\x89PNG\r\n\x1a\n" or head[12:16] != b"IHDR":
+        return None
+    width, height = int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
+    return width, height, _PNG_CHANNELS.get(head[25], 4), 2 if head[24] == 16 else 1
 
 
 def is_binary_mask(data) -> bool:
@@ -161,6 +214,13 @@ def read_raster(path, band: Optional[int] = None) -> Tuple[np.ndarray, Optional[
         return band
 
     if ext == ".npy":
+        head = _npy_header(p)
+        if head is not None:
+            shape, dtype = head
+            n = 1
+            for k in shape:
+                n *= k
+            _check_raster_bytes(p, n * dtype.itemsize, f"a {' x '.join(map(str, shape)) or 'scalar'} {dtype} array")
         try:
             a = np.load(p, allow_pickle=False)
         except ValueError as exc:
@@ -187,6 +247,11 @@ def read_raster(path, band: Optional[int] = None) -> Tuple[np.ndarray, Optional[
             raise _unreadable(p, exc) from None
     rio = _rasterio()
     if ext == ".png" or (rio is None and ext in (".tif", ".tiff")):
+        head = _png_header(p) if ext == ".png" else None
+        if head is not None:
+            w, h, ch, bps = head
+            # the decoded buffer and the array made of it
+            _check_raster_bytes(p, 2 * w * h * ch * bps, f"a {h} x {w} image of {ch} channel(s)")
         try:
             img = _core.read_image(p)
         except (OSError, ValueError, RuntimeError, MemoryError) as exc:
@@ -203,6 +268,12 @@ def read_raster(path, band: Optional[int] = None) -> Tuple[np.ndarray, Optional[
         raise OSError(f"path: unsupported or unreadable raster {p!r}: {exc}") from None
     with src:
         b = pick(src.count)
+        try:
+            itemsize = np.dtype(src.dtypes[b - 1]).itemsize
+        except TypeError:  # GDAL types numpy has no name for (complex_int16)
+            itemsize = 8
+        _check_raster_bytes(p, src.width * src.height * itemsize,
+                            f"a {src.height} x {src.width} {src.dtypes[b - 1]} band")
         try:
             a = src.read(b)
         except rio.errors.RasterioError as exc:

@@ -305,6 +305,194 @@ fn gdal_to_byte(v: f32) -> u8 {
     (v + 0.5).clamp(0.0, 255.0) as u8
 }
 
+/// Rows of bands processed in parallel by [`gdal_rows`]: enough work per
+/// task to amortise the scheduling, small enough to balance two cores.
+const BAND_ROWS: usize = 16;
+
+/// Bytes of four neighbouring interior cells at once: `quad(up, cur, down,
+/// j)` for the centres `j..j + 4` of the row `cur` (reading columns `j - 1
+/// ..= j + 4` of the three rows), or `None` when one of them needs the
+/// scalar path (a NaN value or centre).
+type Quad = fn(&SameRes, &[f32], &[f32], &[f32], usize) -> Option<[u8; 4]>;
+
+/// Bytes of `value` (GDAL's algorithm on a 3 x 3 window) for every cell of
+/// the row-major grid `zs` into `out`, in parallel bands of rows.
+///
+/// The interior of each interior row runs over the three row slices with no
+/// edge test, four cells at a time with `quad` when given (its results are
+/// those of `value`, bit for bit); a window whose value is NaN (a NaN
+/// neighbour propagates through Horn's sums) or whose centre is NaN is
+/// rebuilt with the nodata rule of [`gdal_window`], as are the first and
+/// last rows and columns.
+#[allow(clippy::needless_range_loop)] // columns index three rows at once
+fn gdal_rows<F>(
+    zs: &[f32],
+    rows: usize,
+    cols: usize,
+    out: &mut [u8],
+    value: F,
+    quad: Option<(Quad, SameRes)>,
+) where
+    F: Fn(&[f32; 9]) -> f32 + Sync,
+{
+    let edge = |i: usize, j: usize| -> u8 {
+        match gdal_window(zs, rows, cols, i, j) {
+            Some(w) => gdal_to_byte(value(&w)),
+            None => 0,
+        }
+    };
+    out.par_chunks_mut(cols * BAND_ROWS)
+        .enumerate()
+        .for_each(|(band, chunk)| {
+            for (k, row) in chunk.chunks_mut(cols).enumerate() {
+                let i = band * BAND_ROWS + k;
+                if i == 0 || i + 1 == rows || cols < 3 {
+                    for (j, o) in row.iter_mut().enumerate() {
+                        *o = edge(i, j);
+                    }
+                    continue;
+                }
+                let up = &zs[(i - 1) * cols..i * cols];
+                let cur = &zs[i * cols..(i + 1) * cols];
+                let down = &zs[(i + 1) * cols..(i + 2) * cols];
+                let scalar = |j: usize| -> u8 {
+                    let w = [
+                        up[j - 1],
+                        up[j],
+                        up[j + 1],
+                        cur[j - 1],
+                        cur[j],
+                        cur[j + 1],
+                        down[j - 1],
+                        down[j],
+                        down[j + 1],
+                    ];
+                    let v = value(&w);
+                    if v.is_nan() || w[4].is_nan() {
+                        edge(i, j)
+                    } else {
+                        gdal_to_byte(v)
+                    }
+                };
+                row[0] = edge(i, 0);
+                row[cols - 1] = edge(i, cols - 1);
+                let mut j = 1;
+                if let Some((q, k)) = &quad {
+                    // the last quad reads column j + 4 <= cols - 1
+                    while j + 5 <= cols {
+                        match q(k, up, cur, down, j) {
+                            Some(b) => row[j..j + 4].copy_from_slice(&b),
+                            None => {
+                                for jj in j..j + 4 {
+                                    row[jj] = scalar(jj);
+                                }
+                            }
+                        }
+                        j += 4;
+                    }
+                }
+                for jj in j..cols - 1 {
+                    row[jj] = scalar(jj);
+                }
+            }
+        });
+}
+
+/// Constants of GDAL's same-resolution hillshade (`GDALHillshadeAlg_same_res`).
+#[derive(Debug, Clone, Copy)]
+struct SameRes {
+    sin_alt_254: f64,
+    sin_fact: f64,
+    cos_fact: f64,
+    square_z_inv2: f64,
+}
+
+/// Four cells of `GDALHillshadeAlg_same_res` with SSE2 (part of the x86_64
+/// baseline: no runtime detection needed), the same operations in the same
+/// order as the scalar closure `same` of [`hillshade_gdal_byte`]: float32
+/// Horn sums, double-precision shade, `rsqrtps` (per lane the estimate of
+/// `rsqrtss`) and one Newton step, `max(1 + c, 1)` (equal to GDAL's
+/// `c <= 0 ? 1 : 1 + c` for every non-NaN `c`), then GDAL's float-to-byte
+/// rounding. `None` when a value or a centre is NaN.
+#[cfg(target_arch = "x86_64")]
+fn same_res_quad(k: &SameRes, up: &[f32], cur: &[f32], down: &[f32], j: usize) -> Option<[u8; 4]> {
+    use std::arch::x86_64::*;
+    assert!(j >= 1 && j + 5 <= up.len() && up.len() == cur.len() && cur.len() == down.len());
+    // SAFETY: SSE2 is in the x86_64 baseline. Every load reads the four
+    // floats at offsets o..o + 4 with o in {j - 1, j, j + 1}, so at most up
+    // to index j + 4 < len (asserted above) of slices of equal length; the
+    // store writes a local array of four i32.
+    unsafe {
+        let ld = |s: &[f32], o: usize| _mm_loadu_ps(s.as_ptr().add(o));
+        let (a, b, c) = (ld(up, j - 1), ld(up, j), ld(up, j + 1));
+        let (d, e, f) = (ld(cur, j - 1), ld(cur, j), ld(cur, j + 1));
+        let (g, h, i) = (ld(down, j - 1), ld(down, j), ld(down, j + 1));
+        let mut ax = _mm_sub_ps(a, i);
+        let six_minus_two = _mm_sub_ps(g, c);
+        let mut ay = ax;
+        let three_minus_five = _mm_sub_ps(d, f);
+        let one_minus_seven = _mm_sub_ps(b, h);
+        ax = _mm_add_ps(ax, three_minus_five);
+        ay = _mm_add_ps(ay, one_minus_seven);
+        ax = _mm_add_ps(ax, three_minus_five);
+        ay = _mm_add_ps(ay, one_minus_seven);
+        ax = _mm_add_ps(ax, six_minus_two);
+        ay = _mm_sub_ps(ay, six_minus_two);
+        let one = _mm_set1_pd(1.0);
+        let half = _mm_set1_pd(0.5);
+        let one_and_half = _mm_set1_pd(1.5);
+        let sin_alt = _mm_set1_pd(k.sin_alt_254);
+        let sin_fact = _mm_set1_pd(k.sin_fact);
+        let cos_fact = _mm_set1_pd(k.cos_fact);
+        let sq = _mm_set1_pd(k.square_z_inv2);
+        let shade = |x: __m128d, y: __m128d| -> __m128d {
+            let num = _mm_add_pd(
+                sin_alt,
+                _mm_add_pd(_mm_mul_pd(x, sin_fact), _mm_mul_pd(y, cos_fact)),
+            );
+            let den = _mm_add_pd(
+                one,
+                _mm_mul_pd(sq, _mm_add_pd(_mm_mul_pd(x, x), _mm_mul_pd(y, y))),
+            );
+            let r = _mm_cvtps_pd(_mm_rsqrt_ps(_mm_cvtpd_ps(den)));
+            let r = _mm_mul_pd(
+                r,
+                _mm_sub_pd(
+                    one_and_half,
+                    _mm_mul_pd(_mm_mul_pd(den, half), _mm_mul_pd(r, r)),
+                ),
+            );
+            _mm_mul_pd(num, r)
+        };
+        let c0 = shade(_mm_cvtps_pd(ax), _mm_cvtps_pd(ay));
+        let c1 = shade(
+            _mm_cvtps_pd(_mm_movehl_ps(ax, ax)),
+            _mm_cvtps_pd(_mm_movehl_ps(ay, ay)),
+        );
+        let nan = _mm_movemask_pd(_mm_cmpunord_pd(c0, c0))
+            | _mm_movemask_pd(_mm_cmpunord_pd(c1, c1))
+            | _mm_movemask_ps(_mm_cmpunord_ps(e, e));
+        if nan != 0 {
+            return None;
+        }
+        let v0 = _mm_cvtpd_ps(_mm_max_pd(_mm_add_pd(one, c0), one));
+        let v1 = _mm_cvtpd_ps(_mm_max_pd(_mm_add_pd(one, c1), one));
+        let v = _mm_movelh_ps(v0, v1);
+        let v = _mm_min_ps(
+            _mm_max_ps(_mm_add_ps(v, _mm_set1_ps(0.5)), _mm_setzero_ps()),
+            _mm_set1_ps(255.0),
+        );
+        let mut o = [0i32; 4];
+        _mm_storeu_si128(o.as_mut_ptr() as *mut __m128i, _mm_cvttps_epi32(v));
+        Some([o[0] as u8, o[1] as u8, o[2] as u8, o[3] as u8])
+    }
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+fn same_res_quad(_: &SameRes, _: &[f32], _: &[f32], _: &[f32], _: usize) -> Option<[u8; 4]> {
+    None
+}
+
 /// `gdaldem hillshade -compute_edges` as bytes (`1 + 254 L`, 0 = nodata),
 /// bit for bit, for a float32 grid `z` (NaN = nodata) with square or
 /// rectangular cells `dx` (east) by `dy` (north), both positive.
@@ -369,53 +557,55 @@ pub fn hillshade_gdal_byte(
         let y = ((w[6] + w[7] + w[7] + w[8]) - (w[0] + w[1] + w[1] + w[2])) as f64 * inv_ns;
         (x, y)
     };
-    let value = |w: &[f32; 9]| -> f32 {
-        if p.multidirectional {
-            let (x, y) = horn(w);
-            let (xx, yy) = (x * x, y * y);
-            let xx_plus_yy = xx + yy;
-            if xx_plus_yy == 0.0 {
-                return (1.0 + sin_alt_254) as f32;
-            }
-            let v225 = (sin_alt_127 + (x - y) * cos225_127).max(0.0);
-            let v270 = (sin_alt_127 - x * cos_alt_z_127).max(0.0);
-            let v315 = (sin_alt_127 + (x + y) * cos225_127).max(0.0);
-            let v360 = (sin_alt_127 - y * cos_alt_z_127).max(0.0);
-            let w225 = 0.5 * xx_plus_yy - x * y;
-            let w270 = xx;
-            let w315 = xx_plus_yy - w225;
-            let w360 = yy;
-            let c127 = approx_a_div_sqrt_b(
-                (w225 * v225 + w270 * v270 + w315 * v315 + w360 * v360) / xx_plus_yy,
-                1.0 + square_z * xx_plus_yy,
-            );
-            (1.0 + c127) as f32
-        } else if same_res {
-            let mut acc_x = w[0] - w[8];
-            let six_minus_two = w[6] - w[2];
-            let mut acc_y = acc_x;
-            let three_minus_five = w[3] - w[5];
-            let one_minus_seven = w[1] - w[7];
-            acc_x += three_minus_five;
-            acc_y += one_minus_seven;
-            acc_x += three_minus_five;
-            acc_y += one_minus_seven;
-            acc_x += six_minus_two;
-            acc_y -= six_minus_two;
-            let (x, y) = (acc_x as f64, acc_y as f64);
-            let c = approx_a_div_sqrt_b(
-                sin_alt_254 + (x * sin_fact + y * cos_fact),
-                1.0 + square_z_inv2 * (x * x + y * y),
-            );
-            (if c <= 0.0 { 1.0 } else { 1.0 + c }) as f32
-        } else {
-            let (x, y) = horn(w);
-            let c = approx_a_div_sqrt_b(
-                sin_alt_254 - (y * cos_az_z_254 - x * sin_az_z_254),
-                1.0 + square_z * (x * x + y * y),
-            );
-            (if c <= 0.0 { 1.0 } else { 1.0 + c }) as f32
+    // One closure per GDAL algorithm, each monomorphised into its own
+    // driver loop (no per-pixel test of the mode).
+    let multi = |w: &[f32; 9]| -> f32 {
+        let (x, y) = horn(w);
+        let (xx, yy) = (x * x, y * y);
+        let xx_plus_yy = xx + yy;
+        if xx_plus_yy == 0.0 {
+            return (1.0 + sin_alt_254) as f32;
         }
+        let v225 = (sin_alt_127 + (x - y) * cos225_127).max(0.0);
+        let v270 = (sin_alt_127 - x * cos_alt_z_127).max(0.0);
+        let v315 = (sin_alt_127 + (x + y) * cos225_127).max(0.0);
+        let v360 = (sin_alt_127 - y * cos_alt_z_127).max(0.0);
+        let w225 = 0.5 * xx_plus_yy - x * y;
+        let w270 = xx;
+        let w315 = xx_plus_yy - w225;
+        let w360 = yy;
+        let c127 = approx_a_div_sqrt_b(
+            (w225 * v225 + w270 * v270 + w315 * v315 + w360 * v360) / xx_plus_yy,
+            1.0 + square_z * xx_plus_yy,
+        );
+        (1.0 + c127) as f32
+    };
+    let same = |w: &[f32; 9]| -> f32 {
+        let mut acc_x = w[0] - w[8];
+        let six_minus_two = w[6] - w[2];
+        let mut acc_y = acc_x;
+        let three_minus_five = w[3] - w[5];
+        let one_minus_seven = w[1] - w[7];
+        acc_x += three_minus_five;
+        acc_y += one_minus_seven;
+        acc_x += three_minus_five;
+        acc_y += one_minus_seven;
+        acc_x += six_minus_two;
+        acc_y -= six_minus_two;
+        let (x, y) = (acc_x as f64, acc_y as f64);
+        let c = approx_a_div_sqrt_b(
+            sin_alt_254 + (x * sin_fact + y * cos_fact),
+            1.0 + square_z_inv2 * (x * x + y * y),
+        );
+        (if c <= 0.0 { 1.0 } else { 1.0 + c }) as f32
+    };
+    let general = |w: &[f32; 9]| -> f32 {
+        let (x, y) = horn(w);
+        let c = approx_a_div_sqrt_b(
+            sin_alt_254 - (y * cos_az_z_254 - x * sin_az_z_254),
+            1.0 + square_z * (x * x + y * y),
+        );
+        (if c <= 0.0 { 1.0 } else { 1.0 + c }) as f32
     };
     let zs = z.as_standard_layout();
     let zs = zs
@@ -423,38 +613,26 @@ pub fn hillshade_gdal_byte(
         .ok_or_else(|| CoreError::Internal("dem not contiguous".into()))?;
     let mut out =
         crate::buffers::try_filled(crate::buffers::checked_len(rows, cols, "dem")?, 0u8, "dem")?;
-    out.par_chunks_mut(cols).enumerate().for_each(|(i, row)| {
-        let interior_row = i > 0 && i + 1 < rows;
-        for (j, o) in row.iter_mut().enumerate() {
-            if interior_row && j > 0 && j + 1 < cols {
-                // NaN anywhere around the centre propagates to the value
-                // (the centre itself is not in Horn's sums): only then is the
-                // window rebuilt with the nodata rule
-                let b = (i - 1) * cols + j - 1;
-                let w = [
-                    zs[b],
-                    zs[b + 1],
-                    zs[b + 2],
-                    zs[b + cols],
-                    zs[b + cols + 1],
-                    zs[b + cols + 2],
-                    zs[b + 2 * cols],
-                    zs[b + 2 * cols + 1],
-                    zs[b + 2 * cols + 2],
-                ];
-                let v = value(&w);
-                if !(v.is_nan() || w[4].is_nan()) {
-                    *o = gdal_to_byte(v);
-                    continue;
-                }
-            }
-            let w = gdal_window(zs, rows, cols, i, j);
-            *o = match w {
-                Some(w) => gdal_to_byte(value(&w)),
-                None => 0,
-            };
-        }
-    });
+    if p.multidirectional {
+        gdal_rows(zs, rows, cols, &mut out, multi, None);
+    } else if same_res {
+        let k = SameRes {
+            sin_alt_254,
+            sin_fact,
+            cos_fact,
+            square_z_inv2,
+        };
+        gdal_rows(
+            zs,
+            rows,
+            cols,
+            &mut out,
+            same,
+            Some((same_res_quad as Quad, k)),
+        );
+    } else {
+        gdal_rows(zs, rows, cols, &mut out, general, None);
+    }
     Array2::from_shape_vec((rows, cols), out).map_err(|e| CoreError::Internal(e.to_string()))
 }
 
@@ -551,6 +729,78 @@ mod tests {
         assert_eq!(b[[3, 3]], 0);
         assert_eq!(b[[0, 2]], want);
         assert_eq!(b[[5, 2]], want);
+    }
+
+    #[test]
+    fn quads_equal_the_scalar_path() {
+        // random heights with NaN voids and a wide range of slopes: the SSE2
+        // quads and the scalar closure give the same bytes everywhere
+        let (rows, cols) = (37, 53);
+        let mut state = 12345u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut z = Array2::from_shape_fn((rows, cols), |(i, j)| (i * j) as f32 * 0.7);
+        for v in z.iter_mut() {
+            *v += 300.0 * next();
+        }
+        for &(i, j) in &[(5, 5), (10, 20), (10, 21), (36, 3), (0, 9), (20, 52)] {
+            z[[i, j]] = f32::NAN;
+        }
+        let mut seen = std::collections::BTreeSet::new();
+        for p in [params(315.0), params(135.0), params(20.0)] {
+            for zf in [0.3, 1.0, 7.0] {
+                let p = ShadeParams { z_factor: zf, ..p };
+                let fast = hillshade_gdal_byte(z.view(), 3.0, 3.0, &p).unwrap();
+                // the same cells through the scalar path only (rectangular
+                // code path disabled: equal cells, no quads)
+                let zs: Vec<f32> = z.iter().copied().collect();
+                let mut slow = vec![0u8; rows * cols];
+                let d2r = std::f64::consts::PI / 180.0;
+                let zf8 = zf / 8.0;
+                let inv = 1.0 / 3.0;
+                let cos_alt_z = (p.altitude * d2r).cos() * zf8;
+                let az = p.azimuth * d2r;
+                let k = SameRes {
+                    sin_alt_254: 254.0 * (p.altitude * d2r).sin(),
+                    sin_fact: 254.0 * az.sin() * cos_alt_z * inv,
+                    cos_fact: 254.0 * az.cos() * cos_alt_z * -inv,
+                    square_z_inv2: zf8 * zf8 * inv * inv,
+                };
+                let same = |w: &[f32; 9]| -> f32 {
+                    let mut acc_x = w[0] - w[8];
+                    let six_minus_two = w[6] - w[2];
+                    let mut acc_y = acc_x;
+                    let three_minus_five = w[3] - w[5];
+                    let one_minus_seven = w[1] - w[7];
+                    acc_x += three_minus_five;
+                    acc_y += one_minus_seven;
+                    acc_x += three_minus_five;
+                    acc_y += one_minus_seven;
+                    acc_x += six_minus_two;
+                    acc_y -= six_minus_two;
+                    let (x, y) = (acc_x as f64, acc_y as f64);
+                    let c = approx_a_div_sqrt_b(
+                        k.sin_alt_254 + (x * k.sin_fact + y * k.cos_fact),
+                        1.0 + k.square_z_inv2 * (x * x + y * y),
+                    );
+                    (if c <= 0.0 { 1.0 } else { 1.0 + c }) as f32
+                };
+                gdal_rows(&zs, rows, cols, &mut slow, same, None);
+                assert_eq!(
+                    fast.as_slice().unwrap(),
+                    &slow[..],
+                    "az {} z {zf}",
+                    p.azimuth
+                );
+                seen.extend(fast.iter().copied());
+            }
+        }
+        // shadowed cells (1), bright ones and voids (0) were all exercised
+        assert!(seen.contains(&0) && seen.contains(&1) && seen.iter().any(|&b| b > 200));
     }
 
     #[test]

@@ -387,7 +387,7 @@ impl LSystem {
             return Err(self.too_long(generation));
         }
         let mut out = ModString {
-            syms: Vec::with_capacity(total),
+            syms: crate::buffers::try_with_capacity(total, "max_length")?,
             pstart: Vec::new(),
             params: Vec::new(),
         };
@@ -399,8 +399,9 @@ impl LSystem {
             if np > u32::MAX as usize {
                 return Err(self.too_long(generation));
             }
-            out.params.reserve(np);
-            out.pstart.reserve(total + 1);
+            let oom = || CoreError::out_of_memory("max_length", total + 1, 4);
+            out.params.try_reserve(np).map_err(|_| oom())?;
+            out.pstart.try_reserve(total + 1).map_err(|_| oom())?;
             out.pstart.push(0);
             let mut acc = 0u32;
             for p in pieces {
@@ -464,7 +465,7 @@ impl LSystem {
         if total > self.max_length {
             return Err(self.too_long(generation));
         }
-        let mut out = vec!['\0'; total];
+        let mut out = crate::buffers::try_filled(total, '\0', "max_length")?;
         let mut slices = Vec::with_capacity(sizes.len());
         let mut rest: &mut [char] = &mut out;
         for &k in &sizes {

@@ -6,6 +6,7 @@ import numbers
 import numpy as np
 
 from fractalgeo_rs import _core
+from fractalgeo_rs._backend import array_kind, run_raster
 from fractalgeo_rs._validation import as_array, check_n_threads, check_nodata, check_real_array, check_z_factor
 
 __all__ = ["hillshade", "shade_to_byte", "metres_per_degree"]
@@ -111,8 +112,11 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
 
     Parameters
     ----------
-    dem : array_like, shape (rows, cols)
-        Heights, row 0 to the north. Not modified.
+    dem : array_like, dask.array.Array or xarray.DataArray, shape (rows, cols)
+        Heights, row 0 to the north. Not modified. A Dask array is shaded
+        lazily block by block with a one-cell halo of real neighbours (the
+        edge rule applies to the raster's true edges only, so the result is
+        the same for any chunking); a DataArray keeps its coords and attrs.
     azimuth, altitude : float
         Light direction in degrees; ``0 <= altitude <= 90``.
     cell_size : float or (float, float)
@@ -138,7 +142,7 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
 
     Returns
     -------
-    numpy.ndarray
+    numpy.ndarray (or the input's array type)
         float32 reflectance in [0, 1], NaN at nodata; with ``byte=True``
         uint8, ``1 + 254 L`` rounded, 0 at nodata.
 
@@ -156,18 +160,17 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
     >>> round(float(s[1, 1]), 4)  # flat ground: sin(45 deg)
     0.7071
     """
-    z = check_real_array(dem, "dem")
+    kind = array_kind(dem)
+    data = dem.data if kind == "xarray" else dem
+    lazy = array_kind(data) == "dask"
+    z = data if lazy else check_real_array(data, "dem")
     if z.ndim != 2 or min(z.shape) < 1:
         raise ValueError(f"dem: expected a non-empty 2D array, got shape {z.shape}")
-    if z.dtype == bool:
+    if z.dtype.kind not in "iuf":
+        if z.dtype.kind == "c":
+            raise TypeError(f"dem: complex data is not accepted (dtype {z.dtype}); pass a real array")
         raise TypeError(f"dem: expected a numeric array, got dtype {z.dtype}")
-    if nodata is None:
-        z = np.ascontiguousarray(z, dtype=np.float64)  # the kernel only reads it
-    else:
-        z = np.array(z, dtype=np.float64)  # a copy: the caller's array is never touched
     nodata = check_nodata(nodata)
-    if nodata is not None:
-        z[z == nodata] = np.nan
     for name, v in (("azimuth", azimuth), ("altitude", altitude)):
         if isinstance(v, bool) or not isinstance(v, numbers.Real) or not np.isfinite(v):
             raise ValueError(f"{name}: expected a finite number, got {v!r}")
@@ -188,13 +191,45 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
         dx_rows = dx * m_lon
         dy = dy * float(np.mean(m_lat))
     n_threads = check_n_threads(n_threads)
-    if byte and latitude is None:
-        return _core.hillshade_gdal_byte(np.ascontiguousarray(z, dtype=np.float32), float(dx), float(dy),
-                                         float(azimuth), float(altitude), float(z_factor),
-                                         bool(multidirectional), n_threads)
-    s = _core.hillshade_f64(z, dx_rows.tolist(), float(dy), float(azimuth), float(altitude),
-                            float(z_factor), bool(multidirectional), n_threads)
-    return _core.shade_to_byte(s, n_threads) if byte else s
+    gdal_bytes = byte and latitude is None
+    # gdaldem's bytes are computed on float32 heights: that path converts
+    # once to float32 (no copy of a C-ordered float32 DEM), the reflectance
+    # path to float64; with a nodata value the conversion is a copy and the
+    # caller's array is never touched.
+    work = np.float32 if gdal_bytes else np.float64
+
+    def prepare(block):
+        if lazy:  # a Dask block: the package's ±inf rule, block by block
+            block = check_real_array(block, "dem")
+        if nodata is None:
+            return np.ascontiguousarray(block, dtype=work)  # the kernel only reads it
+        mask = block == np.float64(nodata)  # compared in float64, whatever the dtype
+        out = np.array(block, dtype=work)
+        out[mask] = np.nan
+        return out
+
+    def kernel(block, origin):
+        if gdal_bytes:
+            res = _core.hillshade_gdal_byte(block, float(dx), float(dy), float(azimuth), float(altitude),
+                                            float(z_factor), bool(multidirectional), n_threads)
+        else:
+            r0 = origin[0]
+            res = _core.hillshade_f64(block, dx_rows[r0:r0 + block.shape[0]].tolist(), float(dy),
+                                      float(azimuth), float(altitude), float(z_factor),
+                                      bool(multidirectional), n_threads)
+            if byte:
+                res = _core.shade_to_byte(res, n_threads)
+        return res[None]
+
+    if kind == "xarray" and not lazy:
+        image = dem.copy(data=z)
+    else:
+        image = dem if kind == "xarray" else z
+    # GDAL's edge rule on the raster's true edges only: Dask chunk borders
+    # read their real neighbours (boundary "none")
+    return run_raster(kernel, image, depth=1, n_out=1, dtype=np.uint8 if byte else np.float32,
+                      prepare=prepare, boundary="none", locate=True,
+                      attrs={"long_name": "hillshade"} if kind == "xarray" else None)[0]
 
 
 def shade_to_byte(shade):

@@ -405,8 +405,9 @@ def differential_box_counting(
         without a copy). NaN is nodata and is skipped. (Called ``image``
         before 0.2.0; the old keyword still works, with a DeprecationWarning.)
     box_sizes : sequence of int, optional
-        Block sides in pixels. Default ``2, 4, 8, ...`` up to a quarter of the
-        shorter side (``s = 1`` carries no height information in DBC).
+        Block sides in pixels, at least 2. Default ``2, 4, 8, ...`` up to a
+        quarter of the shorter side (``s = 1`` carries no height information
+        in DBC: it raises ``ValueError``).
     z_scale : float, optional
         Box height per pixel of box size, in data units (e.g. metres per
         pixel). Default: ``(zmax - zmin) / max(rows, cols)``, which puts the
@@ -461,6 +462,9 @@ def differential_box_counting(
     """
     z = _surface_float(data, nodata, "data")
     sizes = check_box_sizes(box_sizes)
+    if sizes is not None and sizes[0] < 2:
+        raise ValueError(f"box_sizes: DBC needs block sides of at least 2 pixels (a 1-pixel block spans no "
+                         f"height range: it always holds one box), got {sizes}")
     offsets = check_positive_int(offsets, "offsets")
     check_choice(offset_reduce, "offset_reduce", ("mean", "min"))
     n_threads = check_n_threads(n_threads)

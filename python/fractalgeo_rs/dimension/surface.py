@@ -24,8 +24,13 @@ from fractalgeo_rs.fit import DimensionFit, ScaleRange, fit_loglog
 __all__ = ["minkowski", "mass_dimension", "blanket"]
 
 
+#: The default radii of :func:`minkowski` reach at least this far (samples).
+MIN_DEFAULT_RADIUS = 4
+
+
 def _radii_default(extent: float) -> np.ndarray:
-    out = [r for r in np.unique(np.round(np.geomspace(1, max(extent / 8, 4), 12)).astype(int)) if r >= 1]
+    out = [r for r in np.unique(np.round(np.geomspace(1, max(extent / 8, MIN_DEFAULT_RADIUS), 12)).astype(int))
+           if r >= 1]
     return np.asarray(out, dtype=float)
 
 
@@ -46,8 +51,11 @@ def minkowski(data, *, radii: Optional[Sequence[float]] = None, scale_range: Sca
         The set; as in :func:`box_counting` (0/1 numbers accepted, NaN refused).
     radii : sequence of float, optional
         Radii in samples; default 12 geometric steps from 1 to an eighth of
-        the set's extent. The array is padded by the largest radius, so the
-        sausage is never cut by the array edge.
+        the set's extent (a set spanning fewer than 32 samples needs explicit
+        radii). The array is padded by the largest radius, so the sausage is
+        never cut by the array edge. Radii on both sides of the set's extent
+        mix two regimes (the set, and the set seen as a point) and raise
+        ``ValueError``; so does a set filling the whole array.
 
     Returns
     -------
@@ -84,15 +92,24 @@ def minkowski(data, *, radii: Optional[Sequence[float]] = None, scale_range: Sca
     coords = np.argwhere(mask)
     if coords.size == 0:
         raise ValueError("data: the set is empty (no foreground sample)")
+    if mask.all() and mask.size > 1:
+        raise ValueError(f"data: the set fills the whole array (shape {mask.shape}, every sample is foreground): "
+                         f"its sausage only grows at the array's border, which says nothing of the set")
     extent = float((coords.max(axis=0) - coords.min(axis=0)).max() + 1)
     if radii is None:
+        if extent < 8 * MIN_DEFAULT_RADIUS:
+            raise ValueError(f"data: the set spans {extent:g} samples, too small for the default radii (1 to an "
+                             f"eighth of the extent, at least 1..{MIN_DEFAULT_RADIUS}: a set of at least "
+                             f"{8 * MIN_DEFAULT_RADIUS} samples); give radii")
         r = _radii_default(extent)
     else:
         r = np.asarray(sorted(set(float(v) for v in radii)))
         if r.size < 3 or r[0] <= 0 or not np.isfinite(r).all():
             raise ValueError(f"radii: need at least 3 distinct positive radii, got {list(radii)}")
-    if r.size < 3:
-        raise ValueError(f"data: the set spans {extent:g} samples, too small for the default radii; give radii")
+        if r[0] < extent <= r[-1]:
+            raise ValueError(f"radii: {r[0]:g}..{r[-1]:g} straddle the set's extent ({extent:g} samples): below it "
+                             f"the sausage measures the set, above it the set looks like a point (D = 0); use "
+                             f"radii well below the extent")
     pad = int(np.ceil(r[-1])) + 1
     lo = coords.min(axis=0)
     hi = coords.max(axis=0) + 1
@@ -242,6 +259,11 @@ def mass_dimension(
                       x_label="box side L", y_label="N(L) = sum P(m,L)/m", extra={"kind": kind})
 
 
+#: Fewest rows and columns (and ``BLANKET_MIN_SIDE**2`` valid samples) of a
+#: surface for :func:`blanket`.
+BLANKET_MIN_SIDE = 3
+
+
 def blanket(data, *, epsilons: Optional[Sequence[int]] = None, z_scale: float = 1.0,
             nodata: Optional[float] = None, scale_range: ScaleRange = None,
             n_threads: Optional[int] = None) -> DimensionFit:
@@ -262,7 +284,8 @@ def blanket(data, *, epsilons: Optional[Sequence[int]] = None, z_scale: float = 
     Parameters
     ----------
     data : array_like, shape (rows, cols)
-        Grayscale surface. NaN and ``nodata`` are missing samples: they are
+        Grayscale surface, at least 3 x 3 with 9 valid samples
+        (``ValueError`` below). NaN and ``nodata`` are missing samples: they are
         not part of the surface, hold no blanket and pass none on (blankets
         grow around holes, as at the edge of the data).
     epsilons : sequence of int, optional
@@ -311,6 +334,11 @@ def blanket(data, *, epsilons: Optional[Sequence[int]] = None, z_scale: float = 
         raise ValueError("data: no valid value (all NaN or nodata)")
     if np.isinf(z).any():
         raise ValueError("data: contains inf; mark invalid samples with NaN or nodata")
+    n_ok = int(np.count_nonzero(~np.isnan(z)))
+    if min(z.shape) < BLANKET_MIN_SIDE or n_ok < BLANKET_MIN_SIDE ** 2:
+        raise ValueError(f"data: the covering blanket needs a surface of at least {BLANKET_MIN_SIDE} x "
+                         f"{BLANKET_MIN_SIDE} valid samples, got shape {z.shape} with {n_ok} valid (a smaller "
+                         f"surface is all edge: its blanket measures the border, not the surface)")
     zs = check_positive_float(z_scale, "z_scale")
     eps = list(range(1, 17)) if epsilons is None else sorted(set(check_positive_int(e, "epsilons") for e in epsilons))
     if len(eps) < 3:

@@ -10,6 +10,7 @@ import numpy as np
 from fractalgeo_rs import _core
 from fractalgeo_rs._validation import (
     as_array,
+    check_memory,
     check_choice,
     check_n_threads,
     check_nodata,
@@ -435,6 +436,7 @@ def grid_from_points(points, values, shape, transform=None, *, method="natural",
     if isinstance(shape, (str, bytes)) or not hasattr(shape, "__len__") or len(shape) != 2:
         raise TypeError(f"shape: expected (rows, cols), got {shape!r}")
     rows, cols = (check_positive_int(s, "shape") for s in shape)
+    check_memory(8 * rows * cols, "shape", what=f"a {rows} x {cols} float64 grid")
     check_choice(method, "method", ("natural", "natural_c1", "linear", "nearest"))
     n_threads = check_n_threads(n_threads)
     if transform is None:

@@ -27,7 +27,7 @@ from typing import Any, Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from fractalgeo_rs import _core
+from fractalgeo_rs import _core, _progress
 from fractalgeo_rs._backend import array_kind, run_raster
 from fractalgeo_rs._compat import keyword_only_since
 from fractalgeo_rs._validation import (
@@ -146,6 +146,7 @@ def fractal_transform(
     return_fit: bool = False,
     dilations: int = 2,
     anisotropy: bool = False,
+    progress: Optional[bool] = None,
 ):
     """Map of local fractal dimension over a moving window.
 
@@ -278,6 +279,11 @@ def fractal_transform(
         on numpy's BLAS threads, which this does not limit (set
         ``OPENBLAS_NUM_THREADS`` before starting Python, e.g. in Dask
         workers).
+    progress : bool or None, default None
+        A progress bar (tqdm, if installed) while an in-memory image is
+        computed in strips of rows (the result is the same bit for bit);
+        ``None`` is off (the CLI turns it on when stderr is a terminal). On
+        Dask, wrap ``compute`` in ``dask.diagnostics.ProgressBar``.
     return_fit : bool, default False
         Also return the map of r² of the log-log fit (1 with two lags); for
         ``"whittle"`` and ``"gls"``, the map of the standard error of ``D``.
@@ -400,7 +406,8 @@ def fractal_transform(
     if method == "gls" and opts["anisotropy"]:
         names += ("anisotropy_angle", "anisotropy_ratio")
     out = run_raster(kernel, image, depth=half, n_out=len(names), step=step,
-                     prepare=prepare if array_kind(arr) == "dask" else None, names=names)
+                     prepare=prepare if array_kind(arr) == "dask" else None, names=names,
+                     progress=_progress.resolve(progress), desc=f"fractal_transform ({method})")
     if method == "gls" and array_kind(arr) != "dask":  # (a lazy map is not read here)
         from fractalgeo_rs.dimension.gls import warn_pinned_map
 
@@ -468,6 +475,7 @@ def lacunarity_map(
     nodata: Optional[float] = None,
     min_valid: float = 0.5,
     n_threads: Optional[int] = None,
+    progress: Optional[bool] = None,
 ) -> np.ndarray:
     """Map of gliding-box lacunarity over a moving window.
 
@@ -490,6 +498,11 @@ def lacunarity_map(
         Box sides, default ``1, 2, 4, 8`` (those not larger than the window).
     min_valid : float, default 0.5
         NaN where fewer than this fraction of the window's pixels are valid.
+    progress : bool or None, default None
+        A progress bar (tqdm, if installed) while an in-memory image is
+        computed in strips of rows (the result is the same bit for bit);
+        ``None`` is off (the CLI turns it on when stderr is a terminal). On
+        Dask, wrap ``compute`` in ``dask.diagnostics.ProgressBar``.
 
     Returns
     -------
@@ -551,4 +564,5 @@ def lacunarity_map(
         image = image.copy(data=z) if array_kind(image) == "xarray" else z
         prep = None
     return run_raster(kernel, image, depth=w // 2, n_out=len(sizes), prepare=prep,
-                      names=("lacunarity",), stack_dim=("box_size", sizes))
+                      names=("lacunarity",), stack_dim=("box_size", sizes),
+                      progress=_progress.resolve(progress), desc="lacunarity_map")

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import argparse
 
-from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads
+from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads, add_progress
 
 
 def add_parsers(sub) -> None:
@@ -13,7 +13,8 @@ def add_parsers(sub) -> None:
         description="Moving-window fractal transform of a raster (paper section 4.2). Reads GeoTIFF "
                     "(rasterio) or any format read_raster knows; writes a float32 GeoTIFF with the input's "
                     "CRS and transform (or .npy). With --chunks the scene is processed by Dask in blocks "
-                    "with a progress bar, for scenes larger than memory.",
+                    "for scenes larger than memory. A progress bar is drawn when stderr is a terminal "
+                    "(--progress / --no-progress).",
     )
     p.add_argument("input", help="input raster")
     p.add_argument("output", help="output map (.tif or .npy)")
@@ -22,8 +23,9 @@ def add_parsers(sub) -> None:
                    help="estimator (default mass: Voss's P(m, L), the paper's method)")
     p.add_argument("--z-scale", type=_z_scale, default="auto",
                    help="mass, dbc, blanket: height units per pixel (e.g. 1 dB or 1 grey level); default auto: "
-                        "1.4826 x median |lag-1 increment| of the whole image, printed; pass a fixed value to "
-                        "compare maps across scenes")
+                        "1.4826 x median |lag-1 increment| of the whole image, printed; 'cell': the file's cell "
+                        "size (cubic boxes for a DEM whose heights and cells share a unit); pass a fixed value "
+                        "to compare maps across scenes")
     p.add_argument("--step", type=int, default=1,
                    help="compute every STEP-th row and column only (output cells STEP pixels wide, "
                         "centred on the input pixels they sample; default 1)")
@@ -31,16 +33,18 @@ def add_parsers(sub) -> None:
     p.add_argument("--chunks", type=int, default=None,
                    help="process with Dask in chunks of this side, with a progress bar (needs the dask extra)")
     add_n_threads(p)
+    add_progress(p)
     p.set_defaults(func=_run)
 
 
 def _z_scale(text: str):
-    return "auto" if text == "auto" else float(text)
+    return text if text in ("auto", "cell") else float(text)
 
 
 def _run(args: argparse.Namespace) -> int:
     import numpy as np
 
+    from fractalgeo_rs import _progress
     from fractalgeo_rs.io import read_raster, write_raster
     from fractalgeo_rs.transform import fractal_transform
 
@@ -48,18 +52,23 @@ def _run(args: argparse.Namespace) -> int:
         raise ValueError(f"--chunks: expected a positive chunk side in pixels, got {args.chunks}")
     data, profile = read_raster(args.input, band=args.band)
     nodata = (profile or {}).get("nodata")
+    cell = abs((profile or {}).get("transform").a) if (profile or {}).get("transform") is not None else None
+    if args.z_scale == "cell":
+        if cell is None:
+            raise ValueError("--z-scale: 'cell' needs a georeferenced input (a cell size in its transform)")
+        args.z_scale = cell
+    show = _progress.resolve(args.progress, cli=True)
     if args.chunks is not None:
-        import dask.array as da
-        from dask.diagnostics import ProgressBar
+        import dask.array as da  # the CLI turns a missing module into one line naming the extra
 
         arr = da.from_array(data, chunks=args.chunks)
         lazy = fractal_transform(arr, args.window, method=args.method, nodata=nodata, n_threads=args.n_threads,
                                  z_scale=args.z_scale, step=args.step)
-        with ProgressBar():
+        with _progress.dask_bar(show):
             dmap = lazy.compute(scheduler="threads", num_workers=1)
     else:
         dmap = fractal_transform(data, args.window, method=args.method, nodata=nodata, n_threads=args.n_threads,
-                                 z_scale=args.z_scale, step=args.step)
+                                 z_scale=args.z_scale, step=args.step, progress=show)
     dmap = np.asarray(dmap, dtype=np.float32)
     if args.output.lower().endswith((".tif", ".tiff")):
         transform = (profile or {}).get("transform")
@@ -72,7 +81,16 @@ def _run(args: argparse.Namespace) -> int:
             # pixels wide with its corner shifted by (1 - step) / 2 pixels
             cell = Affine(args.step, 0.0, shift, 0.0, args.step, shift)
             transform = transform @ cell if hasattr(transform, "__matmul__") else transform * cell
-        write_raster(args.output, dmap, crs=(profile or {}).get("crs"), transform=transform, nodata=float("nan"))
+        tags = {"FRACTAL_METHOD": args.method, "WINDOW_SIZE": str(args.window)}
+        if args.method in ("mass", "dbc", "blanket"):
+            from fractalgeo_rs.transform import default_z_scale
+
+            zs = default_z_scale(data, nodata) if args.z_scale == "auto" else args.z_scale
+            tags["Z_SCALE"] = f"{zs:.9g}"  # data units per box step
+        if cell is not None:
+            tags["INPUT_CELL_SIZE"] = f"{cell:.9g}"
+        write_raster(args.output, dmap, crs=(profile or {}).get("crs"), transform=transform, nodata=float("nan"),
+                     tags=tags)
     else:
         write_raster(args.output, dmap)
     finite = dmap[np.isfinite(dmap)]
