@@ -10,28 +10,13 @@ from typing import Union
 
 import numpy as np
 
-from fractalgeo_rs import _core
 from fractalgeo_rs._validation import atomic_write_path, check_positive_float, check_positive_int
-from fractalgeo_rs.lsystem.geometry import Mesh, Polylines, Segments
+from fractalgeo_rs.lsystem.geometry import Polylines, Segments
+from fractalgeo_rs.lsystem.mesh import Mesh, write_mesh
 
 __all__ = ["write_obj", "write_ply", "write_svg", "write_png"]
 
 PathLike = Union[str, os.PathLike]
-
-
-def _mesh_arrays(mesh: Mesh) -> tuple:
-    if not isinstance(mesh, Mesh):
-        raise TypeError(f"mesh: expected a Mesh, got {type(mesh).__name__}")
-    return (
-        np.ascontiguousarray(mesh.vertices, dtype=np.float32),
-        np.ascontiguousarray(mesh.normals, dtype=np.float32),
-        np.ascontiguousarray(mesh.uvs, dtype=np.float32),
-        np.ascontiguousarray(mesh.faces, dtype=np.uint32),
-        np.ascontiguousarray(mesh.part_ids, dtype=np.uint32),
-        np.ascontiguousarray(mesh.kinds, dtype=np.uint8),
-        np.ascontiguousarray(mesh.colors, dtype=np.uint32),
-        np.ascontiguousarray(mesh.instances, dtype=np.uint32),
-    )
 
 
 def write_obj(mesh: Mesh, path: PathLike) -> None:
@@ -71,7 +56,7 @@ def write_obj(mesh: Mesh, path: PathLike) -> None:
     >>> [ln for ln in lines if ln.startswith(("g ", "f "))][:3]
     ['g branches', 'f 1/1/1 2/2/2 6/6/6', 'f 1/1/1 6/6/6 5/5/5']
     """
-    _core.write_mesh(os.fspath(path), "obj", *_mesh_arrays(mesh))
+    write_mesh(mesh, path, "obj")
 
 
 def write_ply(mesh: Mesh, path: PathLike) -> None:
@@ -109,7 +94,7 @@ def write_ply(mesh: Mesh, path: PathLike) -> None:
     >>> header.splitlines()[:2], len(body) == 8 * 32 + 6 * 26
     ([b'ply', b'format binary_little_endian 1.0'], True)
     """
-    _core.write_mesh(os.fspath(path), "ply", *_mesh_arrays(mesh))
+    write_mesh(mesh, path, "ply")
 
 
 def write_svg(drawing: Polylines, path: PathLike, *, size: float = 800.0, stroke_width: float = 1.0,

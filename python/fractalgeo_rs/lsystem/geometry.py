@@ -14,6 +14,7 @@ import numpy as np
 from fractalgeo_rs import _core
 from fractalgeo_rs._validation import check_n_threads
 from fractalgeo_rs.lsystem.core import LString
+from fractalgeo_rs.lsystem.mesh import Mesh
 
 __all__ = ["Polylines", "Segments", "Mesh", "turtle_2d", "turtle_3d", "plant_mesh", "TURTLE_SYMBOLS"]
 
@@ -167,75 +168,6 @@ class Segments:
 
     def __len__(self) -> int:
         return len(self.starts)
-
-
-@dataclass(frozen=True)
-class Mesh:
-    """An indexed triangle mesh.
-
-    Attributes
-    ----------
-    vertices, normals : (V, 3) float32
-    uvs : (V, 2) float32
-        Texture coordinates: u around a branch tube in [0, 1], v along the
-        branch in turtle units; leaves are mapped to [0, 1]^2.
-    faces : (T, 3) uint32
-        Counter-clockwise seen from outside.
-    part_ids : (T,) uint32
-        Turtle element of the triangle: segment number (branches) or
-        polygon number (leaves).
-    kinds : (T,) uint8
-        0 for branches, 1 for leaves.
-    colors : (T,) uint32
-        Colour index set by ``'``.
-    instances : (T,) uint32
-        Plant number in a scene (0 for a single plant).
-
-    References
-    ----------
-    P. Prusinkiewicz and A. Lindenmayer, *The Algorithmic Beauty of Plants*,
-    Springer, 1990, section 5.1, doi:10.1007/978-1-4613-8476-2.
-
-    J. Bloomenthal, Modeling the mighty maple, *Computer Graphics
-    (SIGGRAPH '85 Proceedings)* 19(3) (1985) 305-311.
-
-    Examples
-    --------
-    One segment as a tube of 3 sides: two rings of 3 + 1 vertices (the last
-    repeats the first for the texture seam) and 2 triangles per side:
-
-    >>> from fractalgeo_rs.lsystem import plant_mesh
-    >>> m = plant_mesh("F", sides=3)
-    >>> m.vertices.shape, m.faces.shape, m.vertices.dtype, m.faces.dtype
-    ((8, 3), (6, 3), dtype('float32'), dtype('uint32'))
-    >>> m.vertices[:, 2].tolist(), m.kinds.tolist()
-    ([0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0], [0, 0, 0, 0, 0, 0])
-    """
-
-    vertices: np.ndarray
-    normals: np.ndarray
-    uvs: np.ndarray
-    faces: np.ndarray
-    part_ids: np.ndarray
-    kinds: np.ndarray
-    colors: np.ndarray
-    instances: np.ndarray
-
-    @classmethod
-    def _from_core(cls, t) -> "Mesh":
-        return cls(*t)
-
-    def write_obj(self, path) -> None:
-        """Write a Wavefront OBJ file (see :func:`fractalgeo_rs.lsystem.write_obj`)."""
-        from fractalgeo_rs.lsystem.export import write_obj
-
-        write_obj(self, path)
-
-    def write_ply(self, path) -> None:
-        """Write a binary PLY file (see :func:`fractalgeo_rs.lsystem.write_ply`)."""
-        from fractalgeo_rs.lsystem.export import write_ply
-
-        write_ply(self, path)
 
 
 def turtle_2d(lstring: Union[LString, str], *, angle: float = 90.0, step: float = 1.0, draw: str = "FG",
