@@ -407,6 +407,37 @@ struct SameRes {
     square_z_inv2: f64,
 }
 
+impl SameRes {
+    /// One cell of `GDALHillshadeAlg_same_res` (Horn gradient, GDAL's
+    /// operation order), as a grey level 1..255 before truncation.
+    #[inline(always)]
+    fn shade(&self, w: &[f32; 9]) -> f32 {
+        let (sin_alt_254, sin_fact, cos_fact, square_z_inv2) = (
+            self.sin_alt_254,
+            self.sin_fact,
+            self.cos_fact,
+            self.square_z_inv2,
+        );
+        let mut acc_x = w[0] - w[8];
+        let six_minus_two = w[6] - w[2];
+        let mut acc_y = acc_x;
+        let three_minus_five = w[3] - w[5];
+        let one_minus_seven = w[1] - w[7];
+        acc_x += three_minus_five;
+        acc_y += one_minus_seven;
+        acc_x += three_minus_five;
+        acc_y += one_minus_seven;
+        acc_x += six_minus_two;
+        acc_y -= six_minus_two;
+        let (x, y) = (acc_x as f64, acc_y as f64);
+        let c = approx_a_div_sqrt_b(
+            sin_alt_254 + (x * sin_fact + y * cos_fact),
+            1.0 + square_z_inv2 * (x * x + y * y),
+        );
+        (if c <= 0.0 { 1.0 } else { 1.0 + c }) as f32
+    }
+}
+
 /// Four cells of `GDALHillshadeAlg_same_res` with SSE2 (part of the x86_64
 /// baseline: no runtime detection needed), the same operations in the same
 /// order as the scalar closure `same` of [`hillshade_gdal_byte`]: float32
@@ -580,25 +611,13 @@ pub fn hillshade_gdal_byte(
         );
         (1.0 + c127) as f32
     };
-    let same = |w: &[f32; 9]| -> f32 {
-        let mut acc_x = w[0] - w[8];
-        let six_minus_two = w[6] - w[2];
-        let mut acc_y = acc_x;
-        let three_minus_five = w[3] - w[5];
-        let one_minus_seven = w[1] - w[7];
-        acc_x += three_minus_five;
-        acc_y += one_minus_seven;
-        acc_x += three_minus_five;
-        acc_y += one_minus_seven;
-        acc_x += six_minus_two;
-        acc_y -= six_minus_two;
-        let (x, y) = (acc_x as f64, acc_y as f64);
-        let c = approx_a_div_sqrt_b(
-            sin_alt_254 + (x * sin_fact + y * cos_fact),
-            1.0 + square_z_inv2 * (x * x + y * y),
-        );
-        (if c <= 0.0 { 1.0 } else { 1.0 + c }) as f32
+    let k = SameRes {
+        sin_alt_254,
+        sin_fact,
+        cos_fact,
+        square_z_inv2,
     };
+    let same = |w: &[f32; 9]| -> f32 { k.shade(w) };
     let general = |w: &[f32; 9]| -> f32 {
         let (x, y) = horn(w);
         let c = approx_a_div_sqrt_b(
@@ -616,12 +635,6 @@ pub fn hillshade_gdal_byte(
     if p.multidirectional {
         gdal_rows(zs, rows, cols, &mut out, multi, None);
     } else if same_res {
-        let k = SameRes {
-            sin_alt_254,
-            sin_fact,
-            cos_fact,
-            square_z_inv2,
-        };
         gdal_rows(
             zs,
             rows,
@@ -770,25 +783,7 @@ mod tests {
                     cos_fact: 254.0 * az.cos() * cos_alt_z * -inv,
                     square_z_inv2: zf8 * zf8 * inv * inv,
                 };
-                let same = |w: &[f32; 9]| -> f32 {
-                    let mut acc_x = w[0] - w[8];
-                    let six_minus_two = w[6] - w[2];
-                    let mut acc_y = acc_x;
-                    let three_minus_five = w[3] - w[5];
-                    let one_minus_seven = w[1] - w[7];
-                    acc_x += three_minus_five;
-                    acc_y += one_minus_seven;
-                    acc_x += three_minus_five;
-                    acc_y += one_minus_seven;
-                    acc_x += six_minus_two;
-                    acc_y -= six_minus_two;
-                    let (x, y) = (acc_x as f64, acc_y as f64);
-                    let c = approx_a_div_sqrt_b(
-                        k.sin_alt_254 + (x * k.sin_fact + y * k.cos_fact),
-                        1.0 + k.square_z_inv2 * (x * x + y * y),
-                    );
-                    (if c <= 0.0 { 1.0 } else { 1.0 + c }) as f32
-                };
+                let same = |w: &[f32; 9]| -> f32 { k.shade(w) };
                 gdal_rows(&zs, rows, cols, &mut slow, same, None);
                 assert_eq!(
                     fast.as_slice().unwrap(),
