@@ -1,6 +1,7 @@
 """Helpers shared by the box-counting estimators."""
 from __future__ import annotations
 
+import math
 import numbers
 from typing import Optional
 
@@ -101,7 +102,8 @@ def default_lattice_counts(box: np.ndarray) -> Optional[dict]:
       counting only the boxes that lie wholly inside it, divided by the
       fraction of the set's samples those boxes hold (the edge correction
       of a crop: ``N(s) = N_inside(s) / f(s)``; exact, ``f = 1``, when
-      ``s`` divides the extent);
+      ``s`` divides the extent; when every inside box is occupied, ``f`` is
+      their share of the bounding box's volume instead);
     * ``"shifted"``: the mean count over the ``b^d`` lattices shifted by
       ``(j_1, ..., j_d) s / b``, ``0 <= j < b`` (the mean cover over lattice
       placements, which smooths the log-periodic oscillation of sets that
@@ -140,7 +142,12 @@ def default_lattice_counts(box: np.ndarray) -> Optional[dict]:
             m = tuple(max(1, n // s) for n in box.shape)  # an axis thinner than s keeps its one box
             inside.append(int(np.count_nonzero(levels[k][tuple(slice(0, v) for v in m)])))
             cover = tuple(slice(0, min(n, v * s)) for n, v in zip(box.shape, m))
-            frac.append(np.count_nonzero(box[cover]) / total)
+            if inside[-1] == math.prod(m):
+                # the set fills the inside boxes at this size: it fills the
+                # rest in proportion to area (no sampling noise)
+                frac.append(math.prod(c.stop for c in cover) / box.size)
+            else:
+                frac.append(np.count_nonzero(box[cover]) / total)
         frac_a = np.asarray(frac, dtype=float)
         meas_a = np.asarray(inside, dtype=float) / frac_a
         # shifted lattices: shifts j * s / b on the level below
