@@ -39,9 +39,11 @@ from fractalgeo_rs._validation import (
 )
 
 from fractalgeo_rs.transform._defaults import default_z_scale
+from fractalgeo_rs.transform._result import FLAGS, TransformFit, flag_map, warn_out_of_range
 from fractalgeo_rs.transform.segment import segment
 
-__all__ = ["default_z_scale", "fractal_transform", "lacunarity_map", "segment", "TRANSFORM_METHODS"]
+__all__ = ["default_z_scale", "fractal_transform", "lacunarity_map", "segment", "TRANSFORM_METHODS", "FLAGS",
+           "TransformFit"]
 
 TRANSFORM_METHODS = {
     # name: (power p, square increments); "mass", "dbc", "blanket" have their own kernels
@@ -276,6 +278,13 @@ def fractal_transform(
     return_fit : bool, default False
         Also return the map of r² of the log-log fit (1 with two lags); for
         ``"whittle"`` and ``"gls"``, the map of the standard error of ``D``.
+        The result is then a :class:`TransformFit` (a tuple of the maps) whose
+        ``flags`` is the flag layer (uint8 bits: 1 ``D < 2``, 2 ``D > 3``,
+        4 pinned at an end of the ``H`` grid, 8 too few valid pixels; 0 =
+        valid; :data:`FLAGS`) and ``params`` the method, window, step and
+        ``z_scale`` used. Without it an in-memory map with values outside
+        ``[2, 3]`` raises one :class:`~fractalgeo_rs.FractalRangeWarning`
+        giving their fractions.
     dilations : int, default 2
         ``"gls"``: largest dilation ``k`` of the increment filters (``8 k``
         filters; the window must exceed ``4 k``).
@@ -291,9 +300,10 @@ def fractal_transform(
     -------
     ndarray of float32 (or the input's dask/xarray type)
         Shape (rows, cols) (with ``step``: the strided grid); NaN where the
-        window has too few valid pixels. With ``return_fit``, a pair
-        (dimension, r²); with ``anisotropy`` (``"gls"``), the angle and
-        ratio maps follow.
+        window has too few valid pixels. With ``return_fit``, a
+        :class:`TransformFit` pair (dimension, r²) carrying ``flags`` and
+        ``params``; with ``anisotropy`` (``"gls"``), the angle and ratio
+        maps follow.
 
     Notes
     -----
@@ -316,9 +326,14 @@ def fractal_transform(
     --------
     >>> import numpy as np, fractalgeo_rs as fg
     >>> i, j = np.indices((40, 40))
-    >>> d = fg.fractal_transform(0.3 * i + 0.2 * j, 9, method="dbc", z_scale=0.1)
-    >>> d.shape, d.dtype
-    ((40, 40), dtype('float32'))
+    >>> d = fg.fractal_transform(0.3 * i + 0.3 * j, 9, method="variogram")
+    >>> d.shape, d.dtype, float(np.nanmax(np.abs(d - 2.0)))  # a plane: D = 2
+    ((40, 40), dtype('float32'), 0.0)
+    >>> out = fg.fractal_transform(np.random.default_rng(0).normal(size=(40, 40)), 9,
+    ...                            method="variogram", return_fit=True)
+    >>> d, r2 = out                      # white noise: D scatters about 3
+    >>> bool(np.all((out.flags == 2) == (d > 3 + 1e-6)))   # bit 2: above 3
+    True
     >>> fg.fractal_transform(np.zeros((40, 40)), 9, method="blanket", step=4).shape
     (10, 10)
     """
@@ -397,17 +412,26 @@ def fractal_transform(
         names += ("anisotropy_angle", "anisotropy_ratio")
     out = run_raster(kernel, image, depth=half, n_out=len(names), step=step,
                      prepare=prepare if array_kind(arr) == "dask" else None, names=names)
-    if method == "gls" and array_kind(arr) != "dask":  # (a lazy map is not read here)
+    lazy = array_kind(arr) == "dask"  # (a lazy map is not read here)
+    if method == "gls" and not lazy:
         from fractalgeo_rs.dimension.gls import warn_pinned_map
 
         warn_pinned_map(np.asarray(out[0]))
+    if not return_fit and not lazy:
+        warn_out_of_range(out[0], method)
+    uses_z = method in ("mass", "dbc", "blanket")
+    params = {"method": method, "window_size": w, "step": step,
+              "z_scale": float(z_scale) if uses_z else None,
+              "z_units": "image units per pixel" if uses_z else None}
     if array_kind(image) == "xarray":  # record what makes maps comparable
         for o in out:
             o.attrs.update({"fractal_method": method, "window_size": w})
-            if method in ("mass", "dbc", "blanket"):
+            if uses_z:
                 o.attrs["z_scale"] = float(z_scale)
     # gls with anisotropy: D[, se], angle, ratio
     out = tuple(out[:2] if return_fit else out[:1]) + tuple(out[2:])
+    if return_fit:
+        return TransformFit(out, flag_map(out[0], method), params)
     return out if len(out) > 1 else out[0]
 
 
