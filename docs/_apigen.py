@@ -35,8 +35,28 @@ def _section(obj) -> str:
     return mod.replace("fractalgeo_rs.", "").split(".")[0].replace("_", " ").capitalize() or "Other"
 
 
+def _subpackages():
+    """The public subpackages and modules of the package that declare ``__all__``."""
+    import importlib
+    import pkgutil
+
+    import fractalgeo_rs as fg
+
+    for info in sorted(pkgutil.iter_modules(fg.__path__), key=lambda m: m.name):
+        if info.name.startswith("_"):
+            continue
+        mod = importlib.import_module(f"fractalgeo_rs.{info.name}")
+        if hasattr(mod, "__all__"):
+            yield info.name, mod
+
+
 def api_entries() -> Dict[str, List[str]]:
-    """Section title -> qualified names (relative to ``fractalgeo_rs``)."""
+    """Section title -> qualified names (relative to ``fractalgeo_rs``).
+
+    The top-level ``__all__`` first, then, per public subpackage, the
+    classes and functions of its ``__all__`` that the top level does not
+    re-export (e.g. ``lsystem.turtle_2d``, ``data.srtm_alps``).
+    """
     import fractalgeo_rs as fg
 
     out: Dict[str, List[str]] = {}
@@ -49,13 +69,16 @@ def api_entries() -> Dict[str, List[str]]:
             modules.append(name)
             continue
         out.setdefault(_section(obj), []).append(name)
-    from fractalgeo_rs import data
-
-    out["Bundled data"] = [
-        f"data.{n}"
-        for n, f in sorted(vars(data).items())
-        if inspect.isfunction(f) and not n.startswith("_") and f.__module__ == data.__name__
-    ]
+    top = set(fg.__all__)
+    for sub, mod in _subpackages():
+        extra = [
+            f"{sub}.{n}"
+            for n in sorted(mod.__all__)
+            if n not in top and (inspect.isclass(getattr(mod, n)) or inspect.isfunction(getattr(mod, n)))
+        ]
+        if extra:
+            title = "Bundled data" if sub == "data" else f"More in fractalgeo_rs.{sub}"
+            out[title] = extra
     out["Modules"] = modules
     return out
 

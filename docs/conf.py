@@ -48,6 +48,9 @@ exclude_patterns = ["_build", "**.ipynb_checkpoints"]
 # -- API reference ------------------------------------------------------------
 autosummary_generate = True
 autosummary_imported_members = True
+# module pages list what the module's __all__ exports, nothing it imports
+autosummary_ignore_module_all = False
+templates_path = ["_templates"]
 autodoc_default_options = {"members": False}
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
@@ -55,6 +58,15 @@ numpydoc_xref_param_type = False
 # a public callable without a docstring fails the build
 numpydoc_validation_checks = {"GL08"}
 numpydoc_validation_exclude = {r"\.__init__$", r"\.__repr__$", r"\.__str__$"}
+
+# Every cross-reference must resolve (with -W a broken one fails the build).
+# The build is offline (no intersphinx), so references to types of other
+# packages cannot resolve; they are listed here and nothing else is.
+nitpicky = True
+nitpick_ignore_regex = [
+    (r"py:.*", r"(numpy|np|xarray|xr|dask|rasterio|affine|pathlib|os|typing|collections|matplotlib)(\..*)?"),
+    (r"py:.*", r"(ndarray|ArrayLike|DataArray|Path|PathLike|Affine|Axes|Figure|Sequence|Mapping|Iterable|Callable)"),
+]
 
 # -- MyST (the Markdown user guide and validation pages) ----------------------
 myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence"]

@@ -2,7 +2,7 @@
 callable's docstring has the sections a reader needs, with examples that run.
 
 The list of names is generated from ``fractalgeo_rs.__all__`` (and the
-functions of ``fractalgeo_rs.data``) by ``docs/_apigen.py``, the module the
+classes and functions in the ``__all__`` of every public subpackage) by ``docs/_apigen.py``, the module the
 Sphinx build uses, so names added to ``__all__`` are checked here without
 editing this file.
 """
@@ -52,10 +52,12 @@ def test_reference_lists_every_public_name(tmp_path):
     apigen.write_api_page(page)
     entries = set(re.findall(r"^   (\S+)$", page.read_text(), re.M))
     expected = {n for n in fg.__all__ if n != "__version__"}
-    expected |= {
-        f"data.{n}" for n, f in vars(fg.data).items()
-        if inspect.isfunction(f) and not n.startswith("_") and f.__module__ == fg.data.__name__
-    }
+    for sub, mod in apigen._subpackages():
+        expected |= {
+            f"{sub}.{n}" for n in mod.__all__
+            if n not in fg.__all__ and (inspect.isclass(getattr(mod, n)) or inspect.isfunction(getattr(mod, n)))
+        }
+    assert "lsystem.turtle_2d" in expected and "data.srtm_alps" in expected
     assert entries == expected
     assert len(entries) == len(NAMES)
 

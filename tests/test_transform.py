@@ -318,7 +318,7 @@ def test_lacunarity_map_equals_per_window_lacunarity():
     with pytest.raises(ValueError, match="image"):
         fg.lacunarity_map(z - 5, 9)
     with pytest.raises(ValueError, match="box_sizes"):
-        fg.lacunarity_map(z, 9, [10])
+        fg.lacunarity_map(z, 9, box_sizes=[10])
 
 
 # ---- DBC and covering-blanket maps ----------------------------------------
@@ -531,13 +531,13 @@ def test_lacunarity_map_on_dask_and_xarray_equals_in_memory():
     rng = np.random.default_rng(3)
     img = rng.gamma(2.0, size=(70, 53))
     img[10:14, 20:30] = np.nan
-    ref = fg.lacunarity_map(img, 9, [1, 2, 4])
+    ref = fg.lacunarity_map(img, 9, box_sizes=[1, 2, 4])
     for chunks in [(70, 53), (20, 17), (5, 40)]:
-        got = fg.lacunarity_map(da.from_array(img, chunks=chunks), 9, [1, 2, 4]).compute()
+        got = fg.lacunarity_map(da.from_array(img, chunks=chunks), 9, box_sizes=[1, 2, 4]).compute()
         np.testing.assert_allclose(got, ref, rtol=1e-5, atol=1e-6, equal_nan=True)
     x = xr.DataArray(img, dims=("y", "x"), coords={"y": np.arange(70) * -10.0, "x": np.arange(53) * 10.0},
                      attrs={"units": "linear"})
-    out = fg.lacunarity_map(x, 9, [1, 2, 4])
+    out = fg.lacunarity_map(x, 9, box_sizes=[1, 2, 4])
     assert out.dims == ("box_size", "y", "x")
     assert list(out.box_size.values) == [1, 2, 4]
     np.testing.assert_array_equal(out.x.values, x.x.values)

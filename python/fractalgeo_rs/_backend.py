@@ -170,7 +170,7 @@ def run_raster(
         dim, values = stack_dim
         coords = {dim: list(values), **{k: v for k, v in grid.coords.items()}}
         return xr.DataArray(stacked, dims=(dim,) + tuple(dims), coords=coords, attrs=new_attrs,
-                            name=(names or [None])[0])
+                            name=names[0] if names else None)
     out = []
     for k in range(n_out):
         a = grid.copy(data=stacked[k]).astype(dtype)

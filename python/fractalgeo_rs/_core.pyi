@@ -53,6 +53,11 @@ __all__ = [
     "write_mesh",
     "write_png",
     "resample_stencil",
+    "RESAMPLE_HALO",
+    "tin_delaunay",
+    "tin_greedy",
+    "tin_grid",
+    "tin_rasterize",
 ]
 
 # ---- dimension ----
@@ -341,7 +346,7 @@ def fractal_resample(
     area: bool,
     seed: int,
     detail: Sequence[bool],
-    origin: Tuple[int, int] = (0, 0),
+    origin: Tuple[int, int] = ...,
     global_cols: int = 0,
     n_threads: Optional[int] = None,
 ) -> npt.NDArray[np.float64]: ...

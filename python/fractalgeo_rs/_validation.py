@@ -115,6 +115,7 @@ def check_n_threads(n_threads) -> Optional[int]:
         return None
     if isinstance(n_threads, bool) or not isinstance(n_threads, numbers.Integral):
         raise TypeError(f"n_threads: expected a positive int or None, got {n_threads!r}")
+    n_threads = int(n_threads)
     if n_threads < 1:
         raise ValueError(f"n_threads: expected a positive int or None, got {n_threads}")
     cap = max_threads()
@@ -191,9 +192,10 @@ def resolve_max_memory(max_memory=None) -> int:
         return default_max_memory()
     if isinstance(max_memory, bool) or not isinstance(max_memory, numbers.Real):
         raise TypeError(f"max_memory: expected a number of bytes or None, got {max_memory!r}")
-    if not (max_memory > 0 and math.isfinite(max_memory)):
+    limit = float(max_memory)
+    if not (limit > 0 and math.isfinite(limit)):
         raise ValueError(f"max_memory: expected a positive number of bytes, got {max_memory}")
-    return int(max_memory)
+    return int(limit)
 
 
 def _gib(n: float) -> str:
@@ -250,6 +252,13 @@ def check_positive_int(value, name: str) -> int:
     if value < 1:
         raise ValueError(f"{name}: expected a positive int, got {value}")
     return int(value)
+
+
+def check_fraction(value, name: str) -> float:
+    """A number in [0, 1] (e.g. ``min_valid``), as a float."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not (0.0 <= float(value) <= 1.0):
+        raise ValueError(f"{name}: expected a fraction in [0, 1], got {value!r}")
+    return float(value)
 
 
 def check_positive_float(value, name: str) -> float:

@@ -15,9 +15,10 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass, field, replace
-from typing import Any, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, Mapping, Optional, Tuple, Union
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from fractalgeo_rs._scales import MIN_SEGMENT, find_break
 
@@ -198,7 +199,7 @@ class DimensionFit:
     dim_factor: float = -1.0
     x_label: str = "scale"
     y_label: str = "measure"
-    extra: Mapping[str, Any] = field(default_factory=dict)
+    extra: Dict[str, Any] = field(default_factory=dict)
     model: Optional[np.ndarray] = None
     valid: bool = True
     flags: Tuple[str, ...] = ()
@@ -212,9 +213,9 @@ class DimensionFit:
         *,
         dimension: float,
         stderr: float,
-        scales: Sequence[float],
-        measures: Sequence[float],
-        model: Sequence[float],
+        scales: "ArrayLike",
+        measures: "ArrayLike",
+        model: "ArrayLike",
         method: str,
         dim_offset: float = 0.0,
         x_label: str = "scale",
@@ -393,8 +394,8 @@ def _auto_range(x: np.ndarray, y: np.ndarray, min_points: int) -> Tuple[int, int
 
 
 def fit_loglog(
-    scales: Sequence[float],
-    measures: Sequence[float],
+    scales: "ArrayLike",
+    measures: "ArrayLike",
     *,
     method: str,
     dim_offset: float = 0.0,

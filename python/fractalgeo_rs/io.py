@@ -29,7 +29,7 @@ empty file never surfaces as a decoder's internal exception.
 from __future__ import annotations
 
 import os
-from typing import Optional, Tuple
+from typing import Any, Dict, Optional, Tuple
 
 import numpy as np
 
@@ -293,7 +293,7 @@ def write_raster(path, data, *, profile: Optional[dict] = None, crs=None, transf
         rio = _rasterio()
         if rio is None:
             raise OSError("path: writing GeoTIFF needs rasterio (pip install 'fractalgeo_rs[geo]')")
-        prof = {"driver": "GTiff"}
+        prof: Dict[str, Any] = {"driver": "GTiff"}
         if profile:
             prof.update({k: v for k, v in profile.items() if k not in ("blockxsize", "blockysize", "tiled")})
         prof.update(driver="GTiff", width=a.shape[1], height=a.shape[0], count=1, dtype=a.dtype.name)

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import math
 import numbers
-from typing import Optional
+from typing import List, Optional
 
 import numpy as np
 
@@ -16,21 +16,21 @@ def check_box_sizes(box_sizes, *, integer: bool = True, name: str = "box_sizes")
         return None
     if isinstance(box_sizes, (str, bytes)) or np.ndim(box_sizes) != 1:
         raise TypeError(f"{name}: expected a 1D sequence of {'ints' if integer else 'numbers'}, got {box_sizes!r}")
-    out = []
+    out: List[float] = []
     for v in box_sizes:
         if isinstance(v, (bool, np.bool_)):
             raise TypeError(f"{name}: expected numbers, got a bool")
         if integer:
             if not isinstance(v, numbers.Integral):
                 if isinstance(v, numbers.Real) and float(v).is_integer():
-                    v = int(v)
+                    v = int(float(v))
                 else:
                     raise TypeError(f"{name}: expected integer box sizes in samples, got {v!r}")
             if v <= 0:
                 raise ValueError(f"{name}: box sizes must be positive, got {v}")
             out.append(int(v))
         else:
-            if not isinstance(v, numbers.Real) or not np.isfinite(v) or v <= 0:
+            if not isinstance(v, numbers.Real) or not np.isfinite(float(v)) or v <= 0:
                 raise ValueError(f"{name}: box sizes must be positive finite numbers, got {v!r}")
             out.append(float(v))
     if len(set(out)) < 3:

@@ -26,6 +26,7 @@ from typing import Optional, Sequence, Tuple
 import numpy as np
 
 from fractalgeo_rs import _core
+from fractalgeo_rs._compat import renamed_parameters
 from fractalgeo_rs._validation import (
     as_array,
     check_choice,
@@ -387,7 +388,7 @@ def _nan_range(z: np.ndarray) -> Tuple[float, float]:
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN slice
         lo = float(np.nanmin(z))
     if math.isnan(lo):
-        raise ValueError("image: no valid value (all NaN or nodata)")
+        raise ValueError("data: no valid value (all NaN or nodata)")
     return lo, float(np.nanmax(z))
 
 
@@ -419,8 +420,9 @@ def _surface_float(data, nodata, name: str = "data", ndims=(2,)) -> np.ndarray:
     return out
 
 
+@renamed_parameters({"image": "data"}, since="0.2.0")
 def differential_box_counting(
-    image,
+    data,
     *,
     box_sizes: Optional[Sequence[int]] = None,
     z_scale: Optional[float] = None,
@@ -444,9 +446,10 @@ def differential_box_counting(
 
     Parameters
     ----------
-    image : array_like, shape (rows, cols)
+    data : array_like, shape (rows, cols)
         Grayscale image or DEM, any real dtype (float32 and float64 are read
-        without a copy). NaN is nodata and is skipped.
+        without a copy). NaN is nodata and is skipped. (Called ``image``
+        before 0.2.0; the old keyword still works, with a DeprecationWarning.)
     box_sizes : sequence of int, optional
         Block sides in pixels. Default ``2, 4, 8, ...`` up to a quarter of the
         shorter side (``s = 1`` carries no height information in DBC).
@@ -502,7 +505,7 @@ def differential_box_counting(
     >>> round(fg.differential_box_counting(dem).dimension, 3)
     2.094
     """
-    z = _surface_float(image, nodata, "image")
+    z = _surface_float(data, nodata, "data")
     sizes = check_box_sizes(box_sizes)
     offsets = check_positive_int(offsets, "offsets")
     check_choice(offset_reduce, "offset_reduce", ("mean", "min"))
@@ -523,7 +526,7 @@ def differential_box_counting(
         sizes = dyadic_up_to(min(rows, cols) / 4, start=2)
         if len(sizes) < 3:
             raise ValueError(
-                f"image: shape {z.shape} is too small for the default box sizes 2, 4, 8 (needs at least 32 pixels a side); give box_sizes"
+                f"data: shape {z.shape} is too small for the default box sizes 2, 4, 8 (needs at least 32 pixels a side); give box_sizes"
             )
     check_choice(edge_blocks, "edge_blocks", ("count", "drop"))
     if edge_blocks == "drop" and offsets != 1:

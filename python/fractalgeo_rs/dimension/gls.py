@@ -47,7 +47,7 @@ dimension for two-dimensional surface data. *Statistica Sinica* 10, 343-376.
 from __future__ import annotations
 
 from functools import lru_cache
-from typing import Optional, Sequence, Tuple
+from typing import Any, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -212,7 +212,7 @@ def quadratic_variations(z: np.ndarray, dilations: int):
         if min(ext) <= 0:
             V[k], n[k] = np.nan, 0
             continue
-        d = 0.0
+        d: Any = 0.0
         for o, wt in zip(offs, w):
             d = d + wt * z[tuple(slice(int(oo), int(oo) + e) for oo, e in zip(o, ext))]
         ok = ~np.isnan(d)

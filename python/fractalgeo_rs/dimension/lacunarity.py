@@ -22,6 +22,7 @@ from typing import Optional, Sequence
 
 import numpy as np
 
+from fractalgeo_rs._compat import keyword_only_since
 from fractalgeo_rs._validation import as_array, check_positive_int
 
 __all__ = ["Lacunarity", "lacunarity"]
@@ -74,7 +75,8 @@ class Lacunarity:
         return ax
 
 
-def lacunarity(data, box_sizes: Optional[Sequence[int]] = None) -> Lacunarity:
+@keyword_only_since(["box_sizes"], since="0.2.0")
+def lacunarity(data, *, box_sizes: Optional[Sequence[int]] = None) -> Lacunarity:
     """Gliding-box lacunarity of a binary or grayscale 2D array.
 
     Parameters

@@ -12,11 +12,13 @@ motion. *IEEE Trans. Information Theory* 38(2), 910-917.
 """
 from __future__ import annotations
 
+import numbers
 from typing import Optional, Sequence
 
 import numpy as np
 
 from fractalgeo_rs import _core
+from fractalgeo_rs._compat import renamed_parameters
 from fractalgeo_rs._validation import check_n_threads, check_positive_int
 from fractalgeo_rs.dimension.variation import _real_array, _with_nodata
 from fractalgeo_rs.fit import DimensionFit, ScaleRange, fit_loglog
@@ -138,7 +140,8 @@ def _gaussian_bank(z: np.ndarray, sigmas: np.ndarray):
         yield sfft.irfft(spec * sfft.rfft(kern), size)[big:big + n]
 
 
-def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, sample_spacing: float = 0.0,
+@renamed_parameters({"sample_spacing": "cell_size"}, since="0.2.0")
+def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, cell_size: float = 0.0,
                 nodata: Optional[float] = None, scale_range: ScaleRange = None) -> DimensionFit:
     """Gaussian scale-space dimension of a profile (the paper's eq. 14).
 
@@ -154,12 +157,14 @@ def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, sample_spacin
         Gaussian widths in samples; default ``1, 1.5, 2, 3, ...`` (ratio
         sqrt 2) up to ``n / 16`` or 256, whichever is smaller (the filter's
         cost grows with sigma).
-    sample_spacing : float, default 0
+    cell_size : float, default 0
         Distance between samples in the units of the values (e.g. metres for
         a height profile in metres). The length of a self-affine graph mixes
         both axes and its scaling depends on their ratio; with the default 0
         the length is the total variation ``sum |dg|``, the steep-graph limit
         in which ``L ~ sigma^(H - 1) = sigma^(1 - D)`` holds at every scale.
+        (Called ``sample_spacing`` before 0.2.0; the old name still works,
+        with a DeprecationWarning.)
 
     Returns
     -------
@@ -185,9 +190,9 @@ def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, sample_spacin
     """
     z = _with_nodata(_real_array(data, (1,)), data, nodata)
     _gap_free(z, "scale space")
-    if isinstance(sample_spacing, bool) or not np.isscalar(sample_spacing) or not sample_spacing >= 0:
-        raise ValueError(f"sample_spacing: expected a number >= 0, got {sample_spacing!r}")
-    dx = float(sample_spacing)
+    if isinstance(cell_size, bool) or not isinstance(cell_size, numbers.Real) or not cell_size >= 0:
+        raise ValueError(f"cell_size: expected a number >= 0, got {cell_size!r}")
+    dx = float(cell_size)
     if sigmas is None:
         sigmas = [2 ** (k / 2) for k in range(0, 40) if 2 ** (k / 2) <= min(z.size / 16, 256)]
     sig = np.asarray(sorted(set(float(s) for s in sigmas)))
@@ -196,7 +201,7 @@ def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, sample_spacin
     lengths = np.array([np.sum(np.hypot(dx, np.diff(g))) for g in _gaussian_bank(z, sig)])
     return fit_loglog(sig, lengths, method="scale_space", domain=(1.0, 2.0), dim_offset=1.0, dim_factor=-1.0,
                       scale_range=scale_range, x_label="sigma (samples)", y_label="length L(sigma)",
-                      extra={"sample_spacing": dx})
+                      extra={"cell_size": dx})
 
 
 def _haar_details(z: np.ndarray):
@@ -265,7 +270,7 @@ def wavelet_dimension(data, *, levels: Optional[Sequence[int]] = None, nodata: O
     min_n = 8 if z.ndim == 1 else 48
     js = np.arange(1, len(det) + 1)
     if levels is None:
-        sel = [j for j in js if det[j - 1].size >= min_n]
+        sel = [int(j) for j in js if det[j - 1].size >= min_n]
     else:
         sel = sorted(set(int(j) for j in levels))
         if not sel or sel[0] < 1 or sel[-1] > len(det):

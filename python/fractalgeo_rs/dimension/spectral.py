@@ -24,6 +24,7 @@ from typing import Optional
 
 import numpy as np
 
+from fractalgeo_rs._compat import renamed_parameters
 from fractalgeo_rs._validation import check_choice, check_positive_int
 from fractalgeo_rs.dimension.variation import _real_array, _with_nodata
 from fractalgeo_rs.fit import DimensionFit, ScaleRange, fit_loglog
@@ -55,10 +56,11 @@ def _window(shape, kind: str) -> np.ndarray:
     return w[0] if len(shape) == 1 else np.outer(w[0], w[1])
 
 
+@renamed_parameters({"window": "taper"}, since="0.2.0")
 def spectral_dimension(
     data,
     *,
-    window: str = "hann",
+    taper: str = "hann",
     detrend: bool = True,
     n_bins: int = 24,
     nodata: Optional[float] = None,
@@ -71,8 +73,10 @@ def spectral_dimension(
     data : array_like, shape (n,) or (rows, cols)
         Profile or surface on a regular grid, without gaps (NaN or ``nodata``
         raise ValueError: fill or crop first, the FFT needs every sample).
-    window : {"hann", "none"}, default "hann"
-        Taper against leakage (a separable Hann window in 2D).
+    taper : {"hann", "none"}, default "hann"
+        Taper against leakage (a separable Hann window in 2D); the same name
+        as in :func:`~fractalgeo_rs.whittle`. (Called ``window`` before
+        0.2.0; the old name still works, with a DeprecationWarning.)
     detrend : bool, default True
         Remove the least-squares line or plane first.
     n_bins : int, default 24
@@ -117,7 +121,7 @@ def spectral_dimension(
     z = _with_nodata(_real_array(data, (1, 2)), data, nodata)
     if np.isnan(z).any():
         raise ValueError("data: NaN or nodata present; the spectrum needs gap-free data (fill or crop first)")
-    check_choice(window, "window", ("hann", "none"))
+    check_choice(taper, "taper", ("hann", "none"))
     n_bins = check_positive_int(n_bins, "n_bins")
     if min(z.shape) < 8:
         raise ValueError(f"data: shape {z.shape} is too small for a spectrum (at least 8 samples per axis)")
@@ -131,7 +135,7 @@ def spectral_dimension(
     if not np.ptp(z) > 1e-10 * max(magnitude, 1e-300):
         raise ValueError("data: no variation left" + (" after removing the least-squares line/plane"
                          if detrend else "") + " (constant or planar data has no fractal dimension)")
-    z = z * _window(z.shape, window)
+    z = z * _window(z.shape, taper)
     if z.ndim == 1:
         power = np.abs(fft.rfft(z)) ** 2
         freq = fft.rfftfreq(z.size)
@@ -159,7 +163,7 @@ def spectral_dimension(
     fit = fit_loglog(f_mean, p_mean, method="spectral", dim_offset=offset, dim_factor=factor,
                      scale_range=scale_range, x_label="frequency (cycles per sample)",
                      domain=(float(z.ndim), z.ndim + 1.0), open_domain=True,
-                     y_label="power", extra={"window": window, "detrend": detrend})
+                     y_label="power", extra={"taper": taper, "detrend": detrend})
     fit.extra["beta"] = -fit.slope
     fit.extra["hurst"] = hurst_of_beta(-fit.slope)
     return fit

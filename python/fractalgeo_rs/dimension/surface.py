@@ -16,7 +16,7 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from fractalgeo_rs._validation import as_array, check_choice, check_positive_float, check_positive_int
+from fractalgeo_rs._validation import as_array, check_choice, check_n_threads, check_positive_float, check_positive_int
 from fractalgeo_rs.dimension.boxcount import _binary_bytes
 from fractalgeo_rs.dimension.variation import _real_array, _with_nodata
 from fractalgeo_rs.fit import DimensionFit, ScaleRange, fit_loglog
@@ -128,6 +128,7 @@ def mass_dimension(
     kind: str = "auto",
     z_scale: Optional[float] = None,
     scale_range: ScaleRange = None,
+    n_threads: Optional[int] = None,
 ) -> DimensionFit:
     """Voss's (1986) P(m, L) dimension (the paper's eq. 13).
 
@@ -152,6 +153,11 @@ def mass_dimension(
     z_scale : float, optional
         Grayscale only: intensity units per pixel; default ``(max - min) /
         max(rows, cols)`` as in DBC. NaN pixels are not points.
+    scale_range : None, "auto" or (float, float)
+        Range of box sides fitted (see :func:`~fractalgeo_rs.box_counting`).
+    n_threads : int, optional
+        Threads of the grayscale kernel (default all cores); results are
+        identical for any value.
 
     Returns
     -------
@@ -222,7 +228,8 @@ def mass_dimension(
         # Rust kernel (shared with the fractal transform): box masses per pixel
         from fractalgeo_rs import _core
 
-        N = _core.mass_curve_image(np.ascontiguousarray(z - zmin), sizes, z_scale, None).tolist()
+        assert z_scale is not None  # set above for grayscale data
+        N = _core.mass_curve_image(np.ascontiguousarray(z - zmin), sizes, z_scale, check_n_threads(n_threads)).tolist()
     else:
         from scipy.spatial import cKDTree
 

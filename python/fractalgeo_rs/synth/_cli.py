@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+from typing import Any
 
 import numpy as np
 
@@ -104,7 +105,7 @@ def _run_hillshade(args: argparse.Namespace) -> int:
     from fractalgeo_rs.io import read_raster, write_raster
 
     z, prof = read_raster(args.dem, band=args.band)
-    cell = 1.0
+    cell: Any = 1.0
     latitude = None
     nodata = None
     if prof:

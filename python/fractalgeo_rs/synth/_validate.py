@@ -6,6 +6,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from fractalgeo_rs._compat import renamed_parameters
 from fractalgeo_rs._validation import as_array
 
 __all__ = ["SurfaceReport", "validate_surface", "variogram", "crease_ratio", "spectral_slope",
@@ -211,14 +212,16 @@ def coastline_dimension(z, level=None, sizes=None):
     return float(-np.polyfit(np.log(sizes), np.log(counts), 1)[0])
 
 
-def validate_surface(z, hurst=None, *, lags=None, periodic=None, coastline=True):
-    r"""Report the fractal statistics of a surface ``z``.
+@renamed_parameters({"z": "data"}, since="0.2.0")
+def validate_surface(data, hurst=None, *, lags=None, periodic=None, coastline=True):
+    r"""Report the fractal statistics of a surface ``data``.
 
     Parameters
     ----------
-    z : array_like, shape (rows, cols)
+    data : array_like, shape (rows, cols)
         Heights; NaN is ignored in the variogram statistics (the spectrum and
-        the coastline need a NaN-free array).
+        the coastline need a NaN-free array). (Called ``z`` before 0.2.0; the
+        old keyword still works, with a DeprecationWarning.)
     hurst : float or None
         The Hurst exponent the surface was made with, kept in the report.
     lags : sequence of int or None
@@ -258,9 +261,9 @@ def validate_surface(z, hurst=None, *, lags=None, periodic=None, coastline=True)
     >>> round(r.hurst_variogram, 2)  # lags 8-64 of one 256 x 256 field: spread about 0.05
     0.47
     """
-    z = as_array(z, "z")
+    z = as_array(data, "data")
     if z.ndim != 2 or min(z.shape) < 32:
-        raise ValueError(f"z: expected a 2D array of at least 32 x 32, got shape {z.shape}")
+        raise ValueError(f"data: expected a 2D array of at least 32 x 32, got shape {z.shape}")
     z = z.astype(np.float64, copy=False)
     if lags is None:
         lags = tuple(v for v in (8, 16, 32, 64) if v <= min(z.shape) // 4) or (1, 2, 4)

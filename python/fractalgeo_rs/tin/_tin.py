@@ -38,7 +38,8 @@ def _affine(transform, cell_size, rows: int) -> Tuple[float, float, float, float
         h = 1.0 if cell_size is None else check_positive_float(cell_size, "cell_size")
         return (h, 0.0, 0.0, 0.0, -h, rows * h)
     if all(hasattr(transform, k) for k in "abcdef"):
-        t = tuple(float(getattr(transform, k)) for k in "abcdef")
+        a, b, c, d, e, f = (float(getattr(transform, k)) for k in "abcdef")
+        t = (a, b, c, d, e, f)
     else:
         try:
             g = [float(v) for v in transform]
@@ -46,7 +47,7 @@ def _affine(transform, cell_size, rows: int) -> Tuple[float, float, float, float
             raise TypeError("transform: expected an Affine or a GDAL 6-tuple") from None
         if len(g) != 6:
             raise ValueError(f"transform: expected 6 numbers (GDAL order), got {len(g)}")
-        t = (g[1], g[2], g[0], g[4], g[5], g[3])
+        t = (float(g[1]), float(g[2]), float(g[0]), float(g[4]), float(g[5]), float(g[3]))
     if not all(np.isfinite(t)) or t[0] * t[4] - t[1] * t[3] == 0:
         raise ValueError(f"transform: must be finite and invertible, got {t}")
     return t

@@ -23,15 +23,17 @@ Voss, R. F. (1986). Characterization and measurement of random fractals.
 """
 from __future__ import annotations
 
-from typing import Optional, Sequence, Union
+from typing import Any, Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from fractalgeo_rs import _core
 from fractalgeo_rs._backend import array_kind, run_raster
+from fractalgeo_rs._compat import keyword_only_since
 from fractalgeo_rs._validation import (
     as_array,
     check_choice,
+    check_fraction,
     check_n_threads,
     check_nodata,
     check_positive_float,
@@ -45,7 +47,7 @@ from fractalgeo_rs.transform.segment import segment
 __all__ = ["default_z_scale", "fractal_transform", "lacunarity_map", "segment", "TRANSFORM_METHODS", "FLAGS",
            "TransformFit"]
 
-TRANSFORM_METHODS = {
+TRANSFORM_METHODS: Dict[str, Tuple[Optional[float], Optional[bool]]] = {
     # name: (power p, square increments); "mass", "dbc", "blanket" have their own kernels
     "mass": (None, None),
     "dbc": (None, None),
@@ -124,6 +126,7 @@ def _grid(z: np.ndarray, w: int, method: str, opts: dict, min_valid: float, step
     if method == "mass":
         return _core.mass_transform_map(z, w, opts["sizes"], opts["z_scale"], min_valid, step, n_threads)
     p, square = TRANSFORM_METHODS[method]
+    assert p is not None and square is not None  # the increment methods
     return _core.variation_transform_map(z, w, opts["lags"], p, square, min_valid, step, n_threads)
 
 
@@ -268,7 +271,9 @@ def fractal_transform(
         Output NaN where fewer than this fraction of the window's pixels are
         valid.
     band : int, optional
-        0-based band index for a 3D (bands, rows, cols) input.
+        1-based band number for a 3D (bands, rows, cols) input, as in
+        rasterio, GDAL and :func:`~fractalgeo_rs.read_raster` (0-based
+        before 0.2.0: ``band=0`` now raises ValueError saying so).
     n_threads : int, optional
         Threads (default all cores); results are identical for any value.
         For ``"whittle"`` these are the FFT workers; its matrix products run
@@ -347,9 +352,7 @@ def fractal_transform(
         z_scale = check_positive_float(z_scale, "z_scale")
     n_threads = check_n_threads(n_threads)
     step = check_positive_int(step, "step")
-    if isinstance(min_valid, bool) or not np.isscalar(min_valid) or not (0.0 <= float(min_valid) <= 1.0):
-        raise ValueError(f"min_valid: expected a fraction in [0, 1], got {min_valid!r}")
-    min_valid = float(min_valid)
+    min_valid = check_fraction(min_valid, "min_valid")
     try:
         lags = sorted(set(int(v) for v in lags))
     except (TypeError, ValueError):
@@ -357,9 +360,10 @@ def fractal_transform(
 
     arr, image = _select_band(image, band)
     w = _check_window(window_size, arr.shape)
-    if auto_z:
-        z_scale = default_z_scale(arr, nodata) if method in ("mass", "dbc", "blanket") else None
-    opts = {"lags": lags, "z_scale": z_scale, "dilations": dilations, "anisotropy": bool(anisotropy)}
+    z_used: Optional[float] = None  # the height unit of the box and mass methods
+    if method in ("mass", "dbc", "blanket"):
+        z_used = default_z_scale(arr, nodata) if auto_z else float(z_scale)
+    opts: Dict[str, Any] = {"lags": lags, "z_scale": z_used, "dilations": dilations, "anisotropy": bool(anisotropy)}
     half = w // 2
     if method == "mass":
         if box_sizes is None:
@@ -407,7 +411,7 @@ def fractal_transform(
         return np.stack(_grid(z, w, method, opts, min_valid, step, n_threads))
 
     image = _prepared(image, arr, prepare)
-    names = ("fractal_dimension", "r_squared" if method not in ("whittle", "gls") else "standard_error")
+    names: Tuple[str, ...] = ("fractal_dimension", "r_squared" if method not in ("whittle", "gls") else "standard_error")
     if method == "gls" and opts["anisotropy"]:
         names += ("anisotropy_angle", "anisotropy_ratio")
     out = run_raster(kernel, image, depth=half, n_out=len(names), step=step,
@@ -419,15 +423,13 @@ def fractal_transform(
         warn_pinned_map(np.asarray(out[0]))
     if not return_fit and not lazy:
         warn_out_of_range(out[0], method)
-    uses_z = method in ("mass", "dbc", "blanket")
-    params = {"method": method, "window_size": w, "step": step,
-              "z_scale": float(z_scale) if uses_z else None,
-              "z_units": "image units per pixel" if uses_z else None}
+    params = {"method": method, "window_size": w, "step": step, "z_scale": z_used,
+              "z_units": None if z_used is None else "image units per pixel"}
     if array_kind(image) == "xarray":  # record what makes maps comparable
         for o in out:
             o.attrs.update({"fractal_method": method, "window_size": w})
-            if uses_z:
-                o.attrs["z_scale"] = float(z_scale)
+            if z_used is not None:
+                o.attrs["z_scale"] = z_used
     # gls with anisotropy: D[, se], angle, ratio
     out = tuple(out[:2] if return_fit else out[:1]) + tuple(out[2:])
     if return_fit:
@@ -438,17 +440,22 @@ def fractal_transform(
 def _select_band(image, band):
     """``(array, image)``: the 2D array to check (numpy or dask) and the
     object to compute on (the same, or the xarray DataArray), with ``band``
-    (0-based) taken from a 3D input."""
+    (1-based, as in rasterio and GDAL) taken from a 3D input."""
     kind = array_kind(image)
     data = image.data if kind == "xarray" else image
     arr = data if array_kind(data) == "dask" else as_array(data, "image")
     if arr.ndim == 3:
         if band is None:
-            raise ValueError(f"band: a 3D input of shape {arr.shape} needs band= (0-based band index)")
-        if isinstance(band, bool) or not isinstance(band, (int, np.integer)) or not (0 <= band < arr.shape[0]):
-            raise ValueError(f"band: expected an index in [0, {arr.shape[0]}), got {band!r}")
-        arr = arr[int(band)]
-        image = image[int(band)] if kind == "xarray" else arr
+            raise ValueError(f"band: a 3D input of shape {arr.shape} needs band= (1-based band number)")
+        if isinstance(band, bool) or not isinstance(band, (int, np.integer)):
+            raise TypeError(f"band: expected a 1-based band number, got {band!r}")
+        if band == 0:
+            raise ValueError("band: band numbers are 1-based, as in rasterio and GDAL (0-based before 0.2.0): "
+                             "band=1 is the first band")
+        if not (1 <= band <= arr.shape[0]):
+            raise ValueError(f"band: expected a band number in [1, {arr.shape[0]}], got {band!r}")
+        arr = arr[int(band) - 1]
+        image = image[int(band) - 1] if kind == "xarray" else arr
     elif kind != "xarray":
         image = arr
     if arr.ndim != 2:
@@ -474,11 +481,12 @@ def _prepared(image, arr, prepare):
     return image.copy(data=z) if array_kind(image) == "xarray" else z
 
 
+@keyword_only_since(["box_sizes"], since="0.2.0")
 def lacunarity_map(
     image,
     window_size: int,
-    box_sizes: Optional[Sequence[int]] = None,
     *,
+    box_sizes: Optional[Sequence[int]] = None,
     nodata: Optional[float] = None,
     min_valid: float = 0.5,
     n_threads: Optional[int] = None,
@@ -540,9 +548,7 @@ def lacunarity_map(
             raise TypeError(f"box_sizes: expected a sequence of ints, got {box_sizes!r}") from None
         if not sizes or any(r < 1 or r > w for r in sizes):
             raise ValueError(f"box_sizes: box sides must be in [1, {w}], got {sizes}")
-    if isinstance(min_valid, bool) or not np.isscalar(min_valid) or not (0.0 <= float(min_valid) <= 1.0):
-        raise ValueError(f"min_valid: expected a fraction in [0, 1], got {min_valid!r}")
-    min_valid = float(min_valid)
+    min_valid = check_fraction(min_valid, "min_valid")
     n_threads = check_n_threads(n_threads)
 
     def prepare(block):

@@ -136,9 +136,9 @@ def _argmin_cubic(c: np.ndarray):
         for root in ((-B + sq) / (2.0 * A), (-B - sq) / (2.0 * A), -C / B):
             ok = np.isfinite(root) & (root >= t_lo) & (root <= t_hi)
             cand.append(np.where(ok, root, t0))
-    t = cand = np.stack(cand, axis=1)
+    t = np.stack(cand, axis=1)
     vals = y[:, :1] + a1[:, None] * t + a2[:, None] * t * (t - 1) + a3[:, None] * t * (t - 1) * (t - 2)
-    best = np.take_along_axis(cand, np.argmin(vals, axis=1)[:, None], axis=1)[:, 0]
+    best = np.take_along_axis(t, np.argmin(vals, axis=1)[:, None], axis=1)[:, 0]
     h = _H_GRID[s] + best * dh
     curv = (2.0 * A * best + B) / dh**2
     return h, curv
