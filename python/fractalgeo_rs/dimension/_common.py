@@ -80,7 +80,7 @@ def _pool(a: np.ndarray, b: int, front=None) -> np.ndarray:
     split = []
     for n in shape:
         split += [n // b, b]
-    return p.reshape(split).any(axis=tuple(range(1, 2 * a.ndim, 2)))
+    return np.asarray(p.reshape(split).any(axis=tuple(range(1, 2 * a.ndim, 2))))
 
 
 def _line_rms(sizes, counts) -> float:

@@ -64,6 +64,12 @@ def default_z_scale(image, nodata: Optional[float] = None) -> float:
         the increments (the same scale for Gaussian increments); 1.0 for a
         constant image.
 
+    References
+    ----------
+    Rousseeuw, P. J., Croux, C. (1993). Alternatives to the median absolute
+    deviation. *Journal of the American Statistical Association* 88(424),
+    1273-1283. doi:10.1080/01621459.1993.10476408 (1.4826 = 1 / Phi^-1(3/4)).
+
     Examples
     --------
     >>> import numpy as np

@@ -43,15 +43,9 @@ _PIN_TOLERANCE = 1e-4
 
 def _pinned_values(method: str) -> Tuple[float, ...]:
     """Values of ``D`` at the ends of the method's ``H`` search grid."""
-    if method == "gls":
-        from fractalgeo_rs.dimension.gls import H_GRID
+    from fractalgeo_rs.transform._methods import METHODS
 
-        return (3.0 - float(H_GRID[0]), 3.0 - float(H_GRID[-1]))
-    if method == "whittle":
-        from fractalgeo_rs.transform._whittle import _H_GRID
-
-        return (3.0 - float(_H_GRID[0]), 3.0 - float(_H_GRID[-1]))
-    return ()
+    return METHODS[method].pinned()
 
 
 def _flags_block(d: np.ndarray, pins: Tuple[float, ...]) -> np.ndarray:
@@ -121,6 +115,24 @@ class TransformFit(tuple):
     params : dict
         ``method``, ``window_size``, ``step``, ``z_scale`` (the value used,
         ``None`` for the scale-free methods) and ``z_units``.
+
+    References
+    ----------
+    CF Conventions 1.11, section 3.5 (flags: ``flag_masks`` and
+    ``flag_meanings``), https://cfconventions.org.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> i, j = np.indices((32, 32))
+    >>> out = fg.fractal_transform((i * j).astype(float), 9, method="square", return_fit=True)
+    >>> d, se = out                      # unpacks like a pair
+    >>> float(np.nanmax(d))              # z = i j: square increments u^2, D = 3 - 2 = 1
+    1.0
+    >>> sorted(np.unique(out.flags).tolist())   # 1: below 2, 8: too few valid pixels
+    [1, 8]
+    >>> out.params["method"], out.params["window_size"], out.params["z_scale"]
+    ('square', 9, None)
     """
 
     flags: Any
