@@ -18,7 +18,9 @@ def add_parsers(sub) -> None:
     p.add_argument("input", help="input raster")
     p.add_argument("output", help="output map (.tif or .npy)")
     p.add_argument("--window", type=int, default=33, help="odd window side in pixels (default 33)")
-    p.add_argument("--method", default="mass", choices=["mass", "variogram", "madogram", "square", "dbc", "blanket", "whittle"],
+    from fractalgeo_rs.transform._methods import METHODS
+
+    p.add_argument("--method", default="mass", choices=list(METHODS),
                    help="estimator (default mass: Voss's P(m, L), the paper's method)")
     p.add_argument("--z-scale", type=_z_scale, default="auto",
                    help="mass, dbc, blanket: height units per pixel (e.g. 1 dB or 1 grey level); default auto: "
