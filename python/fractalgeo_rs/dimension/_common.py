@@ -84,10 +84,11 @@ def _pool(a: np.ndarray, b: int, front=None) -> np.ndarray:
 
 
 def _line_rms(sizes, counts) -> float:
-    """Root mean square residual of the OLS line through ``(log s, log N)``."""
+    """Residual standard deviation (``n - 2`` degrees of freedom) of the OLS
+    line through ``(log s, log N)``."""
     x, y = np.log(np.asarray(sizes, float)), np.log(np.asarray(counts, float))
     coef = np.polyfit(x, y, 1)
-    return float(np.sqrt(np.mean((y - np.polyval(coef, x)) ** 2)))
+    return float(np.sqrt(np.sum((y - np.polyval(coef, x)) ** 2) / max(len(x) - 2, 1)))
 
 
 def default_lattice_counts(box: np.ndarray) -> Optional[dict]:
