@@ -30,12 +30,18 @@ from fractalgeo_rs._compat import renamed_parameters
 from fractalgeo_rs._validation import (
     as_array,
     check_choice,
+    check_memory,
     check_n_threads,
     check_nodata,
     check_positive_float,
     check_positive_int,
 )
-from fractalgeo_rs.dimension._common import check_box_sizes, dyadic_up_to, reduce_offsets
+from fractalgeo_rs.dimension._common import (
+    check_box_sizes,
+    default_lattice_counts,
+    dyadic_up_to,
+    reduce_offsets,
+)
 from fractalgeo_rs.fit import DimensionFit, ScaleRange, fit_loglog
 
 __all__ = [
@@ -111,6 +117,19 @@ def _default_box_sizes(b: np.ndarray, bbox: bool) -> Optional[list]:
     return sizes if len(sizes) >= 3 else None
 
 
+def _bounds(b: np.ndarray):
+    """``(lo, hi)`` of the foreground's bounding box (``hi`` exclusive), or
+    ``None`` for an empty set."""
+    lo, hi = [], []
+    for ax in range(b.ndim):
+        occ = np.flatnonzero(b.any(axis=tuple(a for a in range(b.ndim) if a != ax)))
+        if occ.size == 0:
+            return None
+        lo.append(int(occ[0]))
+        hi.append(int(occ[-1]) + 1)
+    return tuple(lo), tuple(hi)
+
+
 def _binary_bytes(data) -> Tuple[np.ndarray, bool]:
     """A C-contiguous uint8 view (0/1) of a binary set, and whether the axes
     were reversed (a Fortran-ordered input is counted through its transpose,
@@ -170,11 +189,14 @@ def box_counting(
     box_sizes : sequence of int, optional
         Box sides in samples; any positive integers (not only powers of two),
         at least three distinct, none larger than the longest axis. Default:
-        the divisors of the set's extent when they form an even chain (all
-        ratios equal, or all at most 2) or when the extent is not within 5 %
-        of a power of 2 or 3, else powers of that base up to a quarter of the
-        extent; ``docs/boxcounting.md`` has the error table on cropped,
-        offset and padded exact fractals.
+        ``1, b, b^2, ...`` up to a quarter of the set's extent for ``b`` = 2
+        and 3, each counted on the bounding-box lattice with an edge
+        correction for partial boxes and as the mean over ``b^d`` shifted
+        lattices; the straightest of the four log-log relations is fitted,
+        from the first size above the set's sampling scale (see
+        ``docs/boxcounting.md``: within 0.013 of the dimension on cropped,
+        offset and padded exact fractals). ``extra`` records ``base``,
+        ``lattice`` and ``fraction``.
     offsets : int, default 1
         Number of lattice shifts per axis (``offsets**ndim`` lattices). The
         shifts ``j * s_max / offsets`` are global (the same for every box
@@ -235,6 +257,30 @@ def box_counting(
     check_choice(offset_reduce, "offset_reduce", ("mean", "min"))
     check_choice(anchor, "anchor", ("bbox", "array"))
     n_threads = check_n_threads(n_threads)
+    if sizes is None:
+        bounds = _bounds(b)
+        if bounds is not None:
+            lo, hi = bounds
+            check_memory(3 * b.size, "data", what=f"the default box counts of an array of shape {b.shape}")
+            box = b[tuple(slice(a, z) for a, z in zip(lo, hi))].view(bool)
+            res = default_lattice_counts(box)
+            if res is not None and anchor == "bbox" and offsets == 1:
+                if transposed:
+                    lo, hi = lo[::-1], hi[::-1]
+                if scale_range is None and res["start"] > 0:  # smallest sizes below the sampling
+                    scale_range = (res["sizes"][res["start"]], res["sizes"][-1])
+                fit = fit_loglog(
+                    res["sizes"], res["measures"], method="box", scale_range=scale_range,
+                    x_label="box size s (samples)", y_label="occupied boxes N(s)",
+                    extra={"counts": res["counts"], "offset_reduce": offset_reduce,
+                           "n_foreground": int(np.count_nonzero(box)), "bbox": (tuple(lo), tuple(hi)),
+                           "offsets": offsets, "anchor": anchor, "base": res["base"],
+                           "lattice": res["lattice"], "fraction": res["fraction"]},
+                    domain=(0.0, float(b.ndim)),
+                )
+                return fit
+            if res is not None:  # the user's lattice options on the default sizes
+                sizes = res["sizes"]
     s, counts, n_fg, lo, hi = _core.box_count_binary(b, sizes or [], offsets, anchor == "bbox", n_threads)
     if sizes is None and _uneven(s):
         # the kernel's default (divisors of the extent, else powers of 2)

@@ -12,14 +12,16 @@ def add_parsers(sub) -> None:
         help="map of local fractal dimension (moving window) as a float32 GeoTIFF",
         description="Moving-window fractal transform of a raster (paper section 4.2). Reads GeoTIFF "
                     "(rasterio) or any format read_raster knows; writes a float32 GeoTIFF with the input's "
-                    "CRS and transform (or .npy). With --chunks the scene is processed by Dask in blocks "
-                    "for scenes larger than memory. A progress bar is drawn when stderr is a terminal "
-                    "(--progress / --no-progress).",
+                    "CRS and transform and tags recording method, window, step and the z_scale used (or .npy). "
+                    "With --chunks the scene is processed by Dask in blocks for scenes larger than memory. A "
+                    "progress bar is drawn when stderr is a terminal (--progress / --no-progress).",
     )
     p.add_argument("input", help="input raster")
     p.add_argument("output", help="output map (.tif or .npy)")
     p.add_argument("--window", type=int, default=33, help="odd window side in pixels (default 33)")
-    p.add_argument("--method", default="mass", choices=["mass", "variogram", "madogram", "square", "dbc", "blanket", "whittle"],
+    from fractalgeo_rs.transform._methods import METHODS
+
+    p.add_argument("--method", default="mass", choices=list(METHODS),
                    help="estimator (default mass: Voss's P(m, L), the paper's method)")
     p.add_argument("--z-scale", type=_z_scale, default="auto",
                    help="mass, dbc, blanket: height units per pixel (e.g. 1 dB or 1 grey level); default auto: "
@@ -37,6 +39,22 @@ def add_parsers(sub) -> None:
     p.set_defaults(func=_run)
 
 
+def map_tags(params: dict, input_units=None) -> dict:
+    """GeoTIFF metadata tags of a transform map: what makes maps comparable
+    and reproducible (method, window, step, the ``z_scale`` used, units)."""
+    z = params.get("z_scale")
+    tags = {
+        "FRACTAL_METHOD": params["method"],
+        "WINDOW_SIZE": str(params["window_size"]),
+        "STEP": str(params["step"]),
+        "Z_SCALE": "none" if z is None else repr(float(z)),
+        "UNITS": "fractal dimension (dimensionless)",
+    }
+    if z is not None:
+        tags["Z_SCALE_UNITS"] = f"{input_units} per pixel" if input_units else "input units per pixel"
+    return tags
+
+
 def _z_scale(text: str):
     return text if text in ("auto", "cell") else float(text)
 
@@ -46,7 +64,7 @@ def _run(args: argparse.Namespace) -> int:
 
     from fractalgeo_rs import _progress
     from fractalgeo_rs.io import read_raster, write_raster
-    from fractalgeo_rs.transform import fractal_transform
+    from fractalgeo_rs.transform import FLAGS, fractal_transform
 
     if args.chunks is not None and args.chunks < 1:
         raise ValueError(f"--chunks: expected a positive chunk side in pixels, got {args.chunks}")
@@ -58,18 +76,20 @@ def _run(args: argparse.Namespace) -> int:
             raise ValueError("--z-scale: 'cell' needs a georeferenced input (a cell size in its transform)")
         args.z_scale = cell
     show = _progress.resolve(args.progress, cli=True)
+    opts = dict(method=args.method, nodata=nodata, n_threads=args.n_threads, z_scale=args.z_scale,
+                step=args.step, return_fit=True)
     if args.chunks is not None:
         import dask.array as da  # the CLI turns a missing module into one line naming the extra
 
         arr = da.from_array(data, chunks=args.chunks)
-        lazy = fractal_transform(arr, args.window, method=args.method, nodata=nodata, n_threads=args.n_threads,
-                                 z_scale=args.z_scale, step=args.step)
+        fit = fractal_transform(arr, args.window, **opts)
         with _progress.dask_bar(show):
-            dmap = lazy.compute(scheduler="threads", num_workers=1)
+            dmap, flags = da.compute(fit[0], fit.flags, scheduler="threads", num_workers=1)
     else:
-        dmap = fractal_transform(data, args.window, method=args.method, nodata=nodata, n_threads=args.n_threads,
-                                 z_scale=args.z_scale, step=args.step, progress=show)
+        fit = fractal_transform(data, args.window, progress=show, **opts)
+        dmap, flags = fit[0], fit.flags
     dmap = np.asarray(dmap, dtype=np.float32)
+    tags = map_tags(fit.params, (profile or {}).get("units"))
     if args.output.lower().endswith((".tif", ".tiff")):
         transform = (profile or {}).get("transform")
         if transform is not None and args.step > 1:
@@ -81,12 +101,6 @@ def _run(args: argparse.Namespace) -> int:
             # pixels wide with its corner shifted by (1 - step) / 2 pixels
             cell = Affine(args.step, 0.0, shift, 0.0, args.step, shift)
             transform = transform @ cell if hasattr(transform, "__matmul__") else transform * cell
-        tags = {"FRACTAL_METHOD": args.method, "WINDOW_SIZE": str(args.window)}
-        if args.method in ("mass", "dbc", "blanket"):
-            from fractalgeo_rs.transform import default_z_scale
-
-            zs = default_z_scale(data, nodata) if args.z_scale == "auto" else args.z_scale
-            tags["Z_SCALE"] = f"{zs:.9g}"  # data units per box step
         if cell is not None:
             tags["INPUT_CELL_SIZE"] = f"{cell:.9g}"
         write_raster(args.output, dmap, crs=(profile or {}).get("crs"), transform=transform, nodata=float("nan"),
@@ -95,13 +109,15 @@ def _run(args: argparse.Namespace) -> int:
         write_raster(args.output, dmap)
     finite = dmap[np.isfinite(dmap)]
     print(f"{args.input}: {data.shape}, window {args.window}, method {args.method}")
-    if args.method in ("mass", "dbc", "blanket"):
-        from fractalgeo_rs.transform import default_z_scale
-
-        zs = default_z_scale(data, nodata) if args.z_scale == "auto" else args.z_scale
-        print(f"z_scale: {zs:.6g} data units per box step")
+    if fit.params["z_scale"] is not None:
+        print(f"z_scale: {fit.params['z_scale']:.6g} data units per box step")
     if finite.size:
         print(f"local dimension: mean {finite.mean():.3f}, 5-95 % {np.percentile(finite, 5):.3f}-"
               f"{np.percentile(finite, 95):.3f}, NaN pixels {dmap.size - finite.size}")
+        flags = np.asarray(flags)[np.isfinite(dmap)]
+        out = [f"{100 * np.mean(flags & bit > 0):.1f} % {name}" for name, bit in FLAGS.items()
+               if name != "too_few_valid" and np.any(flags & bit)]
+        if out:
+            print("outside the valid domain: " + ", ".join(out) + " (see docs/transform.md)")
     print(f"map: {args.output}")
     return 0

@@ -66,9 +66,9 @@ def default_z_scale(image, nodata: Optional[float] = None) -> float:
 
     References
     ----------
-    P. J. Rousseeuw and C. Croux, Alternatives to the median absolute
-    deviation, *Journal of the American Statistical Association* 88(424)
-    (1993) 1273-1283, doi:10.1080/01621459.1993.10476408.
+    Rousseeuw, P. J., Croux, C. (1993). Alternatives to the median absolute
+    deviation. *Journal of the American Statistical Association* 88(424),
+    1273-1283. doi:10.1080/01621459.1993.10476408 (1.4826 = 1 / Phi^-1(3/4)).
 
     Examples
     --------
