@@ -1,6 +1,5 @@
 """Progress in the CLI: on by default when stderr is a terminal, forced with
 --progress, off with --no-progress; the map is the same either way."""
-import sys
 
 import numpy as np
 import pytest
