@@ -2,8 +2,8 @@
 //! neighbour (Sibson 1981; C0, and C1 with estimated gradients), linear
 //! (barycentric in the containing triangle) and nearest neighbour. Grid
 //! nodes outside the convex hull of the points are NaN for every method.
-use super::delaunay::PointSource;
-use super::{indexed_points, insertion_error, Indexed};
+use super::delaunay::{bulk_load_merged, PointSource};
+use super::{indexed_points, Indexed};
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 use spade::{
@@ -76,23 +76,11 @@ pub fn grid_from_points<P: PointSource>(
         .filter(|&c| c <= (1usize << 40))
         .ok_or_else(|| CoreError::invalid("shape", format!("{rows} x {cols} is too large")))?;
     let vertices = indexed_points("points", n, |i| points.xy(i))?;
-    let mut tri: Tri =
-        Tri::bulk_load(vertices.clone()).map_err(|e| insertion_error("points", e))?;
     // Duplicates: the kept vertex takes the first occurrence's index.
-    if tri.num_vertices() < n {
-        let mut seen = vec![false; n];
-        for v in tri.vertices() {
-            seen[v.data().idx] = true;
-        }
-        for (i, v) in vertices.iter().enumerate() {
-            if !seen[i] {
-                if let PositionInTriangulation::OnVertex(h) = tri.locate(v.pos) {
-                    let d = tri.vertex_data_mut(h);
-                    d.idx = d.idx.min(i);
-                }
-            }
-        }
-    }
+    let tri: Tri = bulk_load_merged(vertices, |i| {
+        let (x, y) = points.xy(i);
+        Point2::new(x + 0.0, y + 0.0)
+    })?;
     if tri.num_vertices() < 3 || tri.num_inner_faces() == 0 {
         return Err(CoreError::invalid(
             "points",
