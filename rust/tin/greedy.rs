@@ -39,6 +39,7 @@ pub struct GreedyTin {
 struct GridVertex {
     pos: Point2<f64>,
     sample: u32,
+    z: f64,
 }
 
 impl HasPosition for GridVertex {
@@ -51,6 +52,10 @@ impl HasPosition for GridVertex {
 type Tri = DelaunayTriangulation<GridVertex>;
 
 const NONE: u32 = u32::MAX;
+
+/// A quiet NaN with a payload no arithmetic produces, marking skipped
+/// samples in `Refiner::zq` (nodata samples are the canonical NaN there).
+const SKIP: u64 = 0x7ff8_dead_beef_0001;
 
 #[derive(Clone, Copy)]
 struct FaceInfo {
@@ -243,9 +248,10 @@ fn simplify_edge(g: &Grid, samples: &[usize], max_error: f64, keep: &mut Vec<usi
 struct Refiner<'a> {
     g: Grid<'a>,
     tri: Tri,
-    /// Samples that are never candidates: vertices, and the raster's edge
-    /// samples with shared tile edges.
-    skip: Vec<bool>,
+    /// The heights, with the samples that are never candidates (vertices,
+    /// and the raster's edge samples with shared tile edges) set to the NaN
+    /// [`SKIP`]: one load per sample tells valid, nodata and skipped apart.
+    zq: Vec<f64>,
     faces: Vec<FaceInfo>,
     heap: Queue,
     max_error: f64,
@@ -257,7 +263,7 @@ impl Refiner<'_> {
         let face = self.tri.face(f);
         let vs = face.vertices();
         let p = vs.map(|v| (v.position().x as i64, v.position().y as i64));
-        let zs = vs.map(|v| self.g.z[v.data().sample as usize]);
+        let zs = vs.map(|v| v.data().z);
         let area2 = (p[1].0 - p[0].0) * (p[2].1 - p[0].1) - (p[1].1 - p[0].1) * (p[2].0 - p[0].0);
         let mut info = FaceInfo::default();
         if area2 > 0 {
@@ -302,19 +308,16 @@ impl Refiner<'_> {
                     (w[0] + d[0] * k0, w[1] + d[1] * k0, w[2] + d[2] * k0);
                 let start = row + (x0 + k0) as usize;
                 let end = row + (x0 + k1) as usize + 1;
-                let (zr, skip) = (&self.g.z[start..end], &self.skip[start..end]);
-                for (j, (&z, &sk)) in zr.iter().zip(skip).enumerate() {
-                    if !sk {
-                        if z.is_nan() {
-                            info.mixed = true;
-                        } else {
-                            let plane =
-                                (w0 as f64 * zs[0] + w1 as f64 * zs[1] + w2 as f64 * zs[2]) * inv;
-                            let e = (z - plane).abs();
-                            if e > best {
-                                best = e;
-                                info.cand = (start + j) as u32;
-                            }
+                for (j, &z) in self.zq[start..end].iter().enumerate() {
+                    if z.is_nan() {
+                        info.mixed |= z.to_bits() != SKIP;
+                    } else {
+                        let plane =
+                            (w0 as f64 * zs[0] + w1 as f64 * zs[1] + w2 as f64 * zs[2]) * inv;
+                        let e = (z - plane).abs();
+                        if e > best {
+                            best = e;
+                            info.cand = (start + j) as u32;
                         }
                     }
                     w0 += d[0];
@@ -352,8 +355,9 @@ impl Refiner<'_> {
         let v = GridVertex {
             pos: Point2::new(c as f64, r as f64),
             sample: s as u32,
+            z: self.g.z[s],
         };
-        self.skip[s] = true;
+        self.zq[s] = f64::from_bits(SKIP);
         let h = match hint {
             Some(h) => self.tri.insert_with_hint(v, h),
             None => self.tri.insert(v),
@@ -423,7 +427,10 @@ pub fn greedy_tin(
             "the valid samples are fewer than 3 or all on one line: there is no triangle",
         ));
     }
-    let mut skip = vec![false; n];
+    let mut zq = Vec::new();
+    zq.try_reserve_exact(n)
+        .map_err(|_| CoreError::invalid("dem", format!("cannot allocate a copy of {n} samples")))?;
+    zq.extend(z.iter().map(|&v| if v.is_nan() { f64::NAN } else { v }));
     let mut edge_error = 0.0f64;
     if shared_edges {
         let top: Vec<usize> = (0..cols).collect();
@@ -433,7 +440,7 @@ pub fn greedy_tin(
         for side in [&top, &bottom, &left, &right] {
             edge_error = edge_error.max(simplify_edge(&g, side, max_error, &mut initial));
             for &s in side {
-                skip[s] = true;
+                zq[s] = f64::from_bits(SKIP);
             }
         }
     }
@@ -442,7 +449,7 @@ pub fn greedy_tin(
     let mut rf = Refiner {
         g,
         tri: Tri::new(),
-        skip,
+        zq,
         faces: Vec::new(),
         heap: Queue::default(),
         max_error,
