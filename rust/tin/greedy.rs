@@ -366,6 +366,41 @@ impl Refiner<'_> {
     }
 }
 
+/// Ask the CPU to start loading the heights in the bounding box of the
+/// grid points `p` (at most 64 cache lines, row by row): the popped face's
+/// samples are rasterised again right after spade has inserted its
+/// candidate, so their loads overlap with the insertion. A hint only: it
+/// reads nothing and changes no result.
+#[inline]
+fn prefetch_box(zq: &[f64], cols: usize, p: [(usize, usize); 3]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        let (x0, x1) = (p.iter().map(|q| q.0).min(), p.iter().map(|q| q.0).max());
+        let (y0, y1) = (p.iter().map(|q| q.1).min(), p.iter().map(|q| q.1).max());
+        let (Some(x0), Some(x1), Some(y0), Some(y1)) = (x0, x1, y0, y1) else {
+            return;
+        };
+        let mut budget = 64usize;
+        for y in y0..=y1 {
+            let Some(row) = zq.get(y * cols + x0..=y * cols + x1) else {
+                return;
+            };
+            for k in (0..row.len()).step_by(8) {
+                if budget == 0 {
+                    return;
+                }
+                budget -= 1;
+                // SAFETY: `k < row.len()`, so the pointer is inside `zq`;
+                // a prefetch never faults and has no observable effect.
+                unsafe { _mm_prefetch(row.as_ptr().add(k) as *const i8, _MM_HINT_T0) };
+            }
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (zq, cols, p);
+}
+
 /// Greedy error-bounded TIN of the `rows x cols` raster `z` (row-major,
 /// NaN = nodata).
 ///
@@ -475,7 +510,13 @@ pub fn greedy_tin(
             return Err(CoreError::Internal("queued face without a handle".into()));
         };
         let face = rf.tri.face(handle);
-        let hint = face.vertices()[0].fix();
+        let vs = face.vertices();
+        prefetch_box(
+            &rf.zq,
+            cols,
+            vs.map(|v| (v.position().x as usize, v.position().y as usize)),
+        );
+        let hint = vs[0].fix();
         let v = rf.insert(info.cand as usize, Some(hint))?;
         star.clear();
         star.extend(

@@ -75,7 +75,9 @@ def delaunay(points, *, constraints=None, n_threads=None) -> np.ndarray:
         at any input point lying on it). Constraints may share end points
         but not cross.
     n_threads : int, optional
-        Accepted for a uniform interface; the triangulation is sequential.
+        Threads for the parallel parts: sorting the points into the order of
+        spade's circle sweep, and reading out the triangles. The sweep
+        itself is sequential. The result does not depend on it.
 
     Returns
     -------
