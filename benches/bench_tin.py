@@ -39,7 +39,7 @@ def best(f, repeat):
 def row(case, ours, base_name, base):
     ratio = f"{base / ours:.1f}x" if base else "-"
     bt = f"{base:.2f} s" if base else "-"
-    print(f"| {case} | {ours:.2f} s | {base_name} {bt} | {ratio} |", flush=True)
+    print(f"| {case} | {ours:.2f} s | {base_name} {bt} | {ratio} | {os.getloadavg()[0]:.1f} |", flush=True)
 
 
 def main() -> None:
@@ -50,8 +50,8 @@ def main() -> None:
     args = ap.parse_args()
     r = args.repeat
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores; "
-          f"{time.strftime('%Y-%m-%d')}")
-    print("| case | fractalgeo_rs | baseline | ratio |\n|---|---|---|---|")
+          f"{time.strftime('%Y-%m-%d %H:%M')}; load average {os.getloadavg()[0]:.1f}")
+    print("| case | fractalgeo_rs | baseline | ratio | load |\n|---|---|---|---|---|")
     from scipy.interpolate import griddata
     from scipy.spatial import Delaunay
 
@@ -124,7 +124,8 @@ def main() -> None:
         dt = time.perf_counter() - t0
         rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20
         print(f"| Delaunay 2^25 uniform points: {len(tb)} triangles, peak RSS {rss:.1f} GiB "
-              f"(before {rss0:.1f} GiB) | {dt:.1f} s | scipy: fails above 2^24 (scipy issue 4985) | - |")
+              f"(before {rss0:.1f} GiB) | {dt:.1f} s | scipy: fails above 2^24 (scipy issue 4985) | - | "
+              f"{os.getloadavg()[0]:.1f} |")
 
 
 if __name__ == "__main__":

@@ -108,6 +108,29 @@ def test_transform_orientation_and_map_coordinates(crop):
     assert np.abs(rasterize(t3) - crop).max() <= 5.0 + 1e-9
 
 
+@pytest.mark.parametrize(
+    "geo",
+    [
+        {},
+        {"cell_size": 30.0},
+        {"transform": (350000.0, 30.0, 0.0, 3800000.0, 0.0, -30.0)},  # GDAL, north up
+        {"transform": (0.0, 10.0, 0.0, 0.0, 0.0, 10.0)},  # south up
+        {"transform": (100.0, 3.0, 1.0, 50.0, 0.5, -2.0)},  # sheared
+    ],
+)
+def test_round_trip_through_grid_from_points(crop, geo):
+    # tin_from_dem and grid_from_points share one convention (cell centres of the
+    # transform): gridding the TIN's vertices on the same geometry puts every vertex
+    # back on its own DEM cell with its height
+    from fractalgeo_rs.tin import grid_from_points
+
+    t = tin_from_dem(crop, max_error=5.0, **geo)
+    col, row = t.grid[:, 0], t.grid[:, 1]
+    for method in ("linear", "natural", "natural_c1", "nearest"):
+        g = grid_from_points(t.vertices[:, :2], t.vertices[:, 2], crop.shape, method=method, **geo)
+        np.testing.assert_allclose(g[row, col], crop[row, col], rtol=0, atol=1e-9)
+
+
 def test_adjacent_tiles_share_edge_vertices(crop, rough):
     for dem, err in [(crop, 3.0), (rough, 8.0)]:
         left, right = dem[:, :65], dem[:, 64:]  # common column 64

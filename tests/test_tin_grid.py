@@ -20,8 +20,8 @@ def scattered():
 def nodes(shape, transform=None):
     rows, cols = shape
     rr, cc = np.mgrid[0:rows, 0:cols]
-    if transform is None:
-        return cc.astype(float), rr.astype(float)
+    if transform is None:  # the default: unit cells, north up, origin at the lower left
+        transform = (0.0, 1.0, 0.0, float(rows), 0.0, -1.0)
     c, a, b, f, d, e = transform  # GDAL order
     return c + a * (cc + 0.5) + b * (rr + 0.5), f + d * (cc + 0.5) + e * (rr + 0.5)
 
@@ -70,7 +70,8 @@ def test_natural_neighbour_interpolates_and_is_bounded(method):
     keep[[0, 19, 380, 399]] = True
     p = p[keep]
     v = rng.normal(size=len(p))
-    g = grid_from_points(p, v, (20, 20), method=method)
+    on_lattice = (-0.5, 1.0, 0.0, -0.5, 0.0, 1.0)  # cell centres at x = col, y = row
+    g = grid_from_points(p, v, (20, 20), on_lattice, method=method)
     np.testing.assert_allclose(g[p[:, 1].astype(int), p[:, 0].astype(int)], v, atol=1e-12)
     if method == "natural":  # Sibson weights are a convex combination
         assert np.nanmin(g) >= v.min() - 1e-12 and np.nanmax(g) <= v.max() + 1e-12
@@ -105,7 +106,7 @@ def test_identical_for_any_n_threads_and_input_kept(scattered):
 def test_duplicates_take_the_first_value():
     p = np.array([[0.0, 0.0], [2.0, 0.0], [0.0, 2.0], [2.0, 2.0], [2.0, 2.0]])
     v = np.array([0.0, 0.0, 0.0, 1.0, 100.0])
-    g = grid_from_points(p, v, (3, 3), method="linear")
+    g = grid_from_points(p, v, (3, 3), (-0.5, 1.0, 0.0, -0.5, 0.0, 1.0), method="linear")
     assert g[2, 2] == 1.0
 
 
@@ -129,3 +130,16 @@ def test_bad_input(args, kwargs, exc, start):
     with pytest.raises(exc) as info:
         grid_from_points(*args, **kwargs)
     assert str(info.value).startswith(start)
+
+
+def test_default_grid_is_cell_centres_north_up():
+    # cell (row, col) of the default grid is centred at x = col + 0.5, y = rows - row - 0.5
+    p = np.array([[0.0, 0.0], [4.0, 0.0], [0.0, 3.0], [4.0, 3.0]])
+    v = 10.0 * p[:, 0] + p[:, 1]
+    g = grid_from_points(p, v, (3, 4), method="linear")
+    assert g[0, 0] == pytest.approx(10.0 * 0.5 + 2.5)
+    assert g[2, 3] == pytest.approx(10.0 * 3.5 + 0.5)
+    g2 = grid_from_points(2.0 * p, v, (3, 4), cell_size=2.0, method="linear")
+    np.testing.assert_allclose(g2, g, atol=1e-12)
+    with pytest.raises(ValueError, match="^cell_size"):
+        grid_from_points(p, v, (3, 4), (0, 1, 0, 3, 0, -1), cell_size=2.0)

@@ -6,9 +6,11 @@
 //! duplicates are merged: the triangles index the first occurrence.
 use super::{indexed_points, insertion_error, Indexed};
 use crate::error::{CoreError, CoreResult};
-use spade::handles::FixedVertexHandle;
+use rayon::prelude::*;
+use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
 use spade::{
-    ConstrainedDelaunayTriangulation, DelaunayTriangulation, PositionInTriangulation, Triangulation,
+    ConstrainedDelaunayTriangulation, DelaunayTriangulation, Point2, PositionInTriangulation,
+    Triangulation,
 };
 
 /// Point `i` of the caller's array as `(x, y)`.
@@ -29,26 +31,60 @@ impl PointSource for ndarray::ArrayView2<'_, f64> {
     }
 }
 
-/// Make every vertex carry the smallest input index among its exact
-/// duplicates (spade keeps one copy of duplicates, not necessarily the
-/// first); return the vertex handle of every input point.
-fn merge_duplicates<T>(tri: &mut T, vertices: &[Indexed]) -> CoreResult<Vec<FixedVertexHandle>>
+/// Put `vertices` in the order spade's circle-sweep bulk loading inserts
+/// them (distance from the mean position, farthest first, then `x`, then
+/// `y`), with the input index as the final key so the order is total.
+///
+/// spade sorts its input by the same key with `sort_unstable`, which returns
+/// at once on a sorted slice: sorting here in parallel (rayon, in the
+/// current pool) moves that sort off the sequential path. The mean is
+/// summed in input order exactly as spade does, so the keys are
+/// bit-identical; were they not, spade would only sort again (same result).
+/// The result does not depend on the number of threads (a total order).
+pub(crate) fn sweep_order(vertices: &mut [Indexed]) {
+    if vertices.is_empty() {
+        return;
+    }
+    let mut sum = Point2::new(0.0f64, 0.0f64);
+    for v in vertices.iter() {
+        sum = Point2::new(sum.x + v.pos.x, sum.y + v.pos.y);
+    }
+    let k = 1.0 / vertices.len() as f64;
+    let center = Point2::new(sum.x * k, sum.y * k);
+    vertices.par_sort_unstable_by(|a, b| {
+        let (da, db) = (center.distance_2(a.pos), center.distance_2(b.pos));
+        db.total_cmp(&da)
+            .then(a.pos.x.total_cmp(&b.pos.x))
+            .then(a.pos.y.total_cmp(&b.pos.y))
+            .then(a.idx.cmp(&b.idx))
+    });
+}
+
+/// Bulk-load `vertices` (in [`sweep_order`] first) and make every vertex
+/// carry the smallest input index among its exact duplicates (spade keeps
+/// one copy of duplicates, not necessarily the first). `xy(i)` is input
+/// point `i`, used to find the kept copy of a dropped duplicate.
+pub(crate) fn bulk_load_merged<T>(
+    mut vertices: Vec<Indexed>,
+    xy: impl Fn(usize) -> Point2<f64>,
+) -> CoreResult<T>
 where
     T: Triangulation<Vertex = Indexed>,
 {
     let n = vertices.len();
-    let mut handle: Vec<Option<FixedVertexHandle>> = vec![None; n];
-    for v in tri.vertices() {
-        handle[v.data().idx] = Some(v.fix());
-    }
+    sweep_order(&mut vertices);
+    let mut tri = T::bulk_load(vertices).map_err(|e| insertion_error("points", e))?;
     if tri.num_vertices() < n {
-        for (i, v) in vertices.iter().enumerate() {
-            if handle[i].is_some() {
+        let mut kept = vec![false; n];
+        for v in tri.vertices() {
+            kept[v.data().idx] = true;
+        }
+        for (i, &k) in kept.iter().enumerate() {
+            if k {
                 continue;
             }
-            match tri.locate(v.pos) {
+            match tri.locate(xy(i)) {
                 PositionInTriangulation::OnVertex(h) => {
-                    handle[i] = Some(h);
                     let d = tri.vertex_data_mut(h);
                     d.idx = d.idx.min(i);
                 }
@@ -57,6 +93,30 @@ where
                         "point {i} was dropped by the triangulation but is not a duplicate"
                     )))
                 }
+            }
+        }
+    }
+    Ok(tri)
+}
+
+/// The vertex handle of every input point (duplicates share one), for a
+/// triangulation made by [`bulk_load_merged`].
+fn input_handles<T>(
+    tri: &T,
+    n: usize,
+    xy: impl Fn(usize) -> Point2<f64>,
+) -> CoreResult<Vec<FixedVertexHandle>>
+where
+    T: Triangulation<Vertex = Indexed>,
+{
+    let mut handle: Vec<Option<FixedVertexHandle>> = vec![None; n];
+    for v in tri.vertices() {
+        handle[v.data().idx] = Some(v.fix());
+    }
+    for (i, h) in handle.iter_mut().enumerate() {
+        if h.is_none() {
+            if let PositionInTriangulation::OnVertex(v) = tri.locate(xy(i)) {
+                *h = Some(v);
             }
         }
     }
@@ -86,10 +146,15 @@ fn check_size<T: Triangulation<Vertex = Indexed>>(tri: &T) -> CoreResult<()> {
     Ok(())
 }
 
-fn triangles_of<T: Triangulation<Vertex = Indexed>>(tri: &T) -> Vec<[i64; 3]> {
-    tri.inner_faces()
-        .map(|f| {
-            let [a, b, c] = f.vertices();
+/// The inner faces as input indices, in spade's face order; faces are read
+/// in parallel (the triangulation is only read), the order is fixed.
+fn triangles_of<T: Triangulation<Vertex = Indexed> + Sync>(tri: &T) -> Vec<[i64; 3]> {
+    let faces: Vec<FixedFaceHandle<InnerTag>> = tri.fixed_inner_faces().collect();
+    faces
+        .par_iter()
+        .with_min_len(1 << 14)
+        .map(|&f| {
+            let [a, b, c] = tri.face(f).vertices();
             [
                 a.data().idx as i64,
                 b.data().idx as i64,
@@ -115,12 +180,13 @@ pub fn delaunay<P: PointSource>(
 ) -> CoreResult<Vec<[i64; 3]>> {
     let n = points.len();
     let vertices = indexed_points("points", n, |i| points.xy(i))?;
+    let xy = |i: usize| {
+        let (x, y) = points.xy(i);
+        Point2::new(x + 0.0, y + 0.0)
+    };
     match constraints {
         None | Some([]) => {
-            let mut tri: DelaunayTriangulation<Indexed> =
-                DelaunayTriangulation::bulk_load(vertices.clone())
-                    .map_err(|e| insertion_error("points", e))?;
-            merge_duplicates(&mut tri, &vertices)?;
+            let tri: DelaunayTriangulation<Indexed> = bulk_load_merged(vertices, xy)?;
             check_size(&tri)?;
             Ok(triangles_of(&tri))
         }
@@ -136,10 +202,9 @@ pub fn delaunay<P: PointSource>(
                 }
             }
             let mut cdt: ConstrainedDelaunayTriangulation<Indexed> =
-                ConstrainedDelaunayTriangulation::bulk_load(vertices.clone())
-                    .map_err(|e| insertion_error("points", e))?;
-            let handle = merge_duplicates(&mut cdt, &vertices)?;
+                bulk_load_merged(vertices, xy)?;
             check_size(&cdt)?;
+            let handle = input_handles(&cdt, n, xy)?;
             for (k, &[a, b]) in edges.iter().enumerate() {
                 let (ha, hb) = (handle[a as usize], handle[b as usize]);
                 if ha == hb {

@@ -21,7 +21,6 @@
 use crate::error::{CoreError, CoreResult};
 use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
 use spade::{DelaunayTriangulation, HasPosition, Point2, Triangulation};
-use std::collections::BinaryHeap;
 
 /// The result of [`greedy_tin`].
 #[derive(Debug, Clone, PartialEq)]
@@ -40,6 +39,7 @@ pub struct GreedyTin {
 struct GridVertex {
     pos: Point2<f64>,
     sample: u32,
+    z: f64,
 }
 
 impl HasPosition for GridVertex {
@@ -52,6 +52,10 @@ impl HasPosition for GridVertex {
 type Tri = DelaunayTriangulation<GridVertex>;
 
 const NONE: u32 = u32::MAX;
+
+/// A quiet NaN with a payload no arithmetic produces, marking skipped
+/// samples in `Refiner::zq` (nodata samples are the canonical NaN there).
+const SKIP: u64 = 0x7ff8_dead_beef_0001;
 
 #[derive(Clone, Copy)]
 struct FaceInfo {
@@ -76,11 +80,66 @@ impl Default for FaceInfo {
 
 /// A queue entry: the priority's bits (non-negative floats order like their
 /// bit patterns), then the lower face index first, then the version.
-#[derive(PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 struct Entry {
     key: u64,
     face_rev: u32,
     version: u32,
+}
+
+/// A 4-ary max-heap of entries with lazy deletion by the caller (stale
+/// entries are skipped when popped). Entries are totally ordered, so the
+/// pop sequence is that of any other max-priority queue; a 4-ary heap has
+/// half the depth of a binary one, hence about half the cache misses per
+/// pop when the queue is large.
+#[derive(Default)]
+struct Queue {
+    v: Vec<Entry>,
+}
+
+impl Queue {
+    fn push(&mut self, e: Entry) {
+        let mut i = self.v.len();
+        self.v.push(e);
+        while i > 0 {
+            let p = (i - 1) / 4;
+            if self.v[p] >= e {
+                break;
+            }
+            self.v[i] = self.v[p];
+            i = p;
+        }
+        self.v[i] = e;
+    }
+
+    fn pop(&mut self) -> Option<Entry> {
+        let last = self.v.pop()?;
+        let n = self.v.len();
+        if n == 0 {
+            return Some(last);
+        }
+        let top = self.v[0];
+        let mut i = 0;
+        loop {
+            let c = 4 * i + 1;
+            if c >= n {
+                break;
+            }
+            let mut m = c;
+            for j in c + 1..(c + 4).min(n) {
+                if self.v[j] > self.v[m] {
+                    m = j;
+                }
+            }
+            if self.v[m] <= last {
+                break;
+            }
+            self.v[i] = self.v[m];
+            i = m;
+        }
+        self.v[i] = last;
+        Some(top)
+    }
 }
 
 struct Grid<'a> {
@@ -189,10 +248,12 @@ fn simplify_edge(g: &Grid, samples: &[usize], max_error: f64, keep: &mut Vec<usi
 struct Refiner<'a> {
     g: Grid<'a>,
     tri: Tri,
-    is_vertex: Vec<bool>,
-    excluded: Vec<bool>,
+    /// The heights, with the samples that are never candidates (vertices,
+    /// and the raster's edge samples with shared tile edges) set to the NaN
+    /// [`SKIP`]: one load per sample tells valid, nodata and skipped apart.
+    zq: Vec<f64>,
     faces: Vec<FaceInfo>,
-    heap: BinaryHeap<Entry>,
+    heap: Queue,
     max_error: f64,
 }
 
@@ -202,7 +263,7 @@ impl Refiner<'_> {
         let face = self.tri.face(f);
         let vs = face.vertices();
         let p = vs.map(|v| (v.position().x as i64, v.position().y as i64));
-        let zs = vs.map(|v| self.g.z[v.data().sample as usize]);
+        let zs = vs.map(|v| v.data().z);
         let area2 = (p[1].0 - p[0].0) * (p[2].1 - p[0].1) - (p[1].1 - p[0].1) * (p[2].0 - p[0].0);
         let mut info = FaceInfo::default();
         if area2 > 0 {
@@ -239,24 +300,29 @@ impl Refiner<'_> {
                         k1 = -1;
                     }
                 }
-                for k in k0..=k1 {
-                    let x = x0 + k;
-                    let s = row + x as usize;
-                    if !self.is_vertex[s] && !self.excluded[s] {
-                        let z = self.g.z[s];
-                        if z.is_nan() {
-                            info.mixed = true;
-                        } else {
-                            let (w0, w1, w2) = (w[0] + d[0] * k, w[1] + d[1] * k, w[2] + d[2] * k);
-                            let plane =
-                                (w0 as f64 * zs[0] + w1 as f64 * zs[1] + w2 as f64 * zs[2]) * inv;
-                            let e = (z - plane).abs();
-                            if e > best {
-                                best = e;
-                                info.cand = s as u32;
-                            }
+                if k0 > k1 {
+                    continue;
+                }
+                // Step the (exact, integer) edge functions along the row.
+                let (mut w0, mut w1, mut w2) =
+                    (w[0] + d[0] * k0, w[1] + d[1] * k0, w[2] + d[2] * k0);
+                let start = row + (x0 + k0) as usize;
+                let end = row + (x0 + k1) as usize + 1;
+                for (j, &z) in self.zq[start..end].iter().enumerate() {
+                    if z.is_nan() {
+                        info.mixed |= z.to_bits() != SKIP;
+                    } else {
+                        let plane =
+                            (w0 as f64 * zs[0] + w1 as f64 * zs[1] + w2 as f64 * zs[2]) * inv;
+                        let e = (z - plane).abs();
+                        if e > best {
+                            best = e;
+                            info.cand = (start + j) as u32;
                         }
                     }
+                    w0 += d[0];
+                    w1 += d[1];
+                    w2 += d[2];
                 }
             }
             info.err = best.max(0.0);
@@ -289,14 +355,50 @@ impl Refiner<'_> {
         let v = GridVertex {
             pos: Point2::new(c as f64, r as f64),
             sample: s as u32,
+            z: self.g.z[s],
         };
-        self.is_vertex[s] = true;
+        self.zq[s] = f64::from_bits(SKIP);
         let h = match hint {
             Some(h) => self.tri.insert_with_hint(v, h),
             None => self.tri.insert(v),
         };
         h.map_err(|e| CoreError::Internal(format!("vertex insertion failed: {e:?}")))
     }
+}
+
+/// Ask the CPU to start loading the heights in the bounding box of the
+/// grid points `p` (at most 64 cache lines, row by row): the popped face's
+/// samples are rasterised again right after spade has inserted its
+/// candidate, so their loads overlap with the insertion. A hint only: it
+/// reads nothing and changes no result.
+#[inline]
+fn prefetch_box(zq: &[f64], cols: usize, p: [(usize, usize); 3]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        let (x0, x1) = (p.iter().map(|q| q.0).min(), p.iter().map(|q| q.0).max());
+        let (y0, y1) = (p.iter().map(|q| q.1).min(), p.iter().map(|q| q.1).max());
+        let (Some(x0), Some(x1), Some(y0), Some(y1)) = (x0, x1, y0, y1) else {
+            return;
+        };
+        let mut budget = 64usize;
+        for y in y0..=y1 {
+            let Some(row) = zq.get(y * cols + x0..=y * cols + x1) else {
+                return;
+            };
+            for k in (0..row.len()).step_by(8) {
+                if budget == 0 {
+                    return;
+                }
+                budget -= 1;
+                // SAFETY: `k < row.len()`, so the pointer is inside `zq`;
+                // a prefetch never faults and has no observable effect.
+                unsafe { _mm_prefetch(row.as_ptr().add(k) as *const i8, _MM_HINT_T0) };
+            }
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (zq, cols, p);
 }
 
 /// Greedy error-bounded TIN of the `rows x cols` raster `z` (row-major,
@@ -360,7 +462,10 @@ pub fn greedy_tin(
             "the valid samples are fewer than 3 or all on one line: there is no triangle",
         ));
     }
-    let mut excluded = vec![false; n];
+    let mut zq = Vec::new();
+    zq.try_reserve_exact(n)
+        .map_err(|_| CoreError::invalid("dem", format!("cannot allocate a copy of {n} samples")))?;
+    zq.extend(z.iter().map(|&v| if v.is_nan() { f64::NAN } else { v }));
     let mut edge_error = 0.0f64;
     if shared_edges {
         let top: Vec<usize> = (0..cols).collect();
@@ -370,7 +475,7 @@ pub fn greedy_tin(
         for side in [&top, &bottom, &left, &right] {
             edge_error = edge_error.max(simplify_edge(&g, side, max_error, &mut initial));
             for &s in side {
-                excluded[s] = true;
+                zq[s] = f64::from_bits(SKIP);
             }
         }
     }
@@ -379,10 +484,9 @@ pub fn greedy_tin(
     let mut rf = Refiner {
         g,
         tri: Tri::new(),
-        is_vertex: vec![false; n],
-        excluded,
+        zq,
         faces: Vec::new(),
-        heap: BinaryHeap::new(),
+        heap: Queue::default(),
         max_error,
     };
     for &s in &initial {
@@ -406,7 +510,13 @@ pub fn greedy_tin(
             return Err(CoreError::Internal("queued face without a handle".into()));
         };
         let face = rf.tri.face(handle);
-        let hint = face.vertices()[0].fix();
+        let vs = face.vertices();
+        prefetch_box(
+            &rf.zq,
+            cols,
+            vs.map(|v| (v.position().x as usize, v.position().y as usize)),
+        );
+        let hint = vs[0].fix();
         let v = rf.insert(info.cand as usize, Some(hint))?;
         star.clear();
         star.extend(

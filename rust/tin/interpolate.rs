@@ -2,10 +2,11 @@
 //! neighbour (Sibson 1981; C0, and C1 with estimated gradients), linear
 //! (barycentric in the containing triangle) and nearest neighbour. Grid
 //! nodes outside the convex hull of the points are NaN for every method.
-use super::delaunay::PointSource;
-use super::{indexed_points, insertion_error, Indexed};
+use super::delaunay::{bulk_load_merged, PointSource};
+use super::{indexed_points, Indexed};
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
+use spade::handles::FixedVertexHandle;
 use spade::{
     DelaunayTriangulation, FloatTriangulation, HierarchyHintGenerator, Point2,
     PositionInTriangulation, Triangulation,
@@ -76,23 +77,11 @@ pub fn grid_from_points<P: PointSource>(
         .filter(|&c| c <= (1usize << 40))
         .ok_or_else(|| CoreError::invalid("shape", format!("{rows} x {cols} is too large")))?;
     let vertices = indexed_points("points", n, |i| points.xy(i))?;
-    let mut tri: Tri =
-        Tri::bulk_load(vertices.clone()).map_err(|e| insertion_error("points", e))?;
     // Duplicates: the kept vertex takes the first occurrence's index.
-    if tri.num_vertices() < n {
-        let mut seen = vec![false; n];
-        for v in tri.vertices() {
-            seen[v.data().idx] = true;
-        }
-        for (i, v) in vertices.iter().enumerate() {
-            if !seen[i] {
-                if let PositionInTriangulation::OnVertex(h) = tri.locate(v.pos) {
-                    let d = tri.vertex_data_mut(h);
-                    d.idx = d.idx.min(i);
-                }
-            }
-        }
-    }
+    let tri: Tri = bulk_load_merged(vertices, |i| {
+        let (x, y) = points.xy(i);
+        Point2::new(x + 0.0, y + 0.0)
+    })?;
     if tri.num_vertices() < 3 || tri.num_inner_faces() == 0 {
         return Err(CoreError::invalid(
             "points",
@@ -105,26 +94,36 @@ pub fn grid_from_points<P: PointSource>(
     })?;
     out.resize(cells, f64::NAN);
     let value = |v: spade::handles::VertexHandle<Indexed, (), (), ()>| values[v.data().idx];
-    let grads: Vec<[f64; 2]> = if method == Method::NaturalC1 {
-        let nn = tri.natural_neighbor();
-        tri.vertices()
-            .map(|v| nn.estimate_gradient(v, value))
-            .collect()
+    // C1: per-vertex values and gradients (spade's area-weighted normals),
+    // by vertex index; each gradient is computed on its own, in parallel.
+    let (vals, grads): (Vec<f64>, Vec<[f64; 2]>) = if method == Method::NaturalC1 {
+        let vals = tri.vertices().map(value).collect();
+        let grads = (0..tri.num_vertices())
+            .into_par_iter()
+            .with_min_len(1024)
+            .map_init(
+                || tri.natural_neighbor(),
+                |nn, i| nn.estimate_gradient(tri.vertex(FixedVertexHandle::from_index(i)), value),
+            )
+            .collect();
+        (vals, grads)
     } else {
-        Vec::new()
+        (Vec::new(), Vec::new())
     };
     out.par_chunks_mut(cols.max(1))
         .enumerate()
         .for_each(|(r, row)| {
             let nn = tri.natural_neighbor();
             let bary = tri.barycentric();
+            let mut weights = Vec::new();
             for (c, o) in row.iter_mut().enumerate() {
                 let (cf, rf) = (c as f64, r as f64);
                 let p = Point2::new(t[0] + t[1] * cf + t[2] * rf, t[3] + t[4] * cf + t[5] * rf);
                 let v = match method {
                     Method::Natural => nn.interpolate(value, p),
                     Method::NaturalC1 => {
-                        nn.interpolate_gradient(value, |v| grads[v.fix().index()], 1.0, p)
+                        nn.get_weights(p, &mut weights);
+                        sibson_c1(&tri, &weights, &vals, &grads, p)
                     }
                     Method::Linear => bary.interpolate(value, p),
                     Method::Nearest => match tri.locate(p) {
@@ -137,6 +136,49 @@ pub fn grid_from_points<P: PointSource>(
             }
         });
     Ok(out)
+}
+
+/// Sibson's C1 natural-neighbour blend at `p` from the natural-neighbour
+/// weights `w` (Sibson 1981): with `r_i = |p - x_i|`, `zeta_i = f_i + grad_i
+/// . (p - x_i)`, `alpha = sum(w_i / r_i^2 * r_i^2) / sum(w_i / r_i^2)`,
+/// `beta = sum(w_i r_i^2)`, the value is `(alpha sum(w_i f_i) + beta
+/// sum(w_i / r_i^2 zeta_i) / sum(w_i / r_i^2)) / (alpha + beta)`.
+///
+/// The same operations as spade's `interpolate_gradient` with flatness 1
+/// (whose `(r_i^2)^flatness` is then `r_i^2` itself), without its `powf`
+/// per neighbour. `vals` and `grads` are indexed by vertex.
+fn sibson_c1(
+    tri: &Tri,
+    w: &[(FixedVertexHandle, f64)],
+    vals: &[f64],
+    grads: &[[f64; 2]],
+    p: Point2<f64>,
+) -> Option<f64> {
+    if w.is_empty() {
+        return None;
+    }
+    let (mut sum_c0, mut sum_c1, mut sum_c1_weights, mut alpha, mut beta) =
+        (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for &(h, weight) in w {
+        let q = tri.vertex(h).position();
+        let (dx, dy) = (p.x - q.x, p.y - q.y);
+        let r2 = dx * dx + dy * dy;
+        let f = vals[h.index()];
+        if r2 == 0.0 {
+            return Some(f);
+        }
+        let c1_weight = weight / r2;
+        let g = grads[h.index()];
+        let zeta = f + (dx * g[0] + dy * g[1]);
+        alpha += c1_weight * r2;
+        beta += weight * r2;
+        sum_c1_weights += c1_weight;
+        sum_c1 += zeta * c1_weight;
+        sum_c0 += f * weight;
+    }
+    alpha /= sum_c1_weights;
+    sum_c1 /= sum_c1_weights;
+    Some((alpha * sum_c0 + beta * sum_c1) / (alpha + beta))
 }
 
 #[cfg(test)]

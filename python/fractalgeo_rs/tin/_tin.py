@@ -77,7 +77,9 @@ def delaunay(points, *, constraints=None, n_threads=None) -> np.ndarray:
         at any input point lying on it). Constraints may share end points
         but not cross.
     n_threads : int, optional
-        Accepted for a uniform interface; the triangulation is sequential.
+        Threads for the parallel parts: sorting the points into the order of
+        spade's circle sweep, and reading out the triangles. The sweep
+        itself is sequential. The result does not depend on it.
 
     Returns
     -------
@@ -372,7 +374,8 @@ def tin_from_dem(dem, *, max_error=None, max_triangles=None, transform=None, cel
                grid=grid, shape=(int(z.shape[0]), int(z.shape[1])), transform=t)
 
 
-def grid_from_points(points, values, shape, transform=None, *, method="natural", n_threads=None) -> np.ndarray:
+def grid_from_points(points, values, shape, transform=None, *, cell_size=None, method="natural",
+                     n_threads=None) -> np.ndarray:
     r"""Grid scattered values through their Delaunay triangulation.
 
     Methods: ``"natural"``, Sibson's natural-neighbour interpolation
@@ -399,8 +402,17 @@ def grid_from_points(points, values, shape, transform=None, *, method="natural",
     shape : (int, int)
         ``(rows, cols)`` of the output grid.
     transform : Affine or GDAL 6-tuple, optional
-        Georeferencing of the output grid; values are computed at cell
-        centres. Default: node ``(row, col)`` at ``x = col, y = row``.
+        Georeferencing of the output grid (pixel corners, GDAL's
+        convention); values are computed at cell centres, ``x = x0 + (col +
+        0.5) dx``, ``y = y0 + (row + 0.5) dy`` for a north-up grid. Default:
+        spacing ``cell_size``, north up, origin at the lower-left corner of
+        the grid, so cell ``(row, col)`` is centred at ``x = (col + 0.5) h``,
+        ``y = (rows - row - 0.5) h``. This is the convention of
+        :func:`tin_from_dem`: ``grid_from_points(tin.vertices[:, :2],
+        tin.vertices[:, 2], dem.shape, transform)`` puts every vertex back
+        on its DEM cell.
+    cell_size : float, optional
+        Cell size ``h`` when there is no ``transform`` (default 1).
     method : {"natural", "natural_c1", "linear", "nearest"}
     n_threads : int, optional
         Rows are interpolated in parallel; the result does not depend on it.
@@ -422,9 +434,10 @@ def grid_from_points(points, values, shape, transform=None, *, method="natural",
     >>> rng = np.random.default_rng(0)
     >>> pts = np.vstack([[0, 0], [10, 0], [0, 10], [10, 10], rng.uniform(0, 10, (50, 2))])
     >>> vals = 2.0 * pts[:, 0] - pts[:, 1]
-    >>> g = grid_from_points(pts, vals, (11, 11))
-    >>> yy, xx = np.mgrid[0:11, 0:11]
-    >>> bool(np.allclose(g, 2.0 * xx - yy))
+    >>> g = grid_from_points(pts, vals, (10, 10))   # cells of size 1 over [0, 10]^2
+    >>> row, col = np.mgrid[0:10, 0:10]
+    >>> x, y = col + 0.5, 10 - row - 0.5            # cell centres, north up
+    >>> bool(np.allclose(g, 2.0 * x - y))
     True
     """
     p = _points(points)
@@ -439,9 +452,6 @@ def grid_from_points(points, values, shape, transform=None, *, method="natural",
     check_memory(8 * rows * cols, "shape", what=f"a {rows} x {cols} float64 grid")
     check_choice(method, "method", ("natural", "natural_c1", "linear", "nearest"))
     n_threads = check_n_threads(n_threads)
-    if transform is None:
-        g = [0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
-    else:
-        a, b, c, d, e, f = _affine(transform, None, rows)
-        g = [c + 0.5 * a + 0.5 * b, a, b, f + 0.5 * d + 0.5 * e, d, e]
+    a, b, c, d, e, f = _affine(transform, cell_size, rows)
+    g = [c + 0.5 * a + 0.5 * b, a, b, f + 0.5 * d + 0.5 * e, d, e]
     return _core.tin_grid(p, np.ascontiguousarray(v, dtype=np.float64), rows, cols, g, method, n_threads)
