@@ -250,12 +250,8 @@ def run_raster(
     prep = prepare or (lambda b: b)
     if boundary not in ("nan", "none"):
         raise ValueError(f"boundary: expected 'nan' or 'none', got {boundary!r}")
-    if locate:
-        def run(b, origin):
-            return kernel(prep(b), origin)
-    else:
-        def run(b):
-            return kernel(prep(b))
+    def run(b, *origin):  # origin: the block's (row, col) when locate is set
+        return kernel(prep(b), *origin)
     stacked = _RUNNERS[inner](run, data, depth=depth, step=step, n_out=n_out, dtype=dtype,
                               boundary=boundary, locate=locate, progress=progress, desc=desc)
     if xr_obj is None:

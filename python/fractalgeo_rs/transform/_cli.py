@@ -70,7 +70,8 @@ def _run(args: argparse.Namespace) -> int:
         raise ValueError(f"--chunks: expected a positive chunk side in pixels, got {args.chunks}")
     data, profile = read_raster(args.input, band=args.band)
     nodata = (profile or {}).get("nodata")
-    cell = abs((profile or {}).get("transform").a) if (profile or {}).get("transform") is not None else None
+    geo = (profile or {}).get("transform")
+    cell = abs(geo.a) if geo is not None else None
     if args.z_scale == "cell":
         if cell is None:
             raise ValueError("--z-scale: 'cell' needs a georeferenced input (a cell size in its transform)")
