@@ -20,11 +20,11 @@ from typing import Optional, Sequence
 _DOMAIN_CLIS = (
     "fractalgeo_rs.dem._cli",
     "fractalgeo_rs.dimension._cli",
+    "fractalgeo_rs.demo",
     "fractalgeo_rs.lsystem._cli",
     "fractalgeo_rs.synth._cli",
     "fractalgeo_rs.transform._cli",
     "fractalgeo_rs.tin._cli",
-    # each issue adds its domain's _cli module here
 )
 
 

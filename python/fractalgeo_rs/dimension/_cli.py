@@ -1,4 +1,4 @@
-"""``fractalgeo dimension`` and ``fractalgeo demo``."""
+"""``fractalgeo dimension``."""
 from __future__ import annotations
 
 import argparse
@@ -30,13 +30,6 @@ def add_parsers(sub) -> None:
     p.add_argument("--plot", default=None, metavar="PNG", help="write the log-log plot to this PNG")
     add_n_threads(p)
     p.set_defaults(func=_run_dimension)
-
-    d = sub.add_parser("demo", formatter_class=HelpFormatter, help="run the demo on bundled real data and write a figure",
-                       description="Box-counting dimensions of real data bundled with the package "
-                                   "(SRTM DEM of the Alps, Kilauea coastline, Sentinel-1 backscatter); "
-                                   "prints the fits and writes a PNG figure.")
-    d.add_argument("--out", default="demo-output", help="output folder (default ./demo-output)")
-    d.set_defaults(func=_run_demo)
 
 
 def _parse_range(text):
@@ -99,11 +92,4 @@ def _run_dimension(args: argparse.Namespace) -> int:
         ax.set_title(f"{args.path}")
         save_figure(fig, args.plot)
         print(f"plot: {args.plot}")
-    return 0
-
-
-def _run_demo(args: argparse.Namespace) -> int:
-    from fractalgeo_rs.demo import run_demo
-
-    run_demo(args.out)  # prints the fits and the paths it wrote (shown in the README)
     return 0

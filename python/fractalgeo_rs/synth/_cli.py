@@ -2,9 +2,7 @@
 from __future__ import annotations
 
 import argparse
-from typing import Any
 
-import numpy as np
 
 from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads
 
@@ -35,25 +33,6 @@ def add_parsers(sub) -> None:
     p.add_argument("--altitude", type=float, default=45.0, help="light altitude for --hillshade (degrees)")
     add_n_threads(p)
     p.set_defaults(func=_run_synth)
-
-    h = sub.add_parser(
-        "hillshade", formatter_class=HelpFormatter,
-        help="shaded relief of a DEM as an 8-bit PNG",
-        description="Lambertian shaded relief with Horn's gradients (GDAL's conventions; 0 = nodata, "
-        "1-255 = shade; with -compute_edges the bytes of gdaldem hillshade -compute_edges). Cell size and "
-        "nodata come from the file's georeferencing when it has any. A .tif output keeps the DEM's CRS and "
-        "transform with nodata 0; a .png output gets a world file (.pgw) and the CRS in .prj.",
-    )
-    h.add_argument("dem", help="DEM (.tif, .npy, .exr, .png, any GDAL format with rasterio)")
-    h.add_argument("output", help="output .png or .tif")
-    h.add_argument("--band", type=int, default=None, help="1-based band of the DEM (None: its only band)")
-    h.add_argument("--azimuth", type=float, default=315.0, help="light azimuth, degrees clockwise from north")
-    h.add_argument("--altitude", type=float, default=45.0, help="light altitude, degrees above the horizon")
-    h.add_argument("--z-factor", type=float, default=1.0, help="vertical exaggeration, > 0")
-    h.add_argument("--cell-size", type=float, default=None, help="override the file's cell size")
-    h.add_argument("--multidirectional", action="store_true", help="GDAL's multidirectional shading")
-    add_n_threads(h)
-    h.set_defaults(func=_run_hillshade)
 
 
 def _run_synth(args: argparse.Namespace) -> int:
@@ -97,37 +76,4 @@ def _run_synth(args: argparse.Namespace) -> int:
                       n_threads=args.n_threads)
         write_raster(args.hillshade, s, crs=geo["crs"], transform=geo["transform"])
         print(f"hillshade: {args.hillshade}")
-    return 0
-
-
-def _run_hillshade(args: argparse.Namespace) -> int:
-    from fractalgeo_rs.dem import hillshade
-    from fractalgeo_rs.io import read_raster, write_raster
-
-    z, prof = read_raster(args.dem, band=args.band)
-    cell: Any = 1.0
-    latitude = None
-    nodata = None
-    if prof:
-        t = prof.get("transform")
-        nodata = prof.get("nodata")
-        if t is not None:
-            cell = (abs(t.e), abs(t.a))
-            crs = prof.get("crs")
-            if crs is not None and getattr(crs, "is_geographic", False):
-                latitude = t.f + t.e * (np.arange(z.shape[0]) + 0.5)
-    if args.cell_size is not None:
-        cell = args.cell_size
-    s = hillshade(z, azimuth=args.azimuth, altitude=args.altitude, z_factor=args.z_factor, cell_size=cell,
-                  nodata=nodata, multidirectional=args.multidirectional, latitude=latitude, byte=True,
-                  n_threads=args.n_threads)
-    crs = (prof or {}).get("crs")
-    transform = (prof or {}).get("transform")
-    if str(args.output).lower().endswith((".tif", ".tiff")):
-        write_raster(args.output, s, crs=crs, transform=transform, nodata=0)
-    else:
-        write_raster(args.output, s, crs=crs, transform=transform)
-    cs = cell if isinstance(cell, tuple) else (cell, cell)
-    print(f"hillshade: {z.shape[0]} x {z.shape[1]} DEM, cell {cs[0]:g} x {cs[1]:g}, azimuth {args.azimuth:g}, "
-          f"altitude {args.altitude:g}, {int((s == 0).sum())} nodata pixels -> {args.output}")
     return 0
