@@ -488,18 +488,20 @@ impl Shared {
     }
 }
 
-/// Per-point parameter maps on the input grid, looked up by fine position.
+/// Per-point parameter maps on the input grid (row-major), looked up by
+/// fine position; a 1 x 1 map is a constant.
 struct Maps<'a> {
-    h: ArrayView2<'a, f64>,
-    s: ArrayView2<'a, f64>,
+    h: &'a [f64],
+    s: &'a [f64],
+    rows: usize,
+    cols: usize,
 }
 
 impl Maps<'_> {
     #[inline]
     fn at(&self, i: usize, j: usize) -> (f64, f64) {
-        let (r, c) = self.h.dim();
-        let (i, j) = (i.min(r - 1), j.min(c - 1));
-        (self.h[(i, j)], self.s[(i, j)])
+        let k = i.min(self.rows - 1) * self.cols + j.min(self.cols - 1);
+        (self.h[k], self.s[k])
     }
 }
 
@@ -513,13 +515,18 @@ fn collect_masks<F>(
     targets: F,
 ) -> BTreeSet<u16>
 where
-    F: Fn(usize) -> Vec<usize> + Sync,
+    F: Fn(usize) -> std::iter::StepBy<std::ops::Range<usize>> + Sync,
 {
     (0..rows)
         .into_par_iter()
         .fold(BTreeSet::new, |mut set, i| {
+            let row_inside = i >= reach && i + reach < g.rows;
             for j in targets(i) {
-                if !any_nan && g.interior(i, j, reach) {
+                if !any_nan && row_inside {
+                    if j >= reach && j + reach < g.cols {
+                        continue;
+                    }
+                } else if !any_nan && g.interior(i, j, reach) {
                     continue;
                 }
                 let (m, hole) = g.mask(st, i, j);
@@ -548,10 +555,10 @@ fn check(
             format!("need at least 2 x 2 samples, got {r} x {c}"),
         ));
     }
-    if hurst.dim() != (r, c) || sigma.dim() != (r, c) {
+    if hurst.dim() != sigma.dim() || (hurst.dim() != (r, c) && hurst.dim() != (1, 1)) {
         return Err(CoreError::invalid(
             "hurst",
-            "the hurst and sigma maps must have the shape of dem",
+            "the hurst and sigma maps must have the shape of dem (or both be 1 x 1)",
         ));
     }
     if p.levels == 0 || p.levels > 12 {
@@ -567,8 +574,8 @@ fn check(
 }
 
 /// Resample `dem` by `2^levels` (see the module docs). `hurst` and `sigma`
-/// are maps on the input grid (sigma: the lag-1 increment standard deviation
-/// in height units; NaN in either gives NaN).
+/// are maps on the input grid, or both 1 x 1 for constants (sigma: the lag-1
+/// increment standard deviation in height units; NaN in either gives NaN).
 pub fn resample(
     dem: ArrayView2<f64>,
     hurst: ArrayView2<f64>,
@@ -576,13 +583,24 @@ pub fn resample(
     p: &ResampleParams,
 ) -> CoreResult<Array2<f64>> {
     check(&dem, &hurst, &sigma, p)?;
-    let maps = Maps { h: hurst, s: sigma };
-    let mut cur = dem.as_standard_layout().to_owned();
-    for l in 0..p.levels {
-        cur = match p.support {
-            Support::Point => level_point(cur.view(), &maps, p, l)?,
-            Support::Area => level_area(cur.view(), &maps, p, l)?,
-        };
+    let (hc, sc) = (hurst.as_standard_layout(), sigma.as_standard_layout());
+    let (h, s) = match (hc.as_slice(), sc.as_slice()) {
+        (Some(h), Some(s)) => (h, s),
+        _ => return Err(CoreError::Internal("maps not contiguous".into())),
+    };
+    let maps = Maps {
+        h,
+        s,
+        rows: hurst.dim().0,
+        cols: hurst.dim().1,
+    };
+    let level = |v: ArrayView2<f64>, l: u32| match p.support {
+        Support::Point => level_point(v, &maps, p, l),
+        Support::Area => level_area(v, &maps, p, l),
+    };
+    let mut cur = level(dem.as_standard_layout().view(), 0)?;
+    for l in 1..p.levels {
+        cur = level(cur.view(), l)?;
     }
     Ok(cur)
 }
@@ -628,21 +646,18 @@ fn level_point(
         let full = &tables[step];
         let key = stream(p, l, step as u64);
         // Targets of row i: diamond rows odd, columns odd; square: i + j odd.
-        let targets = move |i: usize| -> Vec<usize> {
+        let targets = move |i: usize| {
             if step == 0 {
-                if i % 2 == 1 {
-                    (1..fc).step_by(2).collect()
-                } else {
-                    Vec::new()
-                }
+                (1..if i % 2 == 1 { fc } else { 0 }).step_by(2)
             } else {
-                ((1 - i % 2)..fc).step_by(2).collect()
+                ((1 - i % 2)..fc).step_by(2)
             }
         };
         let partial = {
             let g = Grid::of(&fine, fr, fc, true);
             Partial::build(st, step, collect_masks(&g, st, fr, 3, any_nan, targets))
         };
+        let offs: [isize; NS] = st.offsets.map(|(dr, dc)| dr * fc as isize + dc);
         let ptr = Shared(fine.as_mut_ptr());
         let len = fine.len();
         (0..fr).into_par_iter().for_each(|i| {
@@ -662,23 +677,27 @@ fn level_point(
             // the loop; the view reads only cells of the read parity, which
             // no row writes in this step.
             let g = unsafe { Grid::from_raw(base as *const f64, fr, fc, true) };
-            let mut last_h = f64::NAN;
-            let mut cache = ([0.0; NS], 0.0);
-            for j in targets(i) {
+            let mut pc = ParamCache::new(detail, scale);
+            let row_inside = !any_nan && i >= 3 && i + 3 < fr;
+            let first = if step == 0 { 1 } else { 1 - i % 2 };
+            let n_targets = if step == 0 && i % 2 == 0 { 0 } else { fc };
+            for j in (first..n_targets).step_by(2) {
                 let (h, s) = maps.at((i + half) >> shift, (j + half) >> shift);
                 let val = if !(h.is_finite() && s.is_finite()) {
                     f64::NAN
-                } else if !any_nan && g.interior(i, j, 3) {
-                    if h != last_h {
-                        cache = full.at(h);
-                        last_h = h;
-                    }
+                } else if row_inside && j >= 3 && j + 3 < fc {
+                    pc.update(full, h, s);
+                    let c0 = i * fc + j;
                     let mut acc = 0.0;
-                    for (k, &(dr, dc)) in st.offsets.iter().enumerate() {
-                        acc += cache.0[k]
-                            * get((i as isize + dr) as usize, (j as isize + dc) as usize);
+                    for (w, &o) in pc.w.iter().zip(&offs) {
+                        let k = c0.wrapping_add_signed(o);
+                        debug_assert!(k < len);
+                        // SAFETY: the target is 3 cells away from every edge,
+                        // so k = (i + dr) fc + j + dc with |dr|, |dc| <= 3 is
+                        // inside the buffer, and it has the read parity.
+                        acc += w * unsafe { *base.add(k) };
                     }
-                    acc + noise(detail, &key, &cache.1, s, h, scale, g0, g1, gcols, i, j)
+                    acc + pc.noise(&key, g0, g1, gcols, i, j)
                 } else {
                     let (m, hole) = g.mask(st, i, j);
                     if hole {
@@ -699,7 +718,8 @@ fn level_point(
                                     * get((i as isize + dr) as usize, (j as isize + dc) as usize);
                             }
                         }
-                        acc + noise(detail, &key, &sd, s, h, scale, g0, g1, gcols, i, j)
+                        let sd = noise_sd(detail, sd, s, h, scale);
+                        acc + draw(sd, &key, g0, g1, gcols, i, j)
                     }
                 };
                 // SAFETY: (i, j) is a target of this step in row i, inside the buffer.
@@ -710,26 +730,61 @@ fn level_point(
     Array2::from_shape_vec((fr, fc), fine).map_err(|e| CoreError::Internal(e.to_string()))
 }
 
-#[allow(clippy::too_many_arguments)]
+/// Standard deviation of the residual: `sigma (2^-l)^H sd_unit`, or 0 when
+/// the level adds no detail.
 #[inline]
-fn noise(
-    detail: bool,
-    key: &StreamKey,
-    sd_unit: &f64,
-    sigma: f64,
-    h: f64,
-    scale: f64,
-    g0: u64,
-    g1: u64,
-    gcols: u64,
-    i: usize,
-    j: usize,
-) -> f64 {
+fn noise_sd(detail: bool, sd_unit: f64, sigma: f64, h: f64, scale: f64) -> f64 {
     if !detail || sigma == 0.0 {
         return 0.0;
     }
-    let sd = sigma * scale.powf(h.clamp(H_MIN, H_MAX)) * sd_unit;
+    sigma * scale.powf(h.clamp(H_MIN, H_MAX)) * sd_unit
+}
+
+/// `sd` times the standard normal keyed by the global fine position.
+#[inline]
+fn draw(sd: f64, key: &StreamKey, g0: u64, g1: u64, gcols: u64, i: usize, j: usize) -> f64 {
+    if sd == 0.0 {
+        return 0.0;
+    }
     sd * key.normal2(g0 + i as u64, g1 + j as u64, gcols)
+}
+
+/// Weights and residual sd of the full stencil for the last `(H, sigma)`
+/// seen: the table lookup and the power are redone only when they change.
+struct ParamCache {
+    h: f64,
+    s: f64,
+    w: [f64; NS],
+    sd: f64,
+    detail: bool,
+    scale: f64,
+}
+
+impl ParamCache {
+    fn new(detail: bool, scale: f64) -> Self {
+        ParamCache {
+            h: f64::NAN,
+            s: f64::NAN,
+            w: [0.0; NS],
+            sd: 0.0,
+            detail,
+            scale,
+        }
+    }
+    #[inline]
+    fn update(&mut self, t: &Table, h: f64, s: f64) {
+        if h.to_bits() != self.h.to_bits() || s.to_bits() != self.s.to_bits() {
+            let (w, sd) = t.at(h);
+            self.w = w;
+            self.sd = noise_sd(self.detail, sd, s, h, self.scale);
+            self.h = h;
+            self.s = s;
+        }
+    }
+    #[inline]
+    fn noise(&self, key: &StreamKey, g0: u64, g1: u64, gcols: u64, i: usize, j: usize) -> f64 {
+        draw(self.sd, key, g0, g1, gcols, i, j)
+    }
 }
 
 /// One area-support level: `(r, c)` -> `(2r, 2c)`, block means kept.
@@ -761,7 +816,7 @@ fn level_area(
         partials.push(Partial::build(
             st,
             2 + q,
-            collect_masks(&g, st, r, 2, any_nan, |_| (0..c).collect()),
+            collect_masks(&g, st, r, 2, any_nan, |_| (0..c).step_by(1)),
         ));
     }
     let mut fine = crate::buffers::try_zeroed(fr * fc, "factor")?;
@@ -817,13 +872,9 @@ fn level_area(
                         }
                     }
                     v[q] = acc;
-                    e[q] = noise(
-                        detail,
+                    e[q] = draw(
+                        noise_sd(detail, sd, s, h, scale),
                         &key,
-                        &sd,
-                        s,
-                        h,
-                        scale,
                         g0,
                         g1,
                         gcols,

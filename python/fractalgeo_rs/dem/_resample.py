@@ -207,10 +207,11 @@ def _as_float(dem, nodata):
         raise ValueError(f"dem: expected a 2D array, got shape {z.shape}")
     if not (np.issubdtype(z.dtype, np.number) and not np.issubdtype(z.dtype, np.complexfloating)):
         raise TypeError(f"dem: expected a real numeric array, got dtype {z.dtype}")
-    z = z.astype(np.float64, copy=True)
+    # No copy unless needed: nothing downstream writes into ``z``.
+    z = np.ascontiguousarray(z, dtype=np.float64)
     nodata = check_nodata(nodata)
     if nodata is not None and not np.isnan(nodata):
-        z[z == nodata] = np.nan
+        z = np.where(z == nodata, np.nan, z)
     return z
 
 
@@ -235,9 +236,7 @@ def _param_map(value, name, shape, lo, hi, lo_open, hi_open):
     if isinstance(value, bool):
         raise TypeError(f"{name}: expected a number or an array, got {value!r}")
     a = as_array(value, name).astype(np.float64)
-    if a.ndim == 0:
-        a = np.full(shape, float(a))
-    elif a.shape != shape:
+    if a.ndim != 0 and a.shape != shape:
         raise ValueError(f"{name}: expected a number or an array of shape {shape}, got {a.shape}")
     f = a[np.isfinite(a)]
     bad = (f <= lo if lo_open else f < lo).any() | (f >= hi if hi_open else f > hi).any()
@@ -246,7 +245,10 @@ def _param_map(value, name, shape, lo, hi, lo_open, hi_open):
         rb = ")" if hi_open else "]"
         raise ValueError(f"{name}: expected values in {lb}{lo}, {hi}{rb}, got "
                          f"min {np.nanmin(a):.4g}, max {np.nanmax(a):.4g}")
-    return np.ascontiguousarray(a)
+    if a.ndim == 0:
+        # A read-only broadcast view (no memory of the DEM's size).
+        return np.broadcast_to(a, shape)
+    return a if a.strides == (0, 0) else np.ascontiguousarray(a)
 
 
 def _cell_size(cell_size, dem):
@@ -436,7 +438,11 @@ def run_numpy(dem, levels, hurst, sigma, window, detail, support, nodata, seed, 
     local_h = isinstance(hurst, str) and hurst == "local"
     local_s = isinstance(sigma, str) and sigma == "local"
     an = _maps(z, hurst, sigma, window, support, local_h, local_s)
-    out = _core.fractal_resample(z, an.hurst, an.sigma, levels, support == "area", seed, detail,
+    h, s = an.hurst, an.sigma
+    if h.strides == (0, 0) and s.strides == (0, 0):
+        # Constant maps: the kernel takes them as 1 x 1.
+        h, s = np.ascontiguousarray(h[:1, :1]), np.ascontiguousarray(s[:1, :1])
+    out = _core.fractal_resample(z, h, s, levels, support == "area", seed, detail,
                                  (0, 0), z.shape[1], n_threads)
     return out, an
 
@@ -453,7 +459,9 @@ def _maps(z, hurst, sigma, window, support, local_h, local_s):
         h_map, s_map, frac = a.hurst, a.sigma, a.fraction_clipped
     h = h_map if local_h else _param_map(hurst, "hurst", z.shape, 0.0, 1.0, True, True)
     s = s_map if local_s else _param_map(sigma, "sigma", z.shape, 0.0, np.inf, False, False)
-    return ResampleAnalysis(np.ascontiguousarray(h), np.ascontiguousarray(s), frac,
+    if (h.strides == (0, 0)) != (s.strides == (0, 0)):
+        h, s = np.ascontiguousarray(h), np.ascontiguousarray(s)
+    return ResampleAnalysis(h, s, frac,
                             window if (local_h or local_s) else 0)
 
 
