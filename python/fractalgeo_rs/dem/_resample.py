@@ -1,6 +1,7 @@
 """Fractal resampling of DEMs: finer grids that keep the terrain's roughness."""
 from __future__ import annotations
 
+import functools
 import numbers
 import warnings
 from dataclasses import dataclass
@@ -46,14 +47,66 @@ class ResampleAnalysis:
 
 # ---------------------------------------------------------------- analysis --
 
-def _box_sum(a, half):
-    """Sum over the (2 half + 1)^2 window, per pixel in a fixed order (the
-    value at a pixel depends only on the values inside its window, so blocks
-    of a larger array give bit-identical sums)."""
-    from scipy.ndimage import correlate1d
+#: Spacing (cells) of the nodes where the window sums are computed; the maps
+#: are interpolated bilinearly between them.
+STEP = 8
 
-    w = np.ones(2 * half + 1)
-    return correlate1d(correlate1d(a, w, axis=0, mode="constant"), w, axis=1, mode="constant")
+
+def _pad_width(half, step=STEP):
+    """NaN halo (a multiple of ``step``) the analysis of a block needs: the
+    window, the lag-2 increments and one node spacing for the interpolation."""
+    return -(-(half + 2 + step) // step) * step
+
+
+def _node_sums(a, half, step):
+    """Sums along axis 0 over rows ``[p - half, p + half]`` at the nodes
+    ``p = k step`` whose window fits in ``a``; returns ``(sums, k_first)``.
+
+    Each sum is formed in a fixed order from the values in its window only
+    (blocks of ``step`` rows aligned on the node grid, then the rows left
+    over), so any block of a larger array whose origin is a multiple of
+    ``step`` gives bit-identical sums."""
+    n = a.shape[0]
+    q, rem = divmod(half, step)
+    k0 = -(-half // step)
+    k1 = (n - 3 - half) // step + 1
+    k = np.arange(k0, max(k1, k0))
+    nb = n // step
+    bs = a[0:nb * step:step].copy()
+    for o in range(1, step):
+        bs += a[o:nb * step:step]
+    if q:
+        acc = bs[k - q].copy()
+        for d in range(1, 2 * q):
+            acc += bs[k - q + d]
+    else:
+        acc = np.zeros((k.size,) + a.shape[1:])
+    p = k * step
+    for o in range(-half, -q * step):
+        acc += a[p + o]
+    for o in range(q * step, half + 1):
+        acc += a[p + o]
+    return acc, k0
+
+
+def _interp_nodes(v, k0, lo, hi, step):
+    """Bilinear (along axis 0) interpolation of node values ``v`` (node
+    ``k0 + a`` at row ``(k0 + a) step``) to the rows ``[lo, hi)``."""
+    i = np.arange(lo, hi)
+    a = i // step - k0
+    u = ((i % step) / step).reshape((-1,) + (1,) * (v.ndim - 1))
+    return v[a] * (1.0 - u) + v[a + 1] * u
+
+
+def _box_sum(a, half, t, step=STEP):
+    """Window sums of ``a`` over ``(2 half + 1)^2`` cells at the nodes of a
+    ``step`` grid, interpolated bilinearly to the pixels of ``a`` trimmed by
+    ``t`` (a value depends only on the values in the windows of its 4 nodes,
+    computed in a fixed order)."""
+    r, k0 = _node_sums(a, half, step)
+    c, k1 = _node_sums(np.ascontiguousarray(r.T), half, step)
+    v = _interp_nodes(c, k1, t, a.shape[1] - t, step).T
+    return _interp_nodes(np.ascontiguousarray(v), k0, t, a.shape[0] - t, step)
 
 
 def _block_variogram(hurst, lag, n=2):
@@ -77,14 +130,19 @@ def _block_variogram(hurst, lag, n=2):
 _H_TABLE = np.linspace(0.001, 1.5, 1500)
 
 
+@functools.lru_cache(maxsize=8)
 def _ratio_table(n):
+    """``(H, gamma_B(2) / gamma_B(1), gamma_B(1))`` on ``_H_TABLE``."""
     h = _H_TABLE
-    return h, _block_variogram(h, 2.0, n) / _block_variogram(h, 1.0, n)
+    g1 = _block_variogram(h, 1.0, n)
+    return h, _block_variogram(h, 2.0, n) / g1, g1
 
 
-def _analyse_padded(z, half, support, block=2):
-    """Local maps on a NaN-padded block; returns raw H and the lag-1 point
-    variance, both trimmed by ``half + 2``."""
+def _analyse_padded(z, half, support, block=2, step=STEP):
+    """Local maps on a NaN-padded block whose origin is a multiple of
+    ``step``; returns raw H and the lag-1 point variance, both trimmed by
+    ``_pad_width(half, step)``."""
+    t = _pad_width(half, step)
     m = np.isfinite(z)
     zz = np.where(m, z, 0.0)
     g = []
@@ -101,13 +159,12 @@ def _analyse_padded(z, half, support, block=2):
             # Increment assigned to its first sample.
             s[tuple(sl_b)] += np.where(ok, d * d, 0.0)
             c[tuple(sl_b)] += ok
-        g.append((_box_sum(s, half), _box_sum(c, half)))
-    t = half + 2
+        g.append((_box_sum(s, half, t, step), _box_sum(c, half, t, step)))
     core = (slice(t, z.shape[0] - t), slice(t, z.shape[1] - t))
     (s1, c1), (s2, c2) = g
     with np.errstate(divide="ignore", invalid="ignore"):
-        g1 = (s1 / c1)[core]
-        g2 = (s2 / c2)[core]
+        g1 = s1 / c1
+        g2 = s2 / c2
         ratio = g2 / g1
     ok = np.isfinite(ratio) & (g1 > 0)
     if support == "point":
@@ -116,11 +173,11 @@ def _analyse_padded(z, half, support, block=2):
     else:
         # Block means: invert the regularised variogram ratio for H, then
         # sigma^2 = g1 / gamma_block(1; H).
-        hh, rr = _ratio_table(block)
+        hh, rr, g1tab = _ratio_table(block)
         hraw = np.where(ok, np.interp(np.where(ok, ratio, 1.0), rr, hh, left=-1.0, right=9.0), np.nan)
         hraw = np.where(hraw == -1.0, 0.0, np.where(hraw == 9.0, 2.0, hraw))
         hc = np.clip(np.where(ok, hraw, 0.5), *HURST_RANGE)
-        var1 = np.where(ok, g1 / _block_variogram(hc, 1.0, block), np.nan)
+        var1 = np.where(ok, g1 / np.interp(hc, hh, g1tab), np.nan)
     # An interior pixel of the core is only valid if it was a valid sample.
     hraw = np.where(m[core], hraw, np.nan)
     return hraw, var1
@@ -187,7 +244,7 @@ def resample_analysis(dem, *, window=33, support="point", block=2, nodata=None):
     z = _as_float(dem, nodata)
     window = _check_window(window, z.shape)
     half = window // 2
-    t = half + 2
+    t = _pad_width(half)
     zp = np.pad(z, t, constant_values=np.nan)
     hraw, var1 = _analyse_padded(zp, half, support, block)
     hurst, sigma, frac = _finish(hraw, var1, np.isfinite(z))
@@ -437,7 +494,7 @@ def run_numpy(dem, levels, hurst, sigma, window, detail, support, nodata, seed, 
     _check_memory(z.shape, 1 << levels)
     local_h = isinstance(hurst, str) and hurst == "local"
     local_s = isinstance(sigma, str) and sigma == "local"
-    an = _maps(z, hurst, sigma, window, support, local_h, local_s)
+    an = _maps(z, hurst, sigma, window, support, local_h, local_s, min(1 << levels, 8))
     h, s = an.hurst, an.sigma
     if h.strides == (0, 0) and s.strides == (0, 0):
         # Constant maps: the kernel takes them as 1 x 1.
@@ -452,10 +509,10 @@ def _check_shape(shape):
         raise ValueError(f"dem: the kriging stencil needs at least 4 x 4 samples, got {shape}")
 
 
-def _maps(z, hurst, sigma, window, support, local_h, local_s):
+def _maps(z, hurst, sigma, window, support, local_h, local_s, block=2):
     frac = 0.0
     if local_h or local_s:
-        a = resample_analysis(z, window=window, support=support)
+        a = resample_analysis(z, window=window, support=support, block=block)
         h_map, s_map, frac = a.hurst, a.sigma, a.fraction_clipped
     h = h_map if local_h else _param_map(hurst, "hurst", z.shape, 0.0, 1.0, True, True)
     s = s_map if local_s else _param_map(sigma, "sigma", z.shape, 0.0, np.inf, False, False)
