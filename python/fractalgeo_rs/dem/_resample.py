@@ -145,21 +145,24 @@ def _analyse_padded(z, half, support, block=2, step=STEP):
     t = _pad_width(half, step)
     m = np.isfinite(z)
     zz = np.where(m, z, 0.0)
-    g = []
-    for lag in (1, 2):
-        s = np.zeros(z.shape)
-        c = np.zeros(z.shape)
-        for axis in (0, 1):
-            sl_a = [slice(None)] * 2
-            sl_b = [slice(None)] * 2
-            sl_a[axis] = slice(lag, None)
-            sl_b[axis] = slice(None, -lag)
-            d = zz[tuple(sl_a)] - zz[tuple(sl_b)]
-            ok = m[tuple(sl_a)] & m[tuple(sl_b)]
-            # Increment assigned to its first sample.
-            s[tuple(sl_b)] += np.where(ok, d * d, 0.0)
-            c[tuple(sl_b)] += ok
-        g.append((_box_sum(s, half, t, step), _box_sum(c, half, t, step)))
+    n0 = z.shape[0]
+    sums = {lag: (np.zeros(z.shape), np.zeros(z.shape)) for lag in (1, 2)}
+    # Squared increments (each assigned to its first sample), rows then
+    # columns, in strips of rows so that the temporaries stay small.
+    for r0 in range(0, n0, 256):
+        r1 = min(r0 + 256, n0)
+        for lag, (s, c) in sums.items():
+            e = min(r1, n0 - lag)
+            if e > r0:
+                ok = m[r0 + lag:e + lag] & m[r0:e]
+                d = zz[r0 + lag:e + lag] - zz[r0:e]
+                s[r0:e] += np.where(ok, d * d, 0.0)
+                c[r0:e] += ok
+            ok = m[r0:r1, lag:] & m[r0:r1, :-lag]
+            d = zz[r0:r1, lag:] - zz[r0:r1, :-lag]
+            s[r0:r1, :-lag] += np.where(ok, d * d, 0.0)
+            c[r0:r1, :-lag] += ok
+    g = [(_box_sum(s, half, t, step), _box_sum(c, half, t, step)) for s, c in sums.values()]
     core = (slice(t, z.shape[0] - t), slice(t, z.shape[1] - t))
     (s1, c1), (s2, c2) = g
     with np.errstate(divide="ignore", invalid="ignore"):
