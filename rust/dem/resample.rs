@@ -1259,6 +1259,7 @@ mod tests {
     }
 
     #[test]
+    #[allow(clippy::needless_range_loop)]
     fn area_joint_draw_matches_point_kriging() {
         // Children of 1 point: each child's weights and variance equal the
         // point kriging of `krige` from the 25 window cells (2 x 2 points
