@@ -91,11 +91,14 @@ def _node_sums(a, half, step):
 
 def _interp_nodes(v, k0, lo, hi, step):
     """Bilinear (along axis 0) interpolation of node values ``v`` (node
-    ``k0 + a`` at row ``(k0 + a) step``) to the rows ``[lo, hi)``."""
-    i = np.arange(lo, hi)
-    a = i // step - k0
-    u = ((i % step) / step).reshape((-1,) + (1,) * (v.ndim - 1))
-    return v[a] * (1.0 - u) + v[a + 1] * u
+    ``k0 + a`` at row ``(k0 + a) step``) to the rows ``[lo, hi)``, ``lo`` a
+    multiple of ``step`` (rows grouped by node interval: no gathers)."""
+    a0 = lo // step - k0
+    nb = -(-(hi - lo) // step)
+    u = (np.arange(step) / step).reshape((1, step) + (1,) * (v.ndim - 1))
+    out = v[a0:a0 + nb, None] * (1.0 - u)
+    out += v[a0 + 1:a0 + nb + 1, None] * u
+    return out.reshape((nb * step,) + v.shape[1:])[:hi - lo]
 
 
 def _box_sum(a, half, t, step=STEP):
