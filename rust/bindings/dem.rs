@@ -110,8 +110,8 @@ fn fractal_resample<'py>(
 }
 
 /// Full-stencil kriging weights (16) and residual standard deviation (unit
-/// sigma, coarse spacing 1) of stencil `which` (0 diamond, 1 square, 2-5 area
-/// quadrants) at `hurst`, and the stencil's source offsets.
+/// sigma, coarse spacing 1) of stencil `which` (0 diamond, 1 square) at
+/// `hurst`, and the stencil's source offsets.
 #[pyfunction]
 #[allow(clippy::type_complexity)]
 fn resample_stencil(
@@ -123,8 +123,7 @@ fn resample_stencil(
         let st = match which {
             0 => resample::diamond_stencil(),
             1 => resample::square_stencil(),
-            2..=5 => resample::area_stencil((which - 2) / 2, (which - 2) % 2),
-            _ => return Err(CoreError::invalid("which", "expected 0 to 5")),
+            _ => return Err(CoreError::invalid("which", "expected 0 or 1")),
         };
         let (w, sd) = resample::table_at(which, hurst);
         Ok((w.to_vec(), sd, st.offsets.to_vec()))

@@ -230,41 +230,6 @@ pub fn square_stencil() -> Stencil {
     }
 }
 
-/// Area support, fine cell `(2i + di, 2j + dj)`: offsets into the coarse grid
-/// relative to `(i, j)`; coarse cells are means of the points at `+-1/4`.
-pub fn area_stencil(di: usize, dj: usize) -> Stencil {
-    let mut offsets = [(0, 0); NS];
-    let mut supports = Vec::with_capacity(NS);
-    let mut inner = [0; 4];
-    let mut ni = 0;
-    // Target in coarse units relative to the coarse centre (i, j).
-    let (ty, tx) = (-0.25 + 0.5 * di as f64, -0.25 + 0.5 * dj as f64);
-    for a in 0..4 {
-        for b in 0..4 {
-            let k = a * 4 + b;
-            let dr = a as isize - 2 + di as isize;
-            let dc = b as isize - 2 + dj as isize;
-            offsets[k] = (dr, dc);
-            let (cy, cx) = (dr as f64 - ty, dc as f64 - tx);
-            supports.push(vec![
-                (cy - 0.25, cx - 0.25),
-                (cy - 0.25, cx + 0.25),
-                (cy + 0.25, cx - 0.25),
-                (cy + 0.25, cx + 0.25),
-            ]);
-            if (1..=2).contains(&a) && (1..=2).contains(&b) {
-                inner[ni] = k;
-                ni += 1;
-            }
-        }
-    }
-    Stencil {
-        offsets,
-        supports,
-        inner,
-    }
-}
-
 /// Weights (16, zero for absent samples) and variance for one `H`.
 #[derive(Debug, Clone, Copy)]
 struct Entry {
@@ -315,38 +280,24 @@ impl Table {
 }
 
 /// Full-stencil tables, built once per process.
-fn full_tables() -> &'static [Table; 6] {
-    static T: OnceLock<[Table; 6]> = OnceLock::new();
+fn full_tables() -> &'static [Table; 2] {
+    static T: OnceLock<[Table; 2]> = OnceLock::new();
     T.get_or_init(|| {
         let st = all_stencils();
         let v: Vec<Table> = st
             .par_iter()
             .map(|s| Table::build(s, u16::MAX, N_FULL))
             .collect();
-        [
-            v[0].clone(),
-            v[1].clone(),
-            v[2].clone(),
-            v[3].clone(),
-            v[4].clone(),
-            v[5].clone(),
-        ]
+        [v[0].clone(), v[1].clone()]
     })
 }
 
-fn all_stencils() -> [Stencil; 6] {
-    [
-        diamond_stencil(),
-        square_stencil(),
-        area_stencil(0, 0),
-        area_stencil(0, 1),
-        area_stencil(1, 0),
-        area_stencil(1, 1),
-    ]
+fn all_stencils() -> [Stencil; 2] {
+    [diamond_stencil(), square_stencil()]
 }
 
 /// Full-stencil weights and standard deviation (unit sigma, coarse units) of
-/// stencil `which` (0 diamond, 1 square, 2..6 area quadrants `2 + 2 di + dj`).
+/// stencil `which` (0 diamond, 1 square).
 pub fn table_at(which: usize, h: f64) -> ([f64; NS], f64) {
     full_tables()[which].at(h)
 }
@@ -488,18 +439,20 @@ impl Shared {
     }
 }
 
-/// Per-point parameter maps on the input grid, looked up by fine position.
+/// Per-point parameter maps on the input grid (row-major), looked up by
+/// fine position; a 1 x 1 map is a constant.
 struct Maps<'a> {
-    h: ArrayView2<'a, f64>,
-    s: ArrayView2<'a, f64>,
+    h: &'a [f64],
+    s: &'a [f64],
+    rows: usize,
+    cols: usize,
 }
 
 impl Maps<'_> {
     #[inline]
     fn at(&self, i: usize, j: usize) -> (f64, f64) {
-        let (r, c) = self.h.dim();
-        let (i, j) = (i.min(r - 1), j.min(c - 1));
-        (self.h[(i, j)], self.s[(i, j)])
+        let k = i.min(self.rows - 1) * self.cols + j.min(self.cols - 1);
+        (self.h[k], self.s[k])
     }
 }
 
@@ -513,13 +466,18 @@ fn collect_masks<F>(
     targets: F,
 ) -> BTreeSet<u16>
 where
-    F: Fn(usize) -> Vec<usize> + Sync,
+    F: Fn(usize) -> std::iter::StepBy<std::ops::Range<usize>> + Sync,
 {
     (0..rows)
         .into_par_iter()
         .fold(BTreeSet::new, |mut set, i| {
+            let row_inside = i >= reach && i + reach < g.rows;
             for j in targets(i) {
-                if !any_nan && g.interior(i, j, reach) {
+                if !any_nan && row_inside {
+                    if j >= reach && j + reach < g.cols {
+                        continue;
+                    }
+                } else if !any_nan && g.interior(i, j, reach) {
                     continue;
                 }
                 let (m, hole) = g.mask(st, i, j);
@@ -548,10 +506,10 @@ fn check(
             format!("need at least 2 x 2 samples, got {r} x {c}"),
         ));
     }
-    if hurst.dim() != (r, c) || sigma.dim() != (r, c) {
+    if hurst.dim() != sigma.dim() || (hurst.dim() != (r, c) && hurst.dim() != (1, 1)) {
         return Err(CoreError::invalid(
             "hurst",
-            "the hurst and sigma maps must have the shape of dem",
+            "the hurst and sigma maps must have the shape of dem (or both be 1 x 1)",
         ));
     }
     if p.levels == 0 || p.levels > 12 {
@@ -567,8 +525,8 @@ fn check(
 }
 
 /// Resample `dem` by `2^levels` (see the module docs). `hurst` and `sigma`
-/// are maps on the input grid (sigma: the lag-1 increment standard deviation
-/// in height units; NaN in either gives NaN).
+/// are maps on the input grid, or both 1 x 1 for constants (sigma: the lag-1
+/// increment standard deviation in height units; NaN in either gives NaN).
 pub fn resample(
     dem: ArrayView2<f64>,
     hurst: ArrayView2<f64>,
@@ -576,13 +534,24 @@ pub fn resample(
     p: &ResampleParams,
 ) -> CoreResult<Array2<f64>> {
     check(&dem, &hurst, &sigma, p)?;
-    let maps = Maps { h: hurst, s: sigma };
-    let mut cur = dem.as_standard_layout().to_owned();
-    for l in 0..p.levels {
-        cur = match p.support {
-            Support::Point => level_point(cur.view(), &maps, p, l)?,
-            Support::Area => level_area(cur.view(), &maps, p, l)?,
-        };
+    let (hc, sc) = (hurst.as_standard_layout(), sigma.as_standard_layout());
+    let (h, s) = match (hc.as_slice(), sc.as_slice()) {
+        (Some(h), Some(s)) => (h, s),
+        _ => return Err(CoreError::Internal("maps not contiguous".into())),
+    };
+    let maps = Maps {
+        h,
+        s,
+        rows: hurst.dim().0,
+        cols: hurst.dim().1,
+    };
+    let level = |v: ArrayView2<f64>, l: u32| match p.support {
+        Support::Point => level_point(v, &maps, p, l),
+        Support::Area => level_area(v, &maps, p, l),
+    };
+    let mut cur = level(dem.as_standard_layout().view(), 0)?;
+    for l in 1..p.levels {
+        cur = level(cur.view(), l)?;
     }
     Ok(cur)
 }
@@ -628,21 +597,18 @@ fn level_point(
         let full = &tables[step];
         let key = stream(p, l, step as u64);
         // Targets of row i: diamond rows odd, columns odd; square: i + j odd.
-        let targets = move |i: usize| -> Vec<usize> {
+        let targets = move |i: usize| {
             if step == 0 {
-                if i % 2 == 1 {
-                    (1..fc).step_by(2).collect()
-                } else {
-                    Vec::new()
-                }
+                (1..if i % 2 == 1 { fc } else { 0 }).step_by(2)
             } else {
-                ((1 - i % 2)..fc).step_by(2).collect()
+                ((1 - i % 2)..fc).step_by(2)
             }
         };
         let partial = {
             let g = Grid::of(&fine, fr, fc, true);
             Partial::build(st, step, collect_masks(&g, st, fr, 3, any_nan, targets))
         };
+        let offs: [isize; NS] = st.offsets.map(|(dr, dc)| dr * fc as isize + dc);
         let ptr = Shared(fine.as_mut_ptr());
         let len = fine.len();
         (0..fr).into_par_iter().for_each(|i| {
@@ -662,23 +628,27 @@ fn level_point(
             // the loop; the view reads only cells of the read parity, which
             // no row writes in this step.
             let g = unsafe { Grid::from_raw(base as *const f64, fr, fc, true) };
-            let mut last_h = f64::NAN;
-            let mut cache = ([0.0; NS], 0.0);
-            for j in targets(i) {
+            let mut pc = ParamCache::new(detail, scale);
+            let row_inside = !any_nan && i >= 3 && i + 3 < fr;
+            let first = if step == 0 { 1 } else { 1 - i % 2 };
+            let n_targets = if step == 0 && i % 2 == 0 { 0 } else { fc };
+            for j in (first..n_targets).step_by(2) {
                 let (h, s) = maps.at((i + half) >> shift, (j + half) >> shift);
                 let val = if !(h.is_finite() && s.is_finite()) {
                     f64::NAN
-                } else if !any_nan && g.interior(i, j, 3) {
-                    if h != last_h {
-                        cache = full.at(h);
-                        last_h = h;
-                    }
+                } else if row_inside && j >= 3 && j + 3 < fc {
+                    pc.update(full, h, s);
+                    let c0 = i * fc + j;
                     let mut acc = 0.0;
-                    for (k, &(dr, dc)) in st.offsets.iter().enumerate() {
-                        acc += cache.0[k]
-                            * get((i as isize + dr) as usize, (j as isize + dc) as usize);
+                    for (w, &o) in pc.w.iter().zip(&offs) {
+                        let k = c0.wrapping_add_signed(o);
+                        debug_assert!(k < len);
+                        // SAFETY: the target is 3 cells away from every edge,
+                        // so k = (i + dr) fc + j + dc with |dr|, |dc| <= 3 is
+                        // inside the buffer, and it has the read parity.
+                        acc += w * unsafe { *base.add(k) };
                     }
-                    acc + noise(detail, &key, &cache.1, s, h, scale, g0, g1, gcols, i, j)
+                    acc + pc.noise(&key, g0, g1, gcols, i, j)
                 } else {
                     let (m, hole) = g.mask(st, i, j);
                     if hole {
@@ -699,7 +669,8 @@ fn level_point(
                                     * get((i as isize + dr) as usize, (j as isize + dc) as usize);
                             }
                         }
-                        acc + noise(detail, &key, &sd, s, h, scale, g0, g1, gcols, i, j)
+                        let sd = noise_sd(detail, sd, s, h, scale);
+                        acc + draw(sd, &key, g0, g1, gcols, i, j)
                     }
                 };
                 // SAFETY: (i, j) is a target of this step in row i, inside the buffer.
@@ -710,29 +681,71 @@ fn level_point(
     Array2::from_shape_vec((fr, fc), fine).map_err(|e| CoreError::Internal(e.to_string()))
 }
 
-#[allow(clippy::too_many_arguments)]
+/// Standard deviation of the residual: `sigma (2^-l)^H sd_unit`, or 0 when
+/// the level adds no detail.
 #[inline]
-fn noise(
-    detail: bool,
-    key: &StreamKey,
-    sd_unit: &f64,
-    sigma: f64,
-    h: f64,
-    scale: f64,
-    g0: u64,
-    g1: u64,
-    gcols: u64,
-    i: usize,
-    j: usize,
-) -> f64 {
+fn noise_sd(detail: bool, sd_unit: f64, sigma: f64, h: f64, scale: f64) -> f64 {
     if !detail || sigma == 0.0 {
         return 0.0;
     }
-    let sd = sigma * scale.powf(h.clamp(H_MIN, H_MAX)) * sd_unit;
+    sigma * scale.powf(h.clamp(H_MIN, H_MAX)) * sd_unit
+}
+
+/// `sd` times the standard normal keyed by the global fine position.
+#[inline]
+fn draw(sd: f64, key: &StreamKey, g0: u64, g1: u64, gcols: u64, i: usize, j: usize) -> f64 {
+    if sd == 0.0 {
+        return 0.0;
+    }
     sd * key.normal2(g0 + i as u64, g1 + j as u64, gcols)
 }
 
+/// Weights and residual sd of the full stencil for the last `(H, sigma)`
+/// seen: the table lookup and the power are redone only when they change.
+struct ParamCache {
+    h: f64,
+    s: f64,
+    w: [f64; NS],
+    sd: f64,
+    detail: bool,
+    scale: f64,
+}
+
+impl ParamCache {
+    fn new(detail: bool, scale: f64) -> Self {
+        ParamCache {
+            h: f64::NAN,
+            s: f64::NAN,
+            w: [0.0; NS],
+            sd: 0.0,
+            detail,
+            scale,
+        }
+    }
+    #[inline]
+    fn update(&mut self, t: &Table, h: f64, s: f64) {
+        if h.to_bits() != self.h.to_bits() || s.to_bits() != self.s.to_bits() {
+            let (w, sd) = t.at(h);
+            self.w = w;
+            self.sd = noise_sd(self.detail, sd, s, h, self.scale);
+            self.h = h;
+            self.s = s;
+        }
+    }
+    #[inline]
+    fn noise(&self, key: &StreamKey, g0: u64, g1: u64, gcols: u64, i: usize, j: usize) -> f64 {
+        draw(self.sd, key, g0, g1, gcols, i, j)
+    }
+}
+
 /// One area-support level: `(r, c)` -> `(2r, 2c)`, block means kept.
+///
+/// The four children of a coarse cell are drawn jointly: their kriging means
+/// given the 5 x 5 coarse cells around it (the centre included) plus a
+/// residual with the joint conditional covariance `C` (rank 3: the centre
+/// cell fixes the children's mean), drawn as `L n` for three standard
+/// normals with `L` the Cholesky factor of `C` restricted to children 0-2,
+/// and the fourth residual minus the sum of the others.
 fn level_area(
     coarse: ArrayView2<f64>,
     maps: &Maps,
@@ -745,103 +758,385 @@ fn level_area(
         .as_slice()
         .ok_or_else(|| CoreError::Internal("coarse grid not contiguous".into()))?;
     let any_nan = cs.iter().any(|x| !x.is_finite());
-    let g = Grid::of(cs, r, c, false);
     let shift = l + 1;
     let gmul = 1u64 << shift;
     let (g0, g1) = (p.origin.0 * gmul, p.origin.1 * gmul);
     let gcols = p.global_cols.max(1) * gmul;
     let scale = 2f64.powi(-(l as i32));
     let detail = p.detail[l as usize];
-    let stencils = all_stencils();
-    let tables = full_tables();
     let key = stream(p, l, 0);
-    let mut partials = Vec::with_capacity(4);
-    for q in 0..4 {
-        let st = &stencils[2 + q];
-        partials.push(Partial::build(
-            st,
-            2 + q,
-            collect_masks(&g, st, r, 2, any_nan, |_| (0..c).collect()),
-        ));
-    }
+    let mi = area_model(p.levels, l);
+    let full = area_full(mi);
+    let inside = |i: usize, j: usize| !any_nan && i >= 2 && j >= 2 && i + 2 < r && j + 2 < c;
+    // Tables of the windows cut by an edge or a hole.
+    let masks: BTreeSet<u32> = (0..r)
+        .into_par_iter()
+        .fold(BTreeSet::new, |mut set, i| {
+            for j in 0..c {
+                if !inside(i, j) && cs[i * c + j].is_finite() {
+                    let m = area_mask(cs, r, c, i, j);
+                    if m != AREA_ALL {
+                        set.insert(m);
+                    }
+                }
+            }
+            set
+        })
+        .reduce(BTreeSet::new, |mut a, b| {
+            a.extend(b);
+            a
+        });
+    let partial = area_partial(mi, masks);
+    let offs: [isize; NA] = std::array::from_fn(|k| {
+        let (dr, dc) = area_offset(k);
+        dr * c as isize + dc
+    });
     let mut fine = crate::buffers::try_zeroed(fr * fc, "factor")?;
-    let corr = (4.0f64 / 3.0).sqrt();
     fine.par_chunks_mut(2 * fc)
         .enumerate()
         .for_each(|(i, rows2)| {
             let (top, bottom) = rows2.split_at_mut(fc);
-            let mut last_h = f64::NAN;
-            let mut cache: [([f64; NS], f64); 4] = [([0.0; NS], 0.0); 4];
+            let mut pc = AreaCache::new(detail, scale);
             for j in 0..c {
                 let z = cs[i * c + j];
                 let (h, s) = maps.at(i >> l, j >> l);
                 if !(z.is_finite() && h.is_finite() && s.is_finite()) {
-                    for q in 0..4 {
-                        let (di, dj) = (q / 2, q % 2);
-                        let row = if di == 0 { &mut *top } else { &mut *bottom };
-                        row[2 * j + dj] = f64::NAN;
-                    }
+                    top[2 * j] = f64::NAN;
+                    top[2 * j + 1] = f64::NAN;
+                    bottom[2 * j] = f64::NAN;
+                    bottom[2 * j + 1] = f64::NAN;
                     continue;
                 }
-                let interior = !any_nan && g.interior(i, j, 2);
-                if interior && h != last_h {
-                    for (q, cq) in cache.iter_mut().enumerate() {
-                        *cq = tables[2 + q].at(h);
-                    }
-                    last_h = h;
-                }
                 let mut v = [0.0; 4];
-                let mut e = [0.0; 4];
-                for q in 0..4 {
-                    let (di, dj) = (q / 2, q % 2);
-                    let st = &stencils[2 + q];
-                    let (w, sd, m) = if interior {
-                        (cache[q].0, cache[q].1, u16::MAX)
-                    } else {
-                        let (m, _) = g.mask(st, i, j);
-                        let (w, sd) = if m == u16::MAX {
-                            tables[2 + q].at(h)
-                        } else {
-                            match partials[q].map.get(&m) {
-                                Some(t) => t.at(h),
-                                None => ([0.0; NS], f64::NAN),
-                            }
-                        };
-                        (w, sd, m)
-                    };
-                    let mut acc = 0.0;
-                    for (k, &(dr, dc)) in st.offsets.iter().enumerate() {
-                        if m & (1 << k) != 0 {
-                            let (ii, jj) = ((i as isize + dr) as usize, (j as isize + dc) as usize);
-                            acc += w[k] * cs[ii * c + jj];
+                if inside(i, j) {
+                    pc.update(full, h, s);
+                    let c0 = i * c + j;
+                    for (q, vq) in v.iter_mut().enumerate() {
+                        let mut acc = 0.0;
+                        for (w, &o) in pc.e.w[q].iter().zip(&offs) {
+                            // The window is 2 cells from every edge: inside.
+                            acc += w * cs[c0.wrapping_add_signed(o)];
                         }
+                        *vq = acc;
                     }
-                    v[q] = acc;
-                    e[q] = noise(
-                        detail,
-                        &key,
-                        &sd,
-                        s,
-                        h,
-                        scale,
-                        g0,
-                        g1,
-                        gcols,
-                        2 * i + di,
-                        2 * j + dj,
-                    );
+                } else {
+                    let m = area_mask(cs, r, c, i, j);
+                    let t = if m == AREA_ALL {
+                        full
+                    } else {
+                        match partial.get(&m) {
+                            Some(t) => t.as_ref(),
+                            None => full,
+                        }
+                    };
+                    pc.update_uncached(t, h, s);
+                    for (q, vq) in v.iter_mut().enumerate() {
+                        let mut acc = 0.0;
+                        for k in 0..NA {
+                            if m & (1 << k) != 0 {
+                                let (dr, dc) = area_offset(k);
+                                let (ii, jj) =
+                                    ((i as isize + dr) as usize, (j as isize + dc) as usize);
+                                acc += pc.e.w[q][k] * cs[ii * c + jj];
+                            }
+                        }
+                        *vq = acc;
+                    }
+                }
+                let mut e = [0.0; 4];
+                if pc.sd != 0.0 {
+                    let (a, b) = (g0 + 2 * i as u64, g1 + 2 * j as u64);
+                    let n0 = key.normal2(a, b, gcols);
+                    let n1 = key.normal2(a, b + 1, gcols);
+                    let n2 = key.normal2(a + 1, b, gcols);
+                    let lf = &pc.e.l;
+                    e[0] = pc.sd * (lf[0] * n0);
+                    e[1] = pc.sd * (lf[1] * n0 + lf[2] * n1);
+                    e[2] = pc.sd * (lf[3] * n0 + lf[4] * n1 + lf[5] * n2);
+                    e[3] = -(e[0] + e[1] + e[2]);
                 }
                 let em = 0.25 * (e[0] + e[1] + e[2] + e[3]);
                 let vm = 0.25 * (v[0] + v[1] + v[2] + v[3]);
-                for q in 0..4 {
-                    let (di, dj) = (q / 2, q % 2);
-                    let x = v[q] - vm + z + corr * (e[q] - em);
-                    let row = if di == 0 { &mut *top } else { &mut *bottom };
-                    row[2 * j + dj] = x;
-                }
+                top[2 * j] = v[0] - vm + z + (e[0] - em);
+                top[2 * j + 1] = v[1] - vm + z + (e[1] - em);
+                bottom[2 * j] = v[2] - vm + z + (e[2] - em);
+                bottom[2 * j + 1] = v[3] - vm + z + (e[3] - em);
             }
         });
     Array2::from_shape_vec((fr, fc), fine).map_err(|e| CoreError::Internal(e.to_string()))
+}
+
+/// Cells of the area data window (5 x 5 coarse cells around the parent).
+const NA: usize = 25;
+const AREA_ALL: u32 = (1 << NA) - 1;
+/// H nodes of the area tables (full window) and of cut windows.
+const N_AREA: usize = 101;
+const N_AREA_PARTIAL: usize = 41;
+/// Models of the children's support: `m x m` points, `m = 1, 2, 4`.
+const N_MODELS: usize = 3;
+
+#[inline]
+fn area_offset(k: usize) -> (isize, isize) {
+    ((k / 5) as isize - 2, (k % 5) as isize - 2)
+}
+
+/// Index of the support model at level `l` of `levels`: the children of
+/// level `l` are means of `2^(levels - 1 - l)` fine points per side (the
+/// last level's children are points), capped at 4 x 4 points.
+fn area_model(levels: u32, l: u32) -> usize {
+    ((levels - 1 - l) as usize).min(N_MODELS - 1)
+}
+
+/// Mask of the window cells inside the grid and finite.
+fn area_mask(cs: &[f64], r: usize, c: usize, i: usize, j: usize) -> u32 {
+    let mut m = 0u32;
+    for k in 0..NA {
+        let (dr, dc) = area_offset(k);
+        let (ii, jj) = (i as isize + dr, j as isize + dc);
+        if ii >= 0
+            && jj >= 0
+            && (ii as usize) < r
+            && (jj as usize) < c
+            && cs[ii as usize * c + jj as usize].is_finite()
+        {
+            m |= 1 << k;
+        }
+    }
+    m
+}
+
+/// Kriging weights of the four children (`w[q][k]`, zero for absent cells)
+/// and the Cholesky factor of their conditional covariance restricted to
+/// children 0-2 (`l = [l00, l10, l11, l20, l21, l22]`), unit sigma, coarse
+/// spacing 1.
+#[derive(Debug, Clone, Copy)]
+pub struct AreaEntry {
+    /// Weights of child `q` (0: top left, 1: top right, 2: bottom left,
+    /// 3: bottom right) on window cell `k` (row-major, offsets -2..=2).
+    pub w: [[f64; NA]; 4],
+    /// Lower Cholesky factor, row-major.
+    pub l: [f64; 6],
+}
+
+/// Area tables on a grid of `H`.
+#[derive(Debug, Clone)]
+pub struct AreaTable {
+    entries: Vec<AreaEntry>,
+}
+
+impl AreaTable {
+    fn build(mi: usize, mask: u32, n: usize) -> AreaTable {
+        let entries = (0..n)
+            .into_par_iter()
+            .map(|k| area_solve(1 << mi, mask, h_node(k, n)).0)
+            .collect();
+        AreaTable { entries }
+    }
+    /// Entry interpolated linearly in `H` (clamped to the table's range).
+    pub fn at(&self, h: f64) -> AreaEntry {
+        let n = self.entries.len();
+        let t = ((h.clamp(H_MIN, H_MAX) - H_MIN) / (H_MAX - H_MIN)) * (n - 1) as f64;
+        let k = (t.floor() as usize).min(n - 2);
+        let f = t - k as f64;
+        let (a, b) = (&self.entries[k], &self.entries[k + 1]);
+        let mut e = *a;
+        for q in 0..4 {
+            for k in 0..NA {
+                e.w[q][k] = a.w[q][k] + f * (b.w[q][k] - a.w[q][k]);
+            }
+        }
+        for k in 0..6 {
+            e.l[k] = a.l[k] + f * (b.l[k] - a.l[k]);
+        }
+        e
+    }
+}
+
+/// Points (coarse units, relative to the block centre) of a block of side
+/// `side` sampled by `n x n` points at spacing `side / n`.
+fn block_pattern(side: f64, n: usize) -> Vec<(f64, f64)> {
+    let mut v = Vec::with_capacity(n * n);
+    for a in 0..n {
+        for b in 0..n {
+            v.push((
+                side * ((a as f64 + 0.5) / n as f64 - 0.5),
+                side * ((b as f64 + 0.5) / n as f64 - 0.5),
+            ));
+        }
+    }
+    v
+}
+
+/// Exact area kriging for children of `m x m` points (parents `2m x 2m`),
+/// window cells in `mask`: the entry and the full conditional covariance of
+/// the four children (for tests).
+pub fn area_solve(m: usize, mask: u32, hurst: f64) -> (AreaEntry, [[f64; 4]; 4]) {
+    let pc = block_pattern(1.0, 2 * m);
+    let pk = block_pattern(0.5, m);
+    // Mean semivariogram between two point patterns with centres `d` apart.
+    let gbar = |p: &[(f64, f64)], q: &[(f64, f64)], d: (f64, f64)| {
+        let mut acc = 0.0;
+        for a in p {
+            for b in q {
+                let d2 = (a.0 - b.0 - d.0).powi(2) + (a.1 - b.1 - d.1).powi(2);
+                if d2 > 0.0 {
+                    acc += 0.5 * d2.powf(hurst);
+                }
+            }
+        }
+        acc / (p.len() * q.len()) as f64
+    };
+    let child = |q: usize| (-0.25 + 0.5 * (q / 2) as f64, -0.25 + 0.5 * (q % 2) as f64);
+    let idx: Vec<usize> = (0..NA).filter(|&k| mask & (1 << k) != 0).collect();
+    let n = idx.len();
+    // Coarse-coarse values depend on the offset only: memoised.
+    let mut cc = HashMap::new();
+    let mut g_cc = |a: (isize, isize), b: (isize, isize)| {
+        let d = (a.0 - b.0, a.1 - b.1);
+        *cc.entry(d)
+            .or_insert_with(|| gbar(&pc, &pc, (d.0 as f64, d.1 as f64)))
+    };
+    let mm = n + 1;
+    let mut a = vec![0.0; mm * mm];
+    for (x, &kx) in idx.iter().enumerate() {
+        for (y, &ky) in idx.iter().enumerate() {
+            a[x * mm + y] = g_cc(area_offset(kx), area_offset(ky));
+        }
+        a[x * mm + n] = 1.0;
+        a[n * mm + x] = 1.0;
+    }
+    let g_kc: Vec<Vec<f64>> = (0..4)
+        .map(|q| {
+            let t = child(q);
+            idx.iter()
+                .map(|&k| {
+                    let (dr, dc) = area_offset(k);
+                    gbar(&pc, &pk, (dr as f64 - t.0, dc as f64 - t.1))
+                })
+                .collect()
+        })
+        .collect();
+    let mut e = AreaEntry {
+        w: [[0.0; NA]; 4],
+        l: [0.0; 6],
+    };
+    let mut wq = vec![vec![0.0; n]; 4];
+    for q in 0..4 {
+        let mut rhs = g_kc[q].clone();
+        rhs.push(1.0);
+        let x = solve(a.clone(), rhs, mm);
+        wq[q] = x[..n].to_vec();
+        for (t, &k) in idx.iter().enumerate() {
+            e.w[q][k] = x[t];
+        }
+    }
+    // Cov(e_q, e_r) = sum_a w_qa g(a, r) + sum_b w_rb g(b, q)
+    //               - sum_ab w_qa w_rb g(a, b) - g(q, r).
+    let mut cov = [[0.0; 4]; 4];
+    for q in 0..4 {
+        for rr in 0..4 {
+            let (tq, tr) = (child(q), child(rr));
+            let mut v = -gbar(&pk, &pk, (tq.0 - tr.0, tq.1 - tr.1));
+            for x in 0..n {
+                v += wq[q][x] * g_kc[rr][x] + wq[rr][x] * g_kc[q][x];
+                for y in 0..n {
+                    v -= wq[q][x] * wq[rr][y] * a[x * mm + y];
+                }
+            }
+            cov[q][rr] = v;
+        }
+    }
+    // Cholesky of the leading 3 x 3 block (pivots clamped at 0).
+    let c = &cov;
+    let l00 = c[0][0].max(0.0).sqrt();
+    let inv = |x: f64| if x > 0.0 { 1.0 / x } else { 0.0 };
+    let l10 = c[1][0] * inv(l00);
+    let l11 = (c[1][1] - l10 * l10).max(0.0).sqrt();
+    let l20 = c[2][0] * inv(l00);
+    let l21 = (c[2][1] - l20 * l10) * inv(l11);
+    let l22 = (c[2][2] - l20 * l20 - l21 * l21).max(0.0).sqrt();
+    e.l = [l00, l10, l11, l20, l21, l22];
+    (e, cov)
+}
+
+/// Full-window area tables, one per support model, built on first use.
+pub fn area_full(mi: usize) -> &'static AreaTable {
+    static T: [OnceLock<AreaTable>; N_MODELS] = [OnceLock::new(), OnceLock::new(), OnceLock::new()];
+    T[mi].get_or_init(|| AreaTable::build(mi, AREA_ALL, N_AREA))
+}
+
+type AreaCacheMap = Mutex<HashMap<(usize, u32), Arc<AreaTable>>>;
+
+/// Cut-window tables for `masks` (process-wide cache keyed by model and mask).
+fn area_partial(mi: usize, masks: BTreeSet<u32>) -> HashMap<u32, Arc<AreaTable>> {
+    static C: OnceLock<AreaCacheMap> = OnceLock::new();
+    let cache = C.get_or_init(|| Mutex::new(HashMap::new()));
+    let missing: Vec<u32> = {
+        let c = cache.lock().unwrap_or_else(|e| e.into_inner());
+        masks
+            .iter()
+            .copied()
+            .filter(|m| !c.contains_key(&(mi, *m)))
+            .collect()
+    };
+    let built: Vec<(u32, Arc<AreaTable>)> = missing
+        .into_par_iter()
+        .map(|m| (m, Arc::new(AreaTable::build(mi, m, N_AREA_PARTIAL))))
+        .collect();
+    let mut c = cache.lock().unwrap_or_else(|e| e.into_inner());
+    for (m, t) in built {
+        c.entry((mi, m)).or_insert(t);
+    }
+    masks
+        .into_iter()
+        .filter_map(|m| c.get(&(mi, m)).map(|t| (m, Arc::clone(t))))
+        .collect()
+}
+
+/// Area entry and residual scale for the last `(H, sigma)` seen.
+struct AreaCache {
+    h: f64,
+    s: f64,
+    e: AreaEntry,
+    sd: f64,
+    detail: bool,
+    scale: f64,
+    /// The entry came from the full table (a cut window forces a new lookup).
+    full: bool,
+}
+
+impl AreaCache {
+    fn new(detail: bool, scale: f64) -> Self {
+        AreaCache {
+            h: f64::NAN,
+            s: f64::NAN,
+            e: AreaEntry {
+                w: [[0.0; NA]; 4],
+                l: [0.0; 6],
+            },
+            sd: 0.0,
+            detail,
+            scale,
+            full: false,
+        }
+    }
+    #[inline]
+    fn update(&mut self, t: &AreaTable, h: f64, s: f64) {
+        if !self.full || h.to_bits() != self.h.to_bits() || s.to_bits() != self.s.to_bits() {
+            self.set(t, h, s);
+            self.full = true;
+        }
+    }
+    fn update_uncached(&mut self, t: &AreaTable, h: f64, s: f64) {
+        self.set(t, h, s);
+        self.full = false;
+    }
+    fn set(&mut self, t: &AreaTable, h: f64, s: f64) {
+        self.e = t.at(h);
+        self.sd = noise_sd(self.detail, 1.0, s, h, self.scale);
+        self.h = h;
+        self.s = s;
+    }
 }
 
 #[cfg(test)]
@@ -869,7 +1164,7 @@ mod tests {
     #[test]
     fn weights_sum_to_one_and_are_symmetric() {
         for h in [0.1, 0.5, 0.9] {
-            for which in 0..6 {
+            for which in 0..2 {
                 let (w, sd) = table_at(which, h);
                 let s: f64 = w.iter().sum();
                 assert!((s - 1.0).abs() < 1e-9, "{which} {h} {s}");
@@ -960,6 +1255,65 @@ mod tests {
             }
             let e = 2.0 * i as f64 / 2.0 - 0.5 * j as f64 / 2.0 + 3.0;
             assert!((v - e).abs() < 1e-9, "{i} {j} {v} {e}");
+        }
+    }
+
+    #[test]
+    #[allow(clippy::needless_range_loop)]
+    fn area_joint_draw_matches_point_kriging() {
+        // Children of 1 point: each child's weights and variance equal the
+        // point kriging of `krige` from the 25 window cells (2 x 2 points
+        // each); the joint covariance has rows summing to 0 (the centre cell
+        // fixes the mean) and L L^T reproduces its leading 3 x 3 block.
+        for h in [0.2, 0.5, 0.8] {
+            let (e, cov) = area_solve(1, AREA_ALL, h);
+            let data: Vec<Vec<(f64, f64)>> = (0..NA)
+                .map(|k| {
+                    let (dr, dc) = area_offset(k);
+                    block_pattern(1.0, 2)
+                        .into_iter()
+                        .map(|(y, x)| (y + dr as f64, x + dc as f64))
+                        .collect()
+                })
+                .collect();
+            for q in 0..4 {
+                let t = (-0.25 + 0.5 * (q / 2) as f64, -0.25 + 0.5 * (q % 2) as f64);
+                let (w, v) = krige(&data, t, h);
+                for k in 0..NA {
+                    assert!((w[k] - e.w[q][k]).abs() < 1e-9, "{h} {q} {k}");
+                }
+                assert!(
+                    (v - cov[q][q]).abs() < 1e-9 * v,
+                    "{h} {q} {v} {}",
+                    cov[q][q]
+                );
+                let row: f64 = cov[q].iter().sum();
+                assert!(row.abs() < 1e-9 * v, "{h} {q} {row}");
+            }
+            let l = e.l;
+            let ll = [
+                [l[0] * l[0], l[0] * l[1], l[0] * l[3]],
+                [
+                    l[1] * l[0],
+                    l[1] * l[1] + l[2] * l[2],
+                    l[1] * l[3] + l[2] * l[4],
+                ],
+                [
+                    l[3] * l[0],
+                    l[3] * l[1] + l[4] * l[2],
+                    l[3] * l[3] + l[4] * l[4] + l[5] * l[5],
+                ],
+            ];
+            for a in 0..3 {
+                for b in 0..3 {
+                    assert!((ll[a][b] - cov[a][b]).abs() < 1e-9, "{h} {a} {b}");
+                }
+            }
+        }
+        // Larger child supports: still rank 3 (rows sum to 0).
+        let (_, cov) = area_solve(2, AREA_ALL, 0.7);
+        for row in cov {
+            assert!(row.iter().sum::<f64>().abs() < 1e-9);
         }
     }
 

@@ -1,6 +1,7 @@
 """Fractal resampling of DEMs: finer grids that keep the terrain's roughness."""
 from __future__ import annotations
 
+import functools
 import numbers
 import warnings
 from dataclasses import dataclass
@@ -64,14 +65,69 @@ class ResampleAnalysis:
 
 # ---------------------------------------------------------------- analysis --
 
-def _box_sum(a, half):
-    """Sum over the (2 half + 1)^2 window, per pixel in a fixed order (the
-    value at a pixel depends only on the values inside its window, so blocks
-    of a larger array give bit-identical sums)."""
-    from scipy.ndimage import correlate1d
+#: Spacing (cells) of the nodes where the window sums are computed; the maps
+#: are interpolated bilinearly between them.
+STEP = 8
 
-    w = np.ones(2 * half + 1)
-    return correlate1d(correlate1d(a, w, axis=0, mode="constant"), w, axis=1, mode="constant")
+
+def _pad_width(half, step=STEP):
+    """NaN halo (a multiple of ``step``) the analysis of a block needs: the
+    window, the lag-2 increments and one node spacing for the interpolation."""
+    return -(-(half + 2 + step) // step) * step
+
+
+def _node_sums(a, half, step):
+    """Sums along axis 0 over rows ``[p - half, p + half]`` at the nodes
+    ``p = k step`` whose window fits in ``a``; returns ``(sums, k_first)``.
+
+    Each sum is formed in a fixed order from the values in its window only
+    (blocks of ``step`` rows aligned on the node grid, then the rows left
+    over), so any block of a larger array whose origin is a multiple of
+    ``step`` gives bit-identical sums."""
+    n = a.shape[0]
+    q, rem = divmod(half, step)
+    k0 = -(-half // step)
+    k1 = (n - 3 - half) // step + 1
+    k = np.arange(k0, max(k1, k0))
+    nb = n // step
+    bs = a[0:nb * step:step].copy()
+    for o in range(1, step):
+        bs += a[o:nb * step:step]
+    if q:
+        acc = bs[k - q].copy()
+        for d in range(1, 2 * q):
+            acc += bs[k - q + d]
+    else:
+        acc = np.zeros((k.size,) + a.shape[1:])
+    p = k * step
+    for o in range(-half, -q * step):
+        acc += a[p + o]
+    for o in range(q * step, half + 1):
+        acc += a[p + o]
+    return acc, k0
+
+
+def _interp_nodes(v, k0, lo, hi, step):
+    """Bilinear (along axis 0) interpolation of node values ``v`` (node
+    ``k0 + a`` at row ``(k0 + a) step``) to the rows ``[lo, hi)``, ``lo`` a
+    multiple of ``step`` (rows grouped by node interval: no gathers)."""
+    a0 = lo // step - k0
+    nb = -(-(hi - lo) // step)
+    u = (np.arange(step) / step).reshape((1, step) + (1,) * (v.ndim - 1))
+    out = v[a0:a0 + nb, None] * (1.0 - u)
+    out += v[a0 + 1:a0 + nb + 1, None] * u
+    return out.reshape((nb * step,) + v.shape[1:])[:hi - lo]
+
+
+def _box_sum(a, half, t, step=STEP):
+    """Window sums of ``a`` over ``(2 half + 1)^2`` cells at the nodes of a
+    ``step`` grid, interpolated bilinearly to the pixels of ``a`` trimmed by
+    ``t`` (a value depends only on the values in the windows of its 4 nodes,
+    computed in a fixed order)."""
+    r, k0 = _node_sums(a, half, step)
+    c, k1 = _node_sums(np.ascontiguousarray(r.T), half, step)
+    v = _interp_nodes(c, k1, t, a.shape[1] - t, step).T
+    return _interp_nodes(np.ascontiguousarray(v), k0, t, a.shape[0] - t, step)
 
 
 def _block_variogram(hurst, lag, n=2):
@@ -95,37 +151,44 @@ def _block_variogram(hurst, lag, n=2):
 _H_TABLE = np.linspace(0.001, 1.5, 1500)
 
 
+@functools.lru_cache(maxsize=8)
 def _ratio_table(n):
+    """``(H, gamma_B(2) / gamma_B(1), gamma_B(1))`` on ``_H_TABLE``."""
     h = _H_TABLE
-    return h, _block_variogram(h, 2.0, n) / _block_variogram(h, 1.0, n)
+    g1 = _block_variogram(h, 1.0, n)
+    return h, _block_variogram(h, 2.0, n) / g1, g1
 
 
-def _analyse_padded(z, half, support, block=2):
-    """Local maps on a NaN-padded block; returns raw H and the lag-1 point
-    variance, both trimmed by ``half + 2``."""
+def _analyse_padded(z, half, support, block=2, step=STEP):
+    """Local maps on a NaN-padded block whose origin is a multiple of
+    ``step``; returns raw H and the lag-1 point variance, both trimmed by
+    ``_pad_width(half, step)``."""
+    t = _pad_width(half, step)
     m = np.isfinite(z)
     zz = np.where(m, z, 0.0)
-    g = []
-    for lag in (1, 2):
-        s = np.zeros(z.shape)
-        c = np.zeros(z.shape)
-        for axis in (0, 1):
-            sl_a = [slice(None)] * 2
-            sl_b = [slice(None)] * 2
-            sl_a[axis] = slice(lag, None)
-            sl_b[axis] = slice(None, -lag)
-            d = zz[tuple(sl_a)] - zz[tuple(sl_b)]
-            ok = m[tuple(sl_a)] & m[tuple(sl_b)]
-            # Increment assigned to its first sample.
-            s[tuple(sl_b)] += np.where(ok, d * d, 0.0)
-            c[tuple(sl_b)] += ok
-        g.append((_box_sum(s, half), _box_sum(c, half)))
-    t = half + 2
+    n0 = z.shape[0]
+    sums = {lag: (np.zeros(z.shape), np.zeros(z.shape)) for lag in (1, 2)}
+    # Squared increments (each assigned to its first sample), rows then
+    # columns, in strips of rows so that the temporaries stay small.
+    for r0 in range(0, n0, 256):
+        r1 = min(r0 + 256, n0)
+        for lag, (s, c) in sums.items():
+            e = min(r1, n0 - lag)
+            if e > r0:
+                ok = m[r0 + lag:e + lag] & m[r0:e]
+                d = zz[r0 + lag:e + lag] - zz[r0:e]
+                s[r0:e] += np.where(ok, d * d, 0.0)
+                c[r0:e] += ok
+            ok = m[r0:r1, lag:] & m[r0:r1, :-lag]
+            d = zz[r0:r1, lag:] - zz[r0:r1, :-lag]
+            s[r0:r1, :-lag] += np.where(ok, d * d, 0.0)
+            c[r0:r1, :-lag] += ok
+    g = [(_box_sum(s, half, t, step), _box_sum(c, half, t, step)) for s, c in sums.values()]
     core = (slice(t, z.shape[0] - t), slice(t, z.shape[1] - t))
     (s1, c1), (s2, c2) = g
     with np.errstate(divide="ignore", invalid="ignore"):
-        g1 = (s1 / c1)[core]
-        g2 = (s2 / c2)[core]
+        g1 = s1 / c1
+        g2 = s2 / c2
         ratio = g2 / g1
     ok = np.isfinite(ratio) & (g1 > 0)
     if support == "point":
@@ -134,11 +197,11 @@ def _analyse_padded(z, half, support, block=2):
     else:
         # Block means: invert the regularised variogram ratio for H, then
         # sigma^2 = g1 / gamma_block(1; H).
-        hh, rr = _ratio_table(block)
+        hh, rr, g1tab = _ratio_table(block)
         hraw = np.where(ok, np.interp(np.where(ok, ratio, 1.0), rr, hh, left=-1.0, right=9.0), np.nan)
         hraw = np.where(hraw == -1.0, 0.0, np.where(hraw == 9.0, 2.0, hraw))
         hc = np.clip(np.where(ok, hraw, 0.5), *HURST_RANGE)
-        var1 = np.where(ok, g1 / _block_variogram(hc, 1.0, block), np.nan)
+        var1 = np.where(ok, g1 / np.interp(hc, hh, g1tab), np.nan)
     # An interior pixel of the core is only valid if it was a valid sample.
     hraw = np.where(m[core], hraw, np.nan)
     return hraw, var1
@@ -217,7 +280,7 @@ def resample_analysis(dem, *, window=33, support="point", block=2, nodata=None):
     z = _as_float(dem, nodata)
     window = _check_window(window, z.shape)
     half = window // 2
-    t = half + 2
+    t = _pad_width(half)
     zp = np.pad(z, t, constant_values=np.nan)
     hraw, var1 = _analyse_padded(zp, half, support, block)
     hurst, sigma, frac = _finish(hraw, var1, np.isfinite(z))
@@ -237,10 +300,11 @@ def _as_float(dem, nodata):
         raise ValueError(f"dem: expected a 2D array, got shape {z.shape}")
     if not (np.issubdtype(z.dtype, np.number) and not np.issubdtype(z.dtype, np.complexfloating)):
         raise TypeError(f"dem: expected a real numeric array, got dtype {z.dtype}")
-    z = z.astype(np.float64, copy=True)
+    # No copy unless needed: nothing downstream writes into ``z``.
+    z = np.ascontiguousarray(z, dtype=np.float64)
     nodata = check_nodata(nodata)
     if nodata is not None and not np.isnan(nodata):
-        z[z == nodata] = np.nan
+        z = np.where(z == nodata, np.nan, z)
     return z
 
 
@@ -265,9 +329,7 @@ def _param_map(value, name, shape, lo, hi, lo_open, hi_open):
     if isinstance(value, bool):
         raise TypeError(f"{name}: expected a number or an array, got {value!r}")
     a = as_array(value, name).astype(np.float64)
-    if a.ndim == 0:
-        a = np.full(shape, float(a))
-    elif a.shape != shape:
+    if a.ndim != 0 and a.shape != shape:
         raise ValueError(f"{name}: expected a number or an array of shape {shape}, got {a.shape}")
     f = a[np.isfinite(a)]
     bad = (f <= lo if lo_open else f < lo).any() | (f >= hi if hi_open else f > hi).any()
@@ -276,7 +338,10 @@ def _param_map(value, name, shape, lo, hi, lo_open, hi_open):
         rb = ")" if hi_open else "]"
         raise ValueError(f"{name}: expected values in {lb}{lo}, {hi}{rb}, got "
                          f"min {np.nanmin(a):.4g}, max {np.nanmax(a):.4g}")
-    return np.ascontiguousarray(a)
+    if a.ndim == 0:
+        # A read-only broadcast view (no memory of the DEM's size).
+        return np.broadcast_to(a, shape)
+    return a if a.strides == (0, 0) else np.ascontiguousarray(a)
 
 
 def _cell_size(cell_size, dem):
@@ -465,8 +530,12 @@ def run_numpy(dem, levels, hurst, sigma, window, detail, support, nodata, seed, 
     _check_memory(z.shape, 1 << levels)
     local_h = isinstance(hurst, str) and hurst == "local"
     local_s = isinstance(sigma, str) and sigma == "local"
-    an = _maps(z, hurst, sigma, window, support, local_h, local_s)
-    out = _core.fractal_resample(z, an.hurst, an.sigma, levels, support == "area", seed, detail,
+    an = _maps(z, hurst, sigma, window, support, local_h, local_s, min(1 << levels, 8))
+    h, s = an.hurst, an.sigma
+    if h.strides == (0, 0) and s.strides == (0, 0):
+        # Constant maps: the kernel takes them as 1 x 1.
+        h, s = np.ascontiguousarray(h[:1, :1]), np.ascontiguousarray(s[:1, :1])
+    out = _core.fractal_resample(z, h, s, levels, support == "area", seed, detail,
                                  (0, 0), z.shape[1], n_threads)
     return out, an
 
@@ -476,14 +545,16 @@ def _check_shape(shape):
         raise ValueError(f"dem: the kriging stencil needs at least 4 x 4 samples, got {shape}")
 
 
-def _maps(z, hurst, sigma, window, support, local_h, local_s):
+def _maps(z, hurst, sigma, window, support, local_h, local_s, block=2):
     frac = 0.0
     if local_h or local_s:
-        a = resample_analysis(z, window=window, support=support)
+        a = resample_analysis(z, window=window, support=support, block=block)
         h_map, s_map, frac = a.hurst, a.sigma, a.fraction_clipped
     h = h_map if local_h else _param_map(hurst, "hurst", z.shape, 0.0, 1.0, True, True)
     s = s_map if local_s else _param_map(sigma, "sigma", z.shape, 0.0, np.inf, False, False)
-    return ResampleAnalysis(np.ascontiguousarray(h), np.ascontiguousarray(s), frac,
+    if (h.strides == (0, 0)) != (s.strides == (0, 0)):
+        h, s = np.ascontiguousarray(h), np.ascontiguousarray(s)
+    return ResampleAnalysis(h, s, frac,
                             window if (local_h or local_s) else 0)
 
 

@@ -16,7 +16,7 @@ def _out_bounds(a, b, n, f, point):
     return f * a, f * b
 
 
-def _analysis_maps(dem, hurst, sigma, window, support, nodata):
+def _analysis_maps(dem, hurst, sigma, window, support, nodata, block=2):
     """Hurst and sigma maps as dask arrays chunked like ``dem``."""
     import dask.array as da
 
@@ -24,17 +24,18 @@ def _analysis_maps(dem, hurst, sigma, window, support, nodata):
     local_s = isinstance(sigma, str) and sigma == "local"
     if local_h or local_s:
         half = window // 2
-        t = half + 2
+        t = R._pad_width(half)
 
-        def block(b):
-            hraw, var1 = R._analyse_padded(b, half, support)
+        def block_fn(b):
+            hraw, var1 = R._analyse_padded(b, half, support, block)
             core = b[t:-t, t:-t] if t else b
             h, s, _ = R._finish(hraw, var1, np.isfinite(core))
             return np.stack([h, s])
 
         z = dem.map_blocks(R._as_float, nodata, dtype=np.float64)
-        padded, core = halo_blocks(z, t)
-        hs = padded.map_blocks(block, dtype=np.float64, new_axis=0,
+        # Chunks on multiples of the node step: the nodes sit on one global grid.
+        padded, core = halo_blocks(z, t, R.STEP)
+        hs = padded.map_blocks(block_fn, dtype=np.float64, new_axis=0,
                                chunks=((2,),) + core)
         h_map, s_map = hs[0], hs[1]
     shape = dem.shape
@@ -56,7 +57,7 @@ def run_dask(dem, levels, hurst, sigma, window, detail, support, nodata, seed, n
     R._check_shape(dem.shape)
     f = 1 << levels
     point = support == "point"
-    h_map, s_map = _analysis_maps(dem, hurst, sigma, window, support, nodata)
+    h_map, s_map = _analysis_maps(dem, hurst, sigma, window, support, nodata, min(f, 8))
     n0, n1 = dem.shape
     halo = R._HALO
     row_edges = np.concatenate([[0], np.cumsum(dem.chunks[0])])
