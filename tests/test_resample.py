@@ -123,10 +123,10 @@ def test_dask_equals_memory_for_any_chunking():
     z = fg.fbm_surface(70, 0.6, method="exact", seed=3)
     z[30:33, 5:9] = np.nan
     for support in ("point", "area"):
-        ref = fg.fractal_resample(z, 4, seed=2, support=support, window=9)
+        ref = fg.fractal_resample(z, 4, seed=2, support=support, window_size=9)
         for chunks in ((20, 30), (70, 13), (35, 70)):
             out = fg.fractal_resample(da.from_array(z, chunks=chunks), 4, seed=2,
-                                      support=support, window=9)
+                                      support=support, window_size=9)
             got = out.compute()
             assert got.shape == ref.shape
             np.testing.assert_array_equal(got, ref)
@@ -155,7 +155,7 @@ def test_analysis_matches_a_direct_window_fit():
 
     z = fg.fbm_surface(48, 0.6, method="exact", seed=4)
     z[5, 7] = np.nan
-    a = resample_analysis(z, window=9)
+    a = resample_analysis(z, window_size=9)
 
     def window_sums(p, q, k):
         s = c = 0.0
@@ -209,7 +209,7 @@ def test_real_dem_rougher_than_bicubic(name):
     (dict(min_scale=-1.0), ValueError, "min_scale"),
     (dict(cell_size=float("inf")), ValueError, "cell_size"),
     (dict(support="block"), ValueError, "support"),
-    (dict(window=4), ValueError, "window"),
+    (dict(window_size=4), ValueError, "window_size"),
     (dict(seed=-1), ValueError, "seed"),
 ])
 def test_bad_input(kw, exc, word):
@@ -234,10 +234,14 @@ def test_bad_dem():
 def test_docstring_examples_run():
     import doctest
 
-    from fractalgeo_rs.dem import _resample
+    from fractalgeo_rs.dem import _resample, _resample_api
 
-    res = doctest.testmod(_resample, optionflags=doctest.ELLIPSIS)
-    assert res.failed == 0 and res.attempted >= 4
+    attempted = 0
+    for mod in (_resample, _resample_api):
+        res = doctest.testmod(mod, optionflags=doctest.ELLIPSIS)
+        assert res.failed == 0
+        attempted += res.attempted
+    assert attempted >= 4
 
 
 @pytest.mark.slow
@@ -249,15 +253,15 @@ def test_dask_local_analysis_with_chunks_smaller_than_its_halo():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         for chunks, window in [(10, 33), ((5, 7), 9), ((61, 4), 9)]:
-            ref = fg.fractal_resample(z, 2, seed=1, window=window)
-            got = fg.fractal_resample(da.from_array(z, chunks=chunks), 2, seed=1, window=window).compute()
+            ref = fg.fractal_resample(z, 2, seed=1, window_size=window)
+            got = fg.fractal_resample(da.from_array(z, chunks=chunks), 2, seed=1, window_size=window).compute()
             np.testing.assert_array_equal(got, ref)
 
 
 def test_window_larger_than_twice_the_dem_is_a_value_error():
     z = fg.fbm_surface((33, 33), 0.5, method="exact", seed=1)
     with pytest.raises(ValueError, match="^window"):
-        fg.fractal_resample(z, 2, window=10**6 + 1)
+        fg.fractal_resample(z, 2, window_size=10**6 + 1)
 
 
 @pytest.mark.parametrize("h", [0.5, 0.7])

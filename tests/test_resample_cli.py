@@ -35,7 +35,7 @@ def test_resample_geotiff(tmp_path, capsys):
         # Point support: fine pixel (0, 0) has the centre of input pixel (0, 0).
         assert d.transform.c + 3.75 == pytest.approx(1015.0)
     np.testing.assert_array_equal(out[::4, ::4], z)
-    ref = fg.fractal_resample(z.astype(float), 4, seed=1, window=9, cell_size=30.0, min_scale=10)
+    ref = fg.fractal_resample(z.astype(float), 4, seed=1, window_size=9, cell_size=30.0, min_scale=10)
     np.testing.assert_allclose(out, ref.astype(np.float32))
 
 

@@ -72,6 +72,7 @@ def _run_resample(args: argparse.Namespace) -> int:
 
     from fractalgeo_rs._validation import atomic_write_path, check_positive_int
     from fractalgeo_rs.dem import _resample as R
+    from fractalgeo_rs.synth._common import resolve_seed
     from fractalgeo_rs.io import read_raster
 
     hurst = _number_or_local(args.hurst, "hurst")
@@ -89,7 +90,7 @@ def _run_resample(args: argparse.Namespace) -> int:
     if not np.isfinite(z).any():
         raise ValueError("dem: every sample is NaN or nodata")
     detail = R._detail(levels, cell, args.min_scale)
-    seed = R.resolve_seed(args.seed)
+    seed = resolve_seed(args.seed)
     an = R._maps(z, hurst, sigma, R._check_window(args.window), args.support,
                  hurst == "local", sigma == "local", min(1 << levels, 8))
     from fractalgeo_rs.dem._resample_dask import run_dask

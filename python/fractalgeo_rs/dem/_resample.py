@@ -9,10 +9,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from fractalgeo_rs import _core
-from fractalgeo_rs._validation import as_array, check_choice, check_memory, check_n_threads, check_nodata
-from fractalgeo_rs.synth._common import resolve_seed
+from fractalgeo_rs._compat import renamed_parameters
+from fractalgeo_rs._validation import as_array, check_choice, check_memory, check_nodata
 
-__all__ = ["fractal_resample", "resample_analysis", "ResampleAnalysis", "HURST_RANGE"]
+__all__ = ["resample_analysis", "ResampleAnalysis", "HURST_RANGE"]
 
 #: Range the ``"local"`` Hurst map is clipped to (real DEMs are locally
 #: smoother than any fBm at the pixel scale: the lag-1/lag-2 fit gives H > 1).
@@ -50,7 +50,7 @@ class ResampleAnalysis:
     --------
     >>> import fractalgeo_rs as fg
     >>> z = fg.fbm_surface(128, 0.6, method="exact", seed=3)
-    >>> a = fg.dem.resample_analysis(z, window=33)
+    >>> a = fg.dem.resample_analysis(z, window_size=33)
     >>> a.hurst.shape, a.window, a.fraction_clipped
     ((128, 128), 33, 0.0)
     >>> round(float(a.hurst[64, 64]), 2), round(float(a.sigma[64, 64]), 2)  # fBm of H = 0.6, sigma = 1
@@ -219,19 +219,20 @@ def _finish(hraw, var1, valid):
 
 def _check_window(window, shape=None):
     if isinstance(window, bool) or not isinstance(window, numbers.Integral):
-        raise TypeError(f"window: expected an odd int >= 5, got {window!r}")
+        raise TypeError(f"window_size: expected an odd int >= 5, got {window!r}")
     if window < 5 or window % 2 == 0:
-        raise ValueError(f"window: expected an odd int >= 5, got {window}")
+        raise ValueError(f"window_size: expected an odd int >= 5, got {window}")
     if shape is not None and window > 2 * max(shape) + 1:
-        raise ValueError(f"window: {window} is more than twice the DEM's side {max(shape)}; "
+        raise ValueError(f"window_size: {window} is more than twice the DEM's side {max(shape)}; "
                          f"a window of at most {2 * max(shape) + 1} already covers it")
     return int(window)
 
 
-def resample_analysis(dem, *, window=33, support="point", block=2, nodata=None):
+@renamed_parameters({"window": "window_size"}, since="0.2.0")
+def resample_analysis(dem, *, window_size=33, support="point", block=2, nodata=None):
     r"""Local Hurst exponent and increment scale of a DEM.
 
-    Over each ``window x window`` window, the mean squared increments at lags
+    Over each ``window_size x window_size`` window, the mean squared increments at lags
     1 and 2 cells (rows and columns pooled, NaN-free pairs only) give
     :math:`H = \tfrac12 \log_2(\gamma_2 / \gamma_1)` and
     :math:`\sigma^2 = \gamma_1`: the variogram map of
@@ -247,8 +248,9 @@ def resample_analysis(dem, *, window=33, support="point", block=2, nodata=None):
     ----------
     dem : array_like, shape (rows, cols)
         Heights; NaN and ``nodata`` are missing. Not modified.
-    window : int, default 33
-        Odd window side in cells (>= 5).
+    window_size : int, default 33
+        Odd window side in cells (>= 5). (Called ``window`` before 0.2.0;
+        the old keyword still works, with a DeprecationWarning.)
     support : {"point", "area"}, default "point"
         ``"point"``: the heights are point samples; ``"area"``: each cell is
         the mean height over its area (block-mean variogram model).
@@ -272,13 +274,13 @@ def resample_analysis(dem, *, window=33, support="point", block=2, nodata=None):
     --------
     >>> import numpy as np, fractalgeo_rs as fg
     >>> z = fg.fbm_surface(128, 0.6, method="exact", seed=3)
-    >>> a = fg.dem.resample_analysis(z, window=33)
+    >>> a = fg.dem.resample_analysis(z, window_size=33)
     >>> round(float(a.hurst[64, 64]), 3), round(float(np.median(a.hurst)), 3)  # fBm of H = 0.6
     (0.593, 0.585)
     """
     check_choice(support, "support", ("point", "area"))
     z = _as_float(dem, nodata)
-    window = _check_window(window, z.shape)
+    window = _check_window(window_size, z.shape)
     half = window // 2
     t = _pad_width(half)
     zp = np.pad(z, t, constant_values=np.nan)
@@ -397,130 +399,6 @@ def _coord_step(da):
     return None
 
 
-def fractal_resample(dem, factor=2, *, hurst="local", sigma="local", window=33, min_scale=None,
-                     support="point", cell_size=None, nodata=None, seed=None, n_threads=None,
-                     return_analysis=False):
-    r"""Resample a DEM on a grid ``factor`` times finer with fractal detail.
-
-    The method of the seed paper's section 4.1 (figure 5): the DEM is
-    analysed for its local Hurst exponent ``H`` and increment scale
-    ``sigma`` (:func:`~fractalgeo_rs.dem.resample_analysis`), then refined in x2 levels. Each
-    new sample is the conditional (intrinsic kriging) mean of fBm with the
-    variogram :math:`\gamma(d) = \sigma^2 d^{2H} / 2` (``d`` in input cells)
-    given the 16 nearest samples of the current level, plus an independent
-    Gaussian residual with the kriging variance; at level ``l`` (coarse
-    spacing :math:`2^{-l}` cells) that variance scales by :math:`2^{-2Hl}`.
-    Point support uses the diamond step (cell centres from the 4 x 4 coarse
-    samples around them) then the square step (edge midpoints from the 16
-    nearest samples of the 45-degree lattice); the weights and variances are
-    tabulated once on 201 values of ``H`` in [0.01, 0.99] and interpolated.
-    The 16-sample stencil leaves no dyadic creases (crease ratio of
-    :func:`fractalgeo_rs.validate_surface` about 1.0; see
-    docs/resampling.md). Pointwise the result is one sample of the
-    conditional distribution, so its RMSE against the truth is about
-    :math:`\sqrt 2` times the kriging error: the method keeps statistics
-    (variance at every lag, ``H``, spectrum), not pointwise accuracy.
-
-    Parameters
-    ----------
-    dem : array_like, dask.array.Array or xarray.DataArray, shape (rows, cols)
-        Heights. NaN and ``nodata`` are holes. Not modified.
-    factor : int, default 2
-        Power of 2, at least 2.
-    hurst : "local", float or array, default "local"
-        ``H`` in (0, 1): a number, a map on the input grid, or ``"local"``
-        (estimated by :func:`~fractalgeo_rs.dem.resample_analysis` over ``window``, clipped to
-        ``HURST_RANGE`` = (0.05, 0.95)).
-    sigma : "local", float or array, default "local"
-        Standard deviation (height units) of the point increments at a lag of
-        one input cell, >= 0; ``"local"`` as for ``hurst``.
-    window : int, default 33
-        Window side (cells) of the ``"local"`` analysis.
-    min_scale : float, optional
-        Ground units (those of ``cell_size``): levels producing cells smaller
-        than this get the conditional mean only, no random detail. Default
-        None: detail at every level (the scale below which a landscape stops
-        being self-similar depends on the processes; the seed paper names
-        gravity, diffusion and vegetation).
-    support : {"point", "area"}, default "point"
-        ``"point"``: samples are point heights; the output has shape
-        ``(factor (rows - 1) + 1, factor (cols - 1) + 1)`` and keeps sample
-        ``(i, j)`` exactly at ``(factor i, factor j)``. ``"area"``: cells
-        are block means; the output has shape ``(factor rows, factor cols)``
-        and the mean of each ``factor x factor`` block equals the input cell
-        (to 1e-9 relative).
-    cell_size : float, optional
-        Ground size of an input cell (default: from xarray coords, else 1).
-    nodata : float, optional
-        Value marking holes, in addition to NaN.
-    seed : int, optional
-        Random seed (None: a fresh one). The noise is keyed by position, so
-        the result does not depend on ``n_threads`` or on Dask chunks.
-    n_threads : int, optional
-        Threads (default all cores).
-    return_analysis : bool, default False
-        Also return the :class:`~fractalgeo_rs.dem.ResampleAnalysis` used (the maps actually
-        passed to the kernel).
-
-    Returns
-    -------
-    ndarray of float64 (or the input's dask/xarray type)
-        The finer DEM. Holes: a new point-support sample is NaN when one of
-        its 4 nearest old samples is; an area-support cell is NaN when its
-        input cell is. Samples outside the grid or in holes are left out of
-        the other samples' stencils (weights solved for the samples present),
-        so nothing leaks from holes. With ``return_analysis``, a pair.
-
-    Notes
-    -----
-    The kriging given the current level's 16 samples approximates the full
-    conditional distribution; on fBm the empirical mean and variance of
-    many resamplings at a new point match the exact dense kriging to within
-    the tolerances stated in docs/resampling.md. xarray input returns new
-    cell-centre coords; Dask input is computed chunk by chunk with a halo of
-    8 input cells (plus the analysis window) and equals the in-memory result
-    bit for bit.
-
-    References
-    ----------
-    Mandelbrot, B. B., Van Ness, J. W. (1968). *SIAM Review* 10(4), 422-437.
-    https://doi.org/10.1137/1010093. Chilès, J.-P., Delfiner, P. (2012).
-    *Geostatistics: Modeling Spatial Uncertainty*, 2nd ed., Wiley, ch. 4
-    (intrinsic kriging). https://doi.org/10.1002/9781118136188
-
-    Examples
-    --------
-    >>> import numpy as np, fractalgeo_rs as fg
-    >>> z = fg.fbm_surface(65, 0.7, method="exact", seed=1)
-    >>> fine = fg.fractal_resample(z, 4, hurst=0.7, sigma=1.0, seed=2)
-    >>> fine.shape
-    (257, 257)
-    >>> bool(np.array_equal(fine[::4, ::4], z))
-    True
-    """
-    levels = _levels(factor)
-    f = 1 << levels
-    check_choice(support, "support", ("point", "area"))
-    n_threads = check_n_threads(n_threads)
-    seed = resolve_seed(seed)
-    cell = _cell_size(cell_size, dem)
-    detail = _detail(levels, cell, min_scale)
-    local_h = isinstance(hurst, str) and hurst == "local"
-    local_s = isinstance(sigma, str) and sigma == "local"
-    if local_h or local_s:
-        window = _check_window(window, np.shape(dem))
-    if _is_xarray(dem):
-        return _run_xarray(dem, f, levels, hurst, sigma, window, detail, support, cell, nodata,
-                           seed, n_threads, return_analysis)
-    if _is_dask(dem):
-        from fractalgeo_rs.dem._resample_dask import run_dask
-
-        return run_dask(dem, levels, hurst, sigma, window, detail, support, nodata, seed,
-                        n_threads, return_analysis)
-    out, an = run_numpy(dem, levels, hurst, sigma, window, detail, support, nodata, seed, n_threads)
-    return (out, an) if return_analysis else out
-
-
 def run_numpy(dem, levels, hurst, sigma, window, detail, support, nodata, seed, n_threads):
     """In-memory run on checked options; returns ``(out, analysis)``."""
     z = _as_float(dem, nodata)
@@ -548,7 +426,7 @@ def _check_shape(shape):
 def _maps(z, hurst, sigma, window, support, local_h, local_s, block=2):
     frac = 0.0
     if local_h or local_s:
-        a = resample_analysis(z, window=window, support=support, block=block)
+        a = resample_analysis(z, window_size=window, support=support, block=block)
         h_map, s_map, frac = a.hurst, a.sigma, a.fraction_clipped
     h = h_map if local_h else _param_map(hurst, "hurst", z.shape, 0.0, 1.0, True, True)
     s = s_map if local_s else _param_map(sigma, "sigma", z.shape, 0.0, np.inf, False, False)
@@ -556,32 +434,6 @@ def _maps(z, hurst, sigma, window, support, local_h, local_s, block=2):
         h, s = np.ascontiguousarray(h), np.ascontiguousarray(s)
     return ResampleAnalysis(h, s, frac,
                             window if (local_h or local_s) else 0)
-
-
-def _run_xarray(da, f, levels, hurst, sigma, window, detail, support, cell, nodata, seed,
-                n_threads, return_analysis):
-    import xarray as xr
-
-    if da.ndim != 2:
-        raise ValueError(f"dem: expected a 2D DataArray, got dims {da.dims}")
-    data = da.data
-    if _is_dask(data):
-        from fractalgeo_rs.dem._resample_dask import run_dask
-
-        r = run_dask(data, levels, hurst, sigma, window, detail, support, nodata, seed,
-                     n_threads, return_analysis)
-        out, an = (r if return_analysis else (r, None))
-    else:
-        out, an = run_numpy(np.asarray(data), levels, hurst, sigma, window, detail, support,
-                            nodata, seed, n_threads)
-    ydim, xdim = da.dims
-    coords = {}
-    for dim, n_out in ((ydim, out.shape[0]), (xdim, out.shape[1])):
-        if dim in da.coords:
-            c = np.asarray(da[dim].values, dtype=float)
-            coords[dim] = fine_coords(c, f, support)
-    res = xr.DataArray(out, dims=da.dims, coords=coords, attrs=dict(da.attrs), name=da.name)
-    return (res, an) if return_analysis else res
 
 
 def fine_coords(c, f, support):
