@@ -15,11 +15,10 @@
 //! tables built per band of rows at fixed positions (as in
 //! [`super::variation`]), so the cost per pixel does not grow with the window
 //! and the result does not depend on the thread count.
-use super::sat::{band_rows, check_window, rect, sat_into, sats_into};
-use crate::checks::step_grid;
+use super::driver::{valid_sat, Grid, MapOut};
+use super::sat::{rect, sat_into, sats_into};
 use crate::dimension::dbc::Sample;
 use crate::error::{CoreError, CoreResult};
-use rayon::prelude::*;
 
 const DIRS: [(isize, isize); 4] = [(0, 1), (1, 0), (1, 1), (1, -1)];
 
@@ -246,18 +245,6 @@ pub struct GlsOptions {
     pub anisotropy: bool,
 }
 
-/// Maps of the GLS fit on the `step` grid.
-#[derive(Debug, Clone, Default)]
-pub struct GlsMaps {
-    /// `H` per window.
-    pub hurst: Vec<f32>,
-    /// Standard error of `H`.
-    pub se: Vec<f32>,
-    /// Anisotropy direction (degrees) and ratio (empty unless asked).
-    pub angle: Vec<f32>,
-    pub ratio: Vec<f32>,
-}
-
 /// `ln` of positive finite values in place: a polynomial (atanh series to
 /// `s^13`, relative error below 1e-10) the compiler vectorises, with the
 /// library `ln` for the rare subnormal values.
@@ -300,26 +287,19 @@ fn fast_ln_matches_the_library() {
     assert_eq!(t, vec![(1e-310f64).ln(), 2f64.ln()]);
 }
 
-/// `n_bands` chunks of `chunk` values of `v`, or empty slices when `v` is empty.
-fn split_bands(v: &mut [f32], chunk: usize, n_bands: usize) -> Vec<&mut [f32]> {
-    if v.is_empty() {
-        (0..n_bands).map(|_| <&mut [f32]>::default()).collect()
-    } else {
-        v.chunks_mut(chunk).collect()
-    }
-}
-
 /// Moving-window GLS Hurst exponent (see the module docs); NaN where the
 /// window has too few valid pixels or a filter has no valid increment.
+/// Maps: `d` the Hurst exponent, `r2` its standard error, `extra` the
+/// anisotropy direction and ratio (empty unless asked).
 pub fn gls_transform<T: Sample>(
     z: &[T],
     rows: usize,
     cols: usize,
     opt: &GlsOptions,
     tab: &GlsTables,
-) -> CoreResult<GlsMaps> {
+) -> CoreResult<MapOut> {
     let w = opt.window;
-    let min_pixels = check_window(z.len(), rows, cols, w, opt.min_valid)?;
+    let grid = Grid::new(z.len(), rows, cols, w, opt.min_valid, opt.step)?;
     let k = opt.dilations;
     if k == 0 || 4 * k >= w {
         return Err(CoreError::invalid(
@@ -333,19 +313,7 @@ pub fn gls_transform<T: Sample>(
     let fl = filters(k);
     let nf = fl.len();
     tab.check(nf)?;
-    let step = opt.step;
-    let (orows, ocols) = step_grid(step, rows, cols)?;
-    let h = w / 2;
-    let ob = (band_rows(w) / step).max(1);
-    let n_out = orows * ocols;
-    let nan_map =
-        |on: bool| crate::buffers::try_filled(if on { n_out } else { 0 }, f32::NAN, "image");
-    let mut maps = GlsMaps {
-        hurst: nan_map(true)?,
-        se: nan_map(true)?,
-        angle: nan_map(opt.anisotropy)?,
-        ratio: nan_map(opt.anisotropy)?,
-    };
+    let (ocols, min_pixels) = (grid.ocols, grid.min_pixels);
     let full = (w * w) as f64;
     let polys = tab.step_polys(nf);
     #[derive(Default)]
@@ -354,133 +322,110 @@ pub fn gls_transform<T: Sample>(
         power: Vec<Vec<f64>>,
         count: Vec<Vec<f64>>,
     }
-    let chunk = ob * ocols;
-    let n_bands = orows.div_ceil(ob);
-    // the anisotropy maps split like the others (empty slices when not asked)
-    let (mut angle, mut ratio) = (
-        std::mem::take(&mut maps.angle),
-        std::mem::take(&mut maps.ratio),
-    );
-    let mut aparts = split_bands(&mut angle, chunk, n_bands);
-    let mut rparts = split_bands(&mut ratio, chunk, n_bands);
-    maps.hurst
-        .par_chunks_mut(chunk)
-        .zip(maps.se.par_chunks_mut(chunk))
-        .zip(aparts.par_iter_mut())
-        .zip(rparts.par_iter_mut())
-        .enumerate()
-        .for_each_init(
-            Scratch::default,
-            |sc, (band, (((hout, sout), aout), rout))| {
-                let g0 = band * ob;
-                let g1 = (g0 + ob).min(orows);
-                let i0 = (g0 * step).saturating_sub(h);
-                let i1 = ((g1 - 1) * step + h + 1).min(rows);
-                let nr = i1 - i0;
-                let sw = cols + 1;
-                let get = |r: usize, c: usize| z[(i0 + r) * cols + c].to_f64();
-                sat_into(&mut sc.vsat, nr, cols, |r, c| {
-                    (!get(r, c).is_nan()) as u8 as f64
-                });
-                // a band without missing samples needs no count tables
-                let complete = sc.vsat[nr * sw + cols] == (nr * cols) as f64;
-                sc.power.resize_with(nf, Vec::new);
-                sc.count.resize_with(nf, Vec::new);
-                for (fi, f) in fl.iter().enumerate() {
-                    let inc = |r: usize, c: usize| -> f64 {
-                        if r + f.span.0 >= nr || c + f.span.1 >= cols {
-                            return f64::NAN;
-                        }
-                        let mut d = 0.0;
-                        for &(dr, dc, wt) in &f.taps[..f.n_taps] {
-                            d += wt * get(r + dr, c + dc);
-                        }
-                        d
-                    };
-                    if complete {
-                        sat_into(&mut sc.power[fi], nr, cols, |r, c| {
-                            let d = inc(r, c);
-                            if d.is_nan() {
-                                0.0
-                            } else {
-                                d * d
-                            }
-                        });
+    let an = opt.anisotropy;
+    let mut maps = grid.drive(&[true, true, an, an], |sc: &mut Scratch, band, outs| {
+        let (i0, nr) = (band.i0, band.nr());
+        let sw = cols + 1;
+        let get = |r: usize, c: usize| z[(i0 + r) * cols + c].to_f64();
+        valid_sat(&mut sc.vsat, band, cols, get);
+        // a band without missing samples needs no count tables
+        let complete = sc.vsat[nr * sw + cols] == (nr * cols) as f64;
+        sc.power.resize_with(nf, Vec::new);
+        sc.count.resize_with(nf, Vec::new);
+        for (fi, f) in fl.iter().enumerate() {
+            let inc = |r: usize, c: usize| -> f64 {
+                if r + f.span.0 >= nr || c + f.span.1 >= cols {
+                    return f64::NAN;
+                }
+                let mut d = 0.0;
+                for &(dr, dc, wt) in &f.taps[..f.n_taps] {
+                    d += wt * get(r + dr, c + dc);
+                }
+                d
+            };
+            if complete {
+                sat_into(&mut sc.power[fi], nr, cols, |r, c| {
+                    let d = inc(r, c);
+                    if d.is_nan() {
+                        0.0
                     } else {
-                        let (p, n) = (&mut sc.power[fi], &mut sc.count[fi]);
-                        sats_into([p, n], nr, cols, |r, c| {
-                            let d = inc(r, c);
-                            if d.is_nan() {
-                                [0.0, 0.0]
-                            } else {
-                                [d * d, 1.0]
-                            }
-                        });
+                        d * d
                     }
-                }
-                // one output row at a time, filter by filter (sequential reads of
-                // each table), then the fit per pixel: vrow[q * nf + fi] = V_f,
-                // 0 where the window is skipped or the filter has no valid increment
-                let mut vrow = vec![0.0f64; ocols * nf];
-                let mut validrow = vec![0.0f64; ocols];
-                for g in g0..g1 {
-                    let i = g * step;
-                    let r0 = i.saturating_sub(h) - i0;
-                    let r1 = (i + h + 1).min(rows) - i0;
-                    let win = |q: usize| {
-                        let j = q * step;
-                        (j.saturating_sub(h), (j + h + 1).min(cols))
+                });
+            } else {
+                let (p, n) = (&mut sc.power[fi], &mut sc.count[fi]);
+                sats_into([p, n], nr, cols, |r, c| {
+                    let d = inc(r, c);
+                    if d.is_nan() {
+                        [0.0, 0.0]
+                    } else {
+                        [d * d, 1.0]
+                    }
+                });
+            }
+        }
+        // one output row at a time, filter by filter (sequential reads of
+        // each table), then the fit per pixel: vrow[q * nf + fi] = V_f,
+        // 0 where the window is skipped or the filter has no valid increment
+        let mut vrow = vec![0.0f64; ocols * nf];
+        let mut validrow = vec![0.0f64; ocols];
+        for g in band.g0..band.g1 {
+            let (r0, r1) = grid.win_rows(band, g);
+            for (q, v) in validrow.iter_mut().enumerate() {
+                let (c0, c1) = grid.win_cols(q);
+                *v = rect(&sc.vsat, sw, r0, r1, c0, c1);
+            }
+            for (fi, f) in fl.iter().enumerate() {
+                let rr1 = r1.saturating_sub(f.span.0);
+                let (ps, cs) = (&sc.power[fi], &sc.count[fi]);
+                for q in 0..ocols {
+                    let (c0, c1) = grid.win_cols(q);
+                    let cc1 = c1.saturating_sub(f.span.1);
+                    let sp = rect(ps, sw, r0, rr1, c0, cc1);
+                    let n = if complete {
+                        (rr1.saturating_sub(r0) * cc1.saturating_sub(c0)) as f64
+                    } else {
+                        rect(cs, sw, r0, rr1, c0, cc1)
                     };
-                    for (q, v) in validrow.iter_mut().enumerate() {
-                        let (c0, c1) = win(q);
-                        *v = rect(&sc.vsat, sw, r0, r1, c0, c1);
-                    }
-                    for (fi, f) in fl.iter().enumerate() {
-                        let rr1 = r1.saturating_sub(f.span.0);
-                        let (ps, cs) = (&sc.power[fi], &sc.count[fi]);
-                        for q in 0..ocols {
-                            let (c0, c1) = win(q);
-                            let cc1 = c1.saturating_sub(f.span.1);
-                            let sp = rect(ps, sw, r0, rr1, c0, cc1);
-                            let n = if complete {
-                                (rr1.saturating_sub(r0) * cc1.saturating_sub(c0)) as f64
-                            } else {
-                                rect(cs, sw, r0, rr1, c0, cc1)
-                            };
-                            // no valid increment, a zero variation, or one
-                            // that overflowed (inf samples): not fitted
-                            let v = sp / n;
-                            vrow[q * nf + fi] = if n >= 0.5 && v > 0.0 && v.is_finite() {
-                                v
-                            } else {
-                                0.0
-                            };
-                        }
-                    }
-                    for q in 0..ocols {
-                        let kk = (g - g0) * ocols + q;
-                        let valid = validrow[q];
-                        let ys = &mut vrow[q * nf..(q + 1) * nf];
-                        if valid < min_pixels || ys.contains(&0.0) {
-                            continue;
-                        }
-                        ln_in_place(ys);
-                        let (hh, se) = tab.solve_with(&polys, ys, opt.steps);
-                        hout[kk] = hh as f32;
-                        sout[kk] = (se * (full / valid).sqrt()) as f32;
-                        if !aout.is_empty() {
-                            let (ang, rat) = anisotropy(&ys[..4 * k], k, hh);
-                            aout[kk] = ang as f32;
-                            rout[kk] = rat as f32;
-                        }
-                    }
+                    // no valid increment, a zero variation, or one
+                    // that overflowed (inf samples): not fitted
+                    let v = sp / n;
+                    vrow[q * nf + fi] = if n >= 0.5 && v > 0.0 && v.is_finite() {
+                        v
+                    } else {
+                        0.0
+                    };
                 }
-            },
-        );
-    drop((aparts, rparts));
-    maps.angle = angle;
-    maps.ratio = ratio;
-    Ok(maps)
+            }
+            for q in 0..ocols {
+                let kk = (g - band.g0) * ocols + q;
+                let valid = validrow[q];
+                let ys = &mut vrow[q * nf..(q + 1) * nf];
+                if valid < min_pixels || ys.contains(&0.0) {
+                    continue;
+                }
+                ln_in_place(ys);
+                let (hh, se) = tab.solve_with(&polys, ys, opt.steps);
+                outs[0][kk] = hh as f32;
+                outs[1][kk] = (se * (full / valid).sqrt()) as f32;
+                if an {
+                    let (ang, rat) = anisotropy(&ys[..4 * k], k, hh);
+                    outs[2][kk] = ang as f32;
+                    outs[3][kk] = rat as f32;
+                }
+            }
+        }
+    })?;
+    let extra = maps.split_off(2);
+    let r2 = maps.pop().unwrap_or_default();
+    let d = maps.pop().unwrap_or_default();
+    Ok(MapOut {
+        rows: grid.orows,
+        cols: grid.ocols,
+        d,
+        r2,
+        extra,
+    })
 }
 
 #[cfg(test)]
@@ -570,10 +515,10 @@ mod tests {
         let a = run(1, &opt);
         let b = run(3, &opt);
         assert_eq!(
-            a.hurst.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
-            b.hurst.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+            a.d.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            b.d.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
         );
-        assert!(a.hurst[40 * cols + 30].is_finite() && a.angle[40 * cols + 30].is_finite());
+        assert!(a.d[40 * cols + 30].is_finite() && a.extra[0][40 * cols + 30].is_finite());
         for step in [2usize, 5] {
             let g = run(
                 2,
@@ -583,14 +528,11 @@ mod tests {
                     ..opt.clone()
                 },
             );
-            assert!(g.angle.is_empty());
+            assert!(g.extra[0].is_empty());
             let ocols = cols.div_ceil(step);
             for gi in 0..rows.div_ceil(step) {
                 for gj in 0..ocols {
-                    let (x, y) = (
-                        g.hurst[gi * ocols + gj],
-                        a.hurst[gi * step * cols + gj * step],
-                    );
+                    let (x, y) = (g.d[gi * ocols + gj], a.d[gi * step * cols + gj * step]);
                     assert!(
                         (x.is_nan() && y.is_nan()) || (x - y).abs() < 1e-6,
                         "step {step}"
