@@ -15,8 +15,7 @@
 //! tables built per band of rows at fixed positions (as in
 //! [`super::variation`]), so the cost per pixel does not grow with the window
 //! and the result does not depend on the thread count.
-use super::driver::{valid_sat, Grid, MapOut};
-use super::sat::{rect, sat_into, sats_into};
+use super::driver::{Grid, MapOut};
 use crate::dimension::dbc::Sample;
 use crate::error::{CoreError, CoreResult};
 
@@ -109,7 +108,8 @@ impl GlsTables {
     #[inline]
     fn locate(&self, h: f64) -> (usize, f64) {
         let x = (h - self.h0) / self.dh;
-        let i = x.floor().clamp(0.0, (self.n_h - 2) as f64) as usize;
+        // floor of x clamped to [0, n_h - 2] (a cast truncates: floor for x >= 0)
+        let i = (x.max(0.0) as usize).min(self.n_h - 2);
         (i, x - i as f64)
     }
 
@@ -149,16 +149,21 @@ impl GlsTables {
         let k = ys.len();
         let hi = self.h0 + self.dh * (self.n_h - 1) as f64;
         let mut h = 0.5f64;
+        // the dot products of an interval, reused while the steps stay in it
+        let (mut last, mut y0, mut y1) = (usize::MAX, 0.0, 0.0);
         for _ in 0..steps {
             let (i, s) = self.locate(h);
-            let (g0, g1) = (
-                &self.g[i * k..(i + 1) * k],
-                &self.g[(i + 1) * k..(i + 2) * k],
-            );
-            let (mut y0, mut y1) = (0.0, 0.0);
-            for f in 0..k {
-                y0 += g0[f] * ys[f];
-                y1 += g1[f] * ys[f];
+            if i != last {
+                let (g0, g1) = (
+                    &self.g[i * k..(i + 1) * k],
+                    &self.g[(i + 1) * k..(i + 2) * k],
+                );
+                (y0, y1) = (0.0, 0.0);
+                for f in 0..k {
+                    y0 += g0[f] * ys[f];
+                    y1 += g1[f] * ys[f];
+                }
+                last = i;
             }
             let c = &polys[i];
             let ga = c[0] + s * (c[1] + s * (c[2] + s * (c[3] + s * c[4])));
@@ -287,10 +292,100 @@ fn fast_ln_matches_the_library() {
     assert_eq!(t, vec![(1e-310f64).ln(), 2f64.ln()]);
 }
 
+/// `hi + lo += x` without losing the low-order bits (Knuth's TwoSum): the
+/// pair holds the running sum to about `eps²` of the largest partial sum,
+/// so a window sum left after a large value has slid out is not swamped by
+/// its rounding.
+#[inline(always)]
+fn add2(hi: &mut f64, lo: &mut f64, x: f64) {
+    let s = *hi + x;
+    let bp = s - *hi;
+    *lo += (*hi - (s - bp)) + (x - bp);
+    *hi = s;
+}
+
+/// Squares of the increments of filter `f` anchored on band row `r`,
+/// columns `0 .. n` (taps on rows `r + dr`), added to (`sign = 1`) or taken
+/// from (`sign = -1`) the column sums `(hi, lo)` and, with `cnt`, the
+/// counts; a square that is not finite (a NaN sample, or an overflow) is
+/// left out.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn slide_row<T: Sample, const N: usize>(
+    z: &[T],
+    cols: usize,
+    row0: usize,
+    f: &Filter,
+    sign: f64,
+    hi: &mut [f64],
+    lo: &mut [f64],
+    cnt: Option<&mut [f64]>,
+) {
+    let n = cols.saturating_sub(f.span.1);
+    if n == 0 {
+        return;
+    }
+    let taps: [(&[T], f64); N] = std::array::from_fn(|t| {
+        let (dr, dc, wt) = f.taps[t];
+        let at = (row0 + dr) * cols + dc;
+        (&z[at..at + n], wt)
+    });
+    let sq = |c: usize| -> f64 {
+        let mut d = 0.0;
+        for (row, wt) in &taps {
+            d += wt * row[c].to_f64();
+        }
+        d * d
+    };
+    match cnt {
+        None => {
+            for c in 0..n {
+                add2(&mut hi[c], &mut lo[c], sign * sq(c));
+            }
+        }
+        Some(cnt) => {
+            for c in 0..n {
+                let v = sq(c);
+                let ok = v.is_finite();
+                add2(&mut hi[c], &mut lo[c], if ok { sign * v } else { 0.0 });
+                cnt[c] += if ok { sign } else { 0.0 };
+            }
+        }
+    }
+}
+
+/// Per-thread buffers of [`gls_transform`], reused from band to band.
+#[derive(Default)]
+struct GlsScratch {
+    /// Per filter, column sums (`hi`, `lo`) and counts of the squared
+    /// increments anchored in the current window rows (`nf x cols`).
+    hi: Vec<f64>,
+    lo: Vec<f64>,
+    cnt: Vec<f64>,
+    /// Valid samples per column in the current window rows.
+    vcol: Vec<f64>,
+    /// Prefix sums along the row of those, `(cols + 1) x nf` (counts and
+    /// valid samples: `(cols + 1) x (nf + 1)`).
+    phi: Vec<f64>,
+    plo: Vec<f64>,
+    pcnt: Vec<f64>,
+    /// Anchor rows `lo .. hi` summed now, per filter (and for `vcol`).
+    span: Vec<(usize, usize)>,
+    vrow: Vec<f64>,
+}
+
 /// Moving-window GLS Hurst exponent (see the module docs); NaN where the
 /// window has too few valid pixels or a filter has no valid increment.
 /// Maps: `d` the Hurst exponent, `r2` its standard error, `extra` the
 /// anisotropy direction and ratio (empty unless asked).
+///
+/// Window sums of the squared increments slide down each band (the rows
+/// entering the window added to per-column sums, the rows leaving taken
+/// off, compensated so that no rounding accumulates), then prefix sums
+/// along the output row (compensated too) give every window's sum: one
+/// pass over the band per filter, no table of the band in memory. The
+/// sums restart at each band, whose layout depends on the window and
+/// `step` only, so the result does not depend on the thread count.
 pub fn gls_transform<T: Sample>(
     z: &[T],
     rows: usize,
@@ -316,94 +411,142 @@ pub fn gls_transform<T: Sample>(
     let (ocols, min_pixels) = (grid.ocols, grid.min_pixels);
     let full = (w * w) as f64;
     let polys = tab.step_polys(nf);
-    #[derive(Default)]
-    struct Scratch {
-        vsat: Vec<f64>,
-        power: Vec<Vec<f64>>,
-        count: Vec<Vec<f64>>,
-    }
     let an = opt.anisotropy;
-    let mut maps = grid.drive(&[true, true, an, an], |sc: &mut Scratch, band, outs| {
-        let (i0, nr) = (band.i0, band.nr());
-        let sw = cols + 1;
-        let get = |r: usize, c: usize| z[(i0 + r) * cols + c].to_f64();
-        valid_sat(&mut sc.vsat, band, cols, get);
-        // a band without missing samples needs no count tables
-        let complete = sc.vsat[nr * sw + cols] == (nr * cols) as f64;
-        sc.power.resize_with(nf, Vec::new);
-        sc.count.resize_with(nf, Vec::new);
-        for (fi, f) in fl.iter().enumerate() {
-            let inc = |r: usize, c: usize| -> f64 {
-                if r + f.span.0 >= nr || c + f.span.1 >= cols {
-                    return f64::NAN;
-                }
-                let mut d = 0.0;
-                for &(dr, dc, wt) in &f.taps[..f.n_taps] {
-                    d += wt * get(r + dr, c + dc);
-                }
-                d
-            };
-            if complete {
-                sat_into(&mut sc.power[fi], nr, cols, |r, c| {
-                    let d = inc(r, c);
-                    if d.is_nan() {
-                        0.0
-                    } else {
-                        d * d
-                    }
-                });
-            } else {
-                let (p, n) = (&mut sc.power[fi], &mut sc.count[fi]);
-                sats_into([p, n], nr, cols, |r, c| {
-                    let d = inc(r, c);
-                    if d.is_nan() {
-                        [0.0, 0.0]
-                    } else {
-                        [d * d, 1.0]
-                    }
-                });
-            }
-        }
-        // one output row at a time, filter by filter (sequential reads of
-        // each table), then the fit per pixel: vrow[q * nf + fi] = V_f,
-        // 0 where the window is skipped or the filter has no valid increment
-        let mut vrow = vec![0.0f64; ocols * nf];
-        let mut validrow = vec![0.0f64; ocols];
+    let mut maps = grid.drive(&[true, true, an, an], |sc: &mut GlsScratch, band, outs| {
+        let i0 = band.i0;
+        let zb = &z[i0 * cols..band.i1 * cols];
+        // a band of finite samples whose squares cannot overflow needs no
+        // counts: every increment is valid
+        let complete = zb.iter().all(|v| v.to_f64().abs() <= 1e100);
+        let nc = if complete { 0 } else { nf + 1 };
+        sc.hi.resize(nf * cols, 0.0);
+        sc.lo.resize(nf * cols, 0.0);
+        sc.cnt.resize(nf * cols, 0.0);
+        sc.vcol.resize(cols, 0.0);
+        sc.phi.resize((cols + 1) * nf, 0.0);
+        sc.plo.resize((cols + 1) * nf, 0.0);
+        sc.pcnt.resize((cols + 1) * (nf + 1), 0.0);
+        sc.span.clear();
+        sc.span.resize(nf + 1, (0, 0));
+        sc.vrow.resize(ocols * nf, 0.0);
+        let GlsScratch {
+            hi,
+            lo,
+            cnt,
+            vcol,
+            phi,
+            plo,
+            pcnt,
+            span,
+            vrow,
+        } = sc;
         for g in band.g0..band.g1 {
             let (r0, r1) = grid.win_rows(band, g);
-            for (q, v) in validrow.iter_mut().enumerate() {
-                let (c0, c1) = grid.win_cols(q);
-                *v = rect(&sc.vsat, sw, r0, r1, c0, c1);
-            }
+            // slide each filter's column sums to anchor rows r0 .. rr1
             for (fi, f) in fl.iter().enumerate() {
-                let rr1 = r1.saturating_sub(f.span.0);
-                let (ps, cs) = (&sc.power[fi], &sc.count[fi]);
-                for q in 0..ocols {
-                    let (c0, c1) = grid.win_cols(q);
-                    let cc1 = c1.saturating_sub(f.span.1);
-                    let sp = rect(ps, sw, r0, rr1, c0, cc1);
-                    let n = if complete {
-                        (rr1.saturating_sub(r0) * cc1.saturating_sub(c0)) as f64
+                let rr1 = r1.saturating_sub(f.span.0).max(r0);
+                let (mut a, mut b) = span[fi];
+                let (h, l) = (
+                    &mut hi[fi * cols..(fi + 1) * cols],
+                    &mut lo[fi * cols..(fi + 1) * cols],
+                );
+                let mut ct = (!complete).then(|| &mut cnt[fi * cols..(fi + 1) * cols]);
+                if g == band.g0 || r0 >= b {
+                    // first row of the band, or no overlap: from scratch
+                    h.fill(0.0);
+                    l.fill(0.0);
+                    if let Some(c) = ct.as_deref_mut() {
+                        c.fill(0.0);
+                    }
+                    (a, b) = (r0, r0);
+                }
+                let mut slide = |r: usize, sign: f64| {
+                    let c = ct.as_deref_mut();
+                    if f.n_taps == 2 {
+                        slide_row::<T, 2>(zb, cols, r, f, sign, h, l, c);
                     } else {
-                        rect(cs, sw, r0, rr1, c0, cc1)
+                        slide_row::<T, 3>(zb, cols, r, f, sign, h, l, c);
+                    }
+                };
+                for r in b..rr1 {
+                    slide(r, 1.0);
+                }
+                for r in a..r0 {
+                    slide(r, -1.0);
+                }
+                span[fi] = (r0, rr1.max(b));
+            }
+            // valid samples per column in rows r0 .. r1 (exact: counts)
+            if !complete {
+                let (mut a, mut b) = span[nf];
+                if g == band.g0 || r0 >= b {
+                    vcol.fill(0.0);
+                    (a, b) = (r0, r0);
+                }
+                for (r, sign) in (b..r1).map(|r| (r, 1.0)).chain((a..r0).map(|r| (r, -1.0))) {
+                    for (v, x) in vcol.iter_mut().zip(&zb[r * cols..(r + 1) * cols]) {
+                        *v += if x.to_f64().is_nan() { 0.0 } else { sign };
+                    }
+                }
+                span[nf] = (r0, r1);
+            }
+            // prefix sums along the row, filter-interleaved
+            phi[..nf].fill(0.0);
+            plo[..nf].fill(0.0);
+            for c in 0..cols {
+                let (p, q) = (c * nf, (c + 1) * nf);
+                for fi in 0..nf {
+                    let (mut ph, mut pl) = (phi[p + fi], plo[p + fi]);
+                    add2(&mut ph, &mut pl, hi[fi * cols + c]);
+                    add2(&mut ph, &mut pl, lo[fi * cols + c]);
+                    phi[q + fi] = ph;
+                    plo[q + fi] = pl;
+                }
+            }
+            if !complete {
+                pcnt[..nc].fill(0.0);
+                for c in 0..cols {
+                    let (p, q) = (c * nc, (c + 1) * nc);
+                    for fi in 0..nf {
+                        pcnt[q + fi] = pcnt[p + fi] + cnt[fi * cols + c];
+                    }
+                    pcnt[q + nf] = pcnt[p + nf] + vcol[c];
+                }
+            }
+            for q in 0..ocols {
+                let (c0, c1) = grid.win_cols(q);
+                let valid = if complete {
+                    ((r1 - r0) * (c1 - c0)) as f64
+                } else {
+                    pcnt[c1 * nc + nf] - pcnt[c0 * nc + nf]
+                };
+                let ys = &mut vrow[q * nf..(q + 1) * nf];
+                if valid < min_pixels {
+                    continue;
+                }
+                for (fi, f) in fl.iter().enumerate() {
+                    let cc1 = c1.saturating_sub(f.span.1).max(c0);
+                    let (x, y) = (cc1 * nf + fi, c0 * nf + fi);
+                    let sp = (phi[x] - phi[y]) + (plo[x] - plo[y]);
+                    let rr1 = r1.saturating_sub(f.span.0).max(r0);
+                    let n = if complete {
+                        ((rr1 - r0) * (cc1 - c0)) as f64
+                    } else {
+                        pcnt[cc1 * nc + fi] - pcnt[c0 * nc + fi]
                     };
-                    // no valid increment, a zero variation, or one
-                    // that overflowed (inf samples): not fitted
+                    // no valid increment, a zero variation, or one that
+                    // overflowed: not fitted
                     let v = sp / n;
-                    vrow[q * nf + fi] = if n >= 0.5 && v > 0.0 && v.is_finite() {
+                    ys[fi] = if n >= 0.5 && v > 0.0 && v.is_finite() {
                         v
                     } else {
                         0.0
                     };
                 }
-            }
-            for q in 0..ocols {
-                let kk = (g - band.g0) * ocols + q;
-                let valid = validrow[q];
-                let ys = &mut vrow[q * nf..(q + 1) * nf];
-                if valid < min_pixels || ys.contains(&0.0) {
+                if ys.contains(&0.0) {
                     continue;
                 }
+                let kk = (g - band.g0) * ocols + q;
                 ln_in_place(ys);
                 let (hh, se) = tab.solve_with(&polys, ys, opt.steps);
                 outs[0][kk] = hh as f32;
