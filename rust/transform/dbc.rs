@@ -230,8 +230,8 @@ pub fn dbc_transform(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::transform::sat::{line_fit, log_axis};
     use crate::dimension::dbc::dbc_count;
+    use crate::transform::sat::{line_fit, log_axis};
 
     fn image(rows: usize, cols: usize, seed: u64) -> Vec<f64> {
         let mut s = seed;
