@@ -1,7 +1,8 @@
 //! Bindings of `crate::transform`.
 use super::convert::{array1, array2, array3, c_order, run, FloatArray2};
 use crate::transform::blanket::{blanket_areas, blanket_transform, BlanketMapOptions};
-use crate::transform::dbc::{dbc_transform, DbcMapOptions, LocalMap};
+use crate::transform::dbc::{dbc_transform, DbcMapOptions};
+use crate::transform::driver::MapOut;
 use crate::transform::gls::{gls_transform, GlsOptions, GlsTables};
 use crate::transform::lacunarity::lacunarity_transform;
 use crate::transform::mass::{mass_curve, mass_transform, MassOptions};
@@ -13,25 +14,20 @@ use pyo3::prelude::*;
 type MapPair<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>);
 
 /// The (dimension, r²) pair of a map on the grid of every `step`-th pixel.
-fn step_maps<'py>(
-    py: Python<'py>,
-    (d, r2): (Vec<f32>, Vec<f32>),
-    (rows, cols): (usize, usize),
-    step: usize,
-) -> PyResult<MapPair<'py>> {
-    let shape = (rows.div_ceil(step.max(1)), cols.div_ceil(step.max(1)));
-    Ok((array2(py, shape, d)?, array2(py, shape, r2)?))
+fn map_pair(py: Python<'_>, m: MapOut) -> PyResult<MapPair<'_>> {
+    let shape = (m.rows, m.cols);
+    Ok((array2(py, shape, m.d)?, array2(py, shape, m.r2)?))
 }
 
 /// Run `kernel(z, rows, cols)` on a 2D float32 or float64 image, read in
 /// place (no float64 copy of a float32 scene); evaluates to
 /// `(result, (rows, cols))`.
 macro_rules! on_float_image {
-    ($py:expr, $image:expr, $n_threads:expr, $kernel:path, $opt:expr) => {
+    ($py:expr, $image:expr, $n_threads:expr, $kernel:path, $($opt:expr),+) => {
         with_float!(FloatArray2::extract($image, "image")?, |a| {
             let z = c_order(&a);
             let (rows, cols) = z.rows_cols();
-            let r = run($py, $n_threads, || $kernel(&z.data, rows, cols, $opt))?;
+            let r = run($py, $n_threads, || $kernel(&z.data, rows, cols, $($opt),+))?;
             (r, (rows, cols))
         })
     };
@@ -65,8 +61,8 @@ fn variation_transform_map<'py>(
         min_valid,
         step,
     };
-    let (maps, shape) = on_float_image!(py, image, n_threads, variation_transform, &opt);
-    step_maps(py, maps, shape, step)
+    let (maps, _) = on_float_image!(py, image, n_threads, variation_transform, &opt);
+    map_pair(py, maps)
 }
 
 /// Moving-window P(m, L) mass dimension on a float32 or float64 image.
@@ -91,8 +87,8 @@ fn mass_transform_map<'py>(
         min_valid,
         step,
     };
-    let (maps, shape) = on_float_image!(py, image, n_threads, mass_transform, &opt);
-    step_maps(py, maps, shape, step)
+    let (maps, _) = on_float_image!(py, image, n_threads, mass_transform, &opt);
+    map_pair(py, maps)
 }
 
 /// Moving-window GLS Hurst exponent on a float32 or float64 image, with the
@@ -145,27 +141,13 @@ fn gls_transform_map<'py>(
         step,
         anisotropy,
     };
-    let (maps, (rows, cols)) = with_float!(FloatArray2::extract(image, "image")?, |z| {
-        let z = c_order(&z);
-        let (rows, cols) = z.rows_cols();
-        let r = run(py, n_threads, || {
-            gls_transform(&z.data, rows, cols, &opt, &tab)
-        })?;
-        (r, (rows, cols))
-    });
-    let shape = (rows.div_ceil(step.max(1)), cols.div_ceil(step.max(1)));
-    let mut out = vec![];
-    for v in [maps.hurst, maps.se, maps.angle, maps.ratio] {
-        if !v.is_empty() {
-            out.push(array2(py, shape, v)?);
-        }
-    }
-    Ok(out)
-}
-
-fn local_map_arrays(py: Python<'_>, m: LocalMap) -> PyResult<MapPair<'_>> {
-    let shape = (m.rows, m.cols);
-    Ok((array2(py, shape, m.dim)?, array2(py, shape, m.r2)?))
+    let (maps, _) = on_float_image!(py, image, n_threads, gls_transform, &opt, &tab);
+    let shape = (maps.rows, maps.cols);
+    maps.into_maps()
+        .into_iter()
+        .filter(|v| !v.is_empty())
+        .map(|v| array2(py, shape, v))
+        .collect()
 }
 
 /// Moving-window differential box counting on the grid of every `step`-th
@@ -198,7 +180,7 @@ fn dbc_transform_map<'py>(
         partial_blocks,
     };
     let m = run(py, n_threads, || dbc_transform(z, rows, cols, &opt))?;
-    local_map_arrays(py, m)
+    map_pair(py, m)
 }
 
 /// Moving-window covering blanket on the grid of every `step`-th pixel.
@@ -227,7 +209,7 @@ fn blanket_transform_map<'py>(
         step,
     };
     let m = run(py, n_threads, || blanket_transform(z, rows, cols, &opt))?;
-    local_map_arrays(py, m)
+    map_pair(py, m)
 }
 
 /// Image-wide covering-blanket areas A(e), e = 1 ..= eps_max, and the number

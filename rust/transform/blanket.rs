@@ -26,9 +26,9 @@
 //! `e`. The cost per pixel is `O(w e_max^2)`: it still grows with the window,
 //! linearly instead of as `w^2`.
 //!
-use super::dbc::LocalMap;
-use super::sat::{band_rows, check_window, line_fit, log_axis, rect, sat};
-use crate::checks::{positive_finite, step_grid};
+use super::driver::{Grid, LogFit, MapOut};
+use super::sat::{band_rows, rect, sat};
+use crate::checks::positive_finite;
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 
@@ -529,10 +529,10 @@ pub fn blanket_transform(
     rows: usize,
     cols: usize,
     opt: &BlanketMapOptions,
-) -> CoreResult<LocalMap> {
+) -> CoreResult<MapOut> {
     let w = opt.window;
-    let min_pixels = check_window(z.len(), rows, cols, w, opt.min_valid)?;
-    let (orows, ocols) = step_grid(opt.step, rows, cols)?;
+    let grid = Grid::new(z.len(), rows, cols, w, opt.min_valid, opt.step)?;
+    let (min_pixels, ocols) = (grid.min_pixels, grid.ocols);
     let mut eps = opt.epsilons.clone();
     eps.sort_unstable();
     eps.dedup();
@@ -547,66 +547,51 @@ pub fn blanket_transform(
     }
     positive_finite(opt.z_scale, "z_scale")?;
     let emax = *eps.last().unwrap();
-    let (xs, xm, sxx) = log_axis(&eps);
-    let (h, step) = (w / 2, opt.step);
-    let ob = (band_rows(w) / step).max(1); // output rows per band
-    let mut dim = vec![f32::NAN; orows * ocols];
-    let mut r2 = vec![f32::NAN; orows * ocols];
-    dim.par_chunks_mut(ob * ocols)
-        .zip(r2.par_chunks_mut(ob * ocols))
-        .enumerate()
-        .for_each(|(band, (dout, rout))| {
-            let k0 = band * ob;
-            let k1 = (k0 + ob).min(orows);
-            let ri0 = (k0 * step) as isize - h as isize;
-            let nr = (k1 - 1 - k0) * step + 2 * h + 1;
-            let tq = (band_rows(w) / step).max(1); // output columns per tile
-            let lpw = w + 2;
-            let mut win = Window {
-                w,
-                lu: vec![f64::NEG_INFINITY; lpw * lpw],
-                lb: vec![f64::INFINITY; lpw * lpw],
-                lnu: vec![f64::NEG_INFINITY; lpw * lpw],
-                lnb: vec![f64::INFINITY; lpw * lpw],
-                cs: vec![0.0; w],
-            };
-            let mut areas = vec![0.0f64; emax];
-            let mut ys = vec![0.0f64; eps.len()];
-            for q0 in (0..ocols).step_by(tq) {
-                let q1 = (q0 + tq).min(ocols);
-                let ci0 = (q0 * step) as isize - h as isize;
-                let nc = (q1 - 1 - q0) * step + 2 * h + 1;
-                let g = Grown::new(z, rows, cols, ri0, ci0, nr, nc, emax, opt.z_scale);
-                for k in k0..k1 {
-                    let u0 = (k - k0) * step;
-                    for kc in q0..q1 {
-                        let v0 = (kc - q0) * step;
-                        if rect(&g.valid, nc + 1, u0, u0 + w, v0, v0 + w) < min_pixels {
-                            continue;
-                        }
-                        win.areas(&g, u0, v0, &mut areas);
-                        for (y, &e) in ys.iter_mut().zip(&eps) {
-                            *y = areas[e - 1].ln();
-                        }
-                        let (slope, fit_r2) = line_fit(&xs, xm, sxx, &ys);
-                        let o = (k - k0) * ocols + kc;
-                        dout[o] = (2.0 - slope) as f32;
-                        rout[o] = fit_r2 as f32;
+    let fit = LogFit::new(&eps, |slope| 2.0 - slope);
+    let (h, step) = (grid.h, grid.step);
+    grid.drive_pair(|_: &mut (), band, outs| {
+        let (k0, k1) = (band.g0, band.g1);
+        let ri0 = (k0 * step) as isize - h as isize;
+        let nr = (k1 - 1 - k0) * step + 2 * h + 1;
+        let tq = (band_rows(w) / step).max(1); // output columns per tile
+        let lpw = w + 2;
+        let mut win = Window {
+            w,
+            lu: vec![f64::NEG_INFINITY; lpw * lpw],
+            lb: vec![f64::INFINITY; lpw * lpw],
+            lnu: vec![f64::NEG_INFINITY; lpw * lpw],
+            lnb: vec![f64::INFINITY; lpw * lpw],
+            cs: vec![0.0; w],
+        };
+        let mut areas = vec![0.0f64; emax];
+        let mut ys = vec![0.0f64; eps.len()];
+        for q0 in (0..ocols).step_by(tq) {
+            let q1 = (q0 + tq).min(ocols);
+            let ci0 = (q0 * step) as isize - h as isize;
+            let nc = (q1 - 1 - q0) * step + 2 * h + 1;
+            let g = Grown::new(z, rows, cols, ri0, ci0, nr, nc, emax, opt.z_scale);
+            for k in k0..k1 {
+                let u0 = (k - k0) * step;
+                for kc in q0..q1 {
+                    let v0 = (kc - q0) * step;
+                    if rect(&g.valid, nc + 1, u0, u0 + w, v0, v0 + w) < min_pixels {
+                        continue;
                     }
+                    win.areas(&g, u0, v0, &mut areas);
+                    for (y, &e) in ys.iter_mut().zip(&eps) {
+                        *y = areas[e - 1].ln();
+                    }
+                    fit.write(&ys, outs, (k - k0) * ocols + kc);
                 }
             }
-        });
-    Ok(LocalMap {
-        dim,
-        r2,
-        rows: orows,
-        cols: ocols,
+        }
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::transform::sat::{line_fit, log_axis};
 
     /// Blanket areas from the definition, with explicit bounds checks.
     fn naive(z: &[f64], rows: usize, cols: usize, emax: usize) -> Vec<f64> {
@@ -706,7 +691,7 @@ mod tests {
                     let ys: Vec<f64> = eps.iter().map(|&e| all[e - 1].ln()).collect();
                     let (xs, xm, sxx) = log_axis(&eps);
                     let e = 2.0 - line_fit(&xs, xm, sxx, &ys).0;
-                    let d = m.dim[k * m.cols + kc] as f64;
+                    let d = m.d[k * m.cols + kc] as f64;
                     assert!((d - e).abs() < 1e-5, "w={w} ({k},{kc}) {d} vs {e}");
                 }
             }

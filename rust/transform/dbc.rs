@@ -23,11 +23,11 @@
 //! O(1) per pixel); a window's `N(s)` is then a sum over a lattice of stride
 //! `s`, read from a summed-area table strided by `s` (one table holds every
 //! grid offset). The cost per pixel does not grow with the window.
-use super::sat::{band_rows, check_window, line_fit, log_axis, rect, sat};
+use super::driver::{Grid, LogFit, MapOut};
+use super::sat::{band_rows, rect, sat};
 use super::sliding::rect_minmax;
-use crate::checks::{finite, positive_finite, step_grid};
+use crate::checks::{finite, positive_finite};
 use crate::error::{CoreError, CoreResult};
-use rayon::prelude::*;
 
 /// Options of [`dbc_transform`].
 #[derive(Debug, Clone)]
@@ -46,16 +46,6 @@ pub struct DbcMapOptions {
     /// Count the partial blocks of the last row and column (`false`: drop
     /// them, so box size `s` covers the top-left `floor(w/s) s` square).
     pub partial_blocks: bool,
-}
-
-/// A local map on the grid of every `step`-th pixel: dimension and r²,
-/// row-major `rows x cols`.
-#[derive(Debug, Clone)]
-pub struct LocalMap {
-    pub dim: Vec<f32>,
-    pub r2: Vec<f32>,
-    pub rows: usize,
-    pub cols: usize,
 }
 
 /// Strided-table read that is 0 above or left of the plane.
@@ -98,10 +88,10 @@ pub fn dbc_transform(
     rows: usize,
     cols: usize,
     opt: &DbcMapOptions,
-) -> CoreResult<LocalMap> {
+) -> CoreResult<MapOut> {
     let w = opt.window;
-    let min_pixels = check_window(z.len(), rows, cols, w, opt.min_valid)?;
-    let (orows, ocols) = step_grid(opt.step, rows, cols)?;
+    let grid = Grid::new(z.len(), rows, cols, w, opt.min_valid, opt.step)?;
+    let (min_pixels, ocols) = (grid.min_pixels, grid.ocols);
     let mut sizes = opt.box_sizes.clone();
     sizes.sort_unstable();
     sizes.dedup();
@@ -116,141 +106,124 @@ pub fn dbc_transform(
     }
     positive_finite(opt.z_unit, "z_scale")?;
     finite(opt.z0, "z0")?;
-    let step = opt.step;
-    let (xs, xm, sxx) = log_axis(&sizes);
-    let h = w / 2;
-    let ob = (band_rows(w) / step).max(1); // output rows per band
-    let mut dim = vec![f32::NAN; orows * ocols];
-    let mut r2 = vec![f32::NAN; orows * ocols];
-    dim.par_chunks_mut(ob * ocols)
-        .zip(r2.par_chunks_mut(ob * ocols))
-        .enumerate()
-        .for_each(|(band, (dout, rout))| {
-            let k0 = band * ob;
-            let k1 = (k0 + ob).min(orows);
-            // tiles of output columns, in order (results do not depend on
-            // threads): planes of rows ri0 .. ri0 + nr and columns
-            // ci0 .. ci0 + nc of the NaN-padded image, small enough to stay
-            // in cache
-            let ri0 = (k0 * step) as isize - h as isize;
-            let nr = (k1 - 1 - k0) * step + 2 * h + 1;
-            let tq = (band_rows(w) / step).max(1); // output columns per tile
-            for q0 in (0..ocols).step_by(tq) {
-                let q1 = (q0 + tq).min(ocols);
-                let nq = q1 - q0;
-                let ci0 = (q0 * step) as isize - h as isize;
-                let nc = (q1 - 1 - q0) * step + 2 * h + 1;
-                let mut lo = vec![f64::INFINITY; nr * nc];
-                let mut hi = vec![f64::NEG_INFINITY; nr * nc];
-                let mut valid = vec![0.0f64; nr * nc];
-                // image columns c0 .. c1 of the tile
-                let c0 = ci0.max(0) as usize;
-                let c1 = ((ci0 + nc as isize) as usize).min(cols);
-                for u in 0..nr {
-                    let r = ri0 + u as isize;
-                    if r < 0 || r >= rows as isize {
-                        continue;
-                    }
-                    let src = &z[r as usize * cols + c0..r as usize * cols + c1];
-                    let base = u * nc + (c0 as isize - ci0) as usize;
-                    for (c, &x) in src.iter().enumerate() {
-                        if !x.is_nan() {
-                            lo[base + c] = x;
-                            hi[base + c] = x;
-                            valid[base + c] = 1.0;
-                        }
-                    }
+    let (h, step) = (grid.h, grid.step);
+    let fit = LogFit::new(&sizes, |slope| -slope);
+    grid.drive_pair(|_: &mut (), band, outs| {
+        let (k0, k1) = (band.g0, band.g1);
+        // tiles of output columns, in order (results do not depend on
+        // threads): planes of rows ri0 .. ri0 + nr and columns
+        // ci0 .. ci0 + nc of the NaN-padded image, small enough to stay
+        // in cache
+        let ri0 = (k0 * step) as isize - h as isize;
+        let nr = (k1 - 1 - k0) * step + 2 * h + 1;
+        let tq = (band_rows(w) / step).max(1); // output columns per tile
+        for q0 in (0..ocols).step_by(tq) {
+            let q1 = (q0 + tq).min(ocols);
+            let nq = q1 - q0;
+            let ci0 = (q0 * step) as isize - h as isize;
+            let nc = (q1 - 1 - q0) * step + 2 * h + 1;
+            let mut lo = vec![f64::INFINITY; nr * nc];
+            let mut hi = vec![f64::NEG_INFINITY; nr * nc];
+            let mut valid = vec![0.0f64; nr * nc];
+            // image columns c0 .. c1 of the tile
+            let c0 = ci0.max(0) as usize;
+            let c1 = ((ci0 + nc as isize) as usize).min(cols);
+            for u in 0..nr {
+                let r = ri0 + u as isize;
+                if r < 0 || r >= rows as isize {
+                    continue;
                 }
-                let vsat = sat(&valid, nr, nc);
-                drop(valid);
-                let npix = (k1 - k0) * nq;
-                let mut counts = vec![vec![0.0f64; npix]; sizes.len()];
-                for (si, &s) in sizes.iter().enumerate() {
-                    let hgt = s as f64 * opt.z_unit;
-                    let nf = w / s;
-                    let t = w % s;
-                    let si_ = s as isize;
-                    let last = ((nf - 1) * s) as isize;
-                    // full blocks: table strided by s
-                    let wss = nc - s + 1;
-                    let mut tss = count_field(&lo, &hi, nr, nc, s, s, opt.z0, hgt);
-                    let nss = nr - s + 1;
-                    for row in tss.chunks_mut(wss) {
-                        for v in s..wss {
-                            row[v] += row[v - s];
-                        }
-                    }
-                    for u in s..nss {
-                        let (done, cur) = tss.split_at_mut(u * wss);
-                        let prev = &done[(u - s) * wss..(u - s + 1) * wss];
-                        for (x, &y) in cur[..wss].iter_mut().zip(prev) {
-                            *x += y;
-                        }
-                    }
-                    // partial blocks: bottom row (t x s), right column (s x t), corner (t x t)
-                    let partial = (t > 0 && opt.partial_blocks).then(|| {
-                        let mut pts = count_field(&lo, &hi, nr, nc, t, s, opt.z0, hgt);
-                        for u in 0..nr - t + 1 {
-                            for v in s..wss {
-                                pts[u * wss + v] += pts[u * wss + v - s];
-                            }
-                        }
-                        let wst = nc - t + 1;
-                        let mut pst = count_field(&lo, &hi, nr, nc, s, t, opt.z0, hgt);
-                        for u in s..nr - s + 1 {
-                            for v in 0..wst {
-                                pst[u * wst + v] += pst[(u - s) * wst + v];
-                            }
-                        }
-                        let ptt = count_field(&lo, &hi, nr, nc, t, t, opt.z0, hgt);
-                        (pts, pst, ptt, wst)
-                    });
-                    let out = &mut counts[si];
-                    for k in k0..k1 {
-                        let u0 = ((k - k0) * step) as isize;
-                        for kc in 0..nq {
-                            let v0 = (kc * step) as isize;
-                            let (a, b) = (u0 + last, v0 + last);
-                            let mut n = at(&tss, wss, a, b)
-                                - at(&tss, wss, u0 - si_, b)
-                                - at(&tss, wss, a, v0 - si_)
-                                + at(&tss, wss, u0 - si_, v0 - si_);
-                            if let Some((pts, pst, ptt, wst)) = &partial {
-                                let (ue, ve) = (u0 + (nf * s) as isize, v0 + (nf * s) as isize);
-                                n += at(pts, wss, ue, b) - at(pts, wss, ue, v0 - si_);
-                                n += at(pst, *wst, a, ve) - at(pst, *wst, u0 - si_, ve);
-                                n += at(ptt, *wst, ue, ve);
-                            }
-                            out[(k - k0) * nq + kc] = n;
-                        }
-                    }
-                }
-                let mut ys = vec![0.0f64; sizes.len()];
-                let sw = nc + 1;
-                for k in k0..k1 {
-                    let u0 = (k - k0) * step;
-                    for kc in 0..nq {
-                        let v0 = kc * step;
-                        if rect(&vsat, sw, u0, u0 + w, v0, v0 + w) < min_pixels {
-                            continue;
-                        }
-                        let p = (k - k0) * nq + kc;
-                        for (y, c) in ys.iter_mut().zip(&counts) {
-                            *y = c[p].ln();
-                        }
-                        let (slope, fit_r2) = line_fit(&xs, xm, sxx, &ys);
-                        let o = (k - k0) * ocols + q0 + kc;
-                        dout[o] = (-slope) as f32;
-                        rout[o] = fit_r2 as f32;
+                let src = &z[r as usize * cols + c0..r as usize * cols + c1];
+                let base = u * nc + (c0 as isize - ci0) as usize;
+                for (c, &x) in src.iter().enumerate() {
+                    if !x.is_nan() {
+                        lo[base + c] = x;
+                        hi[base + c] = x;
+                        valid[base + c] = 1.0;
                     }
                 }
             }
-        });
-    Ok(LocalMap {
-        dim,
-        r2,
-        rows: orows,
-        cols: ocols,
+            let vsat = sat(&valid, nr, nc);
+            drop(valid);
+            let npix = (k1 - k0) * nq;
+            let mut counts = vec![vec![0.0f64; npix]; sizes.len()];
+            for (si, &s) in sizes.iter().enumerate() {
+                let hgt = s as f64 * opt.z_unit;
+                let nf = w / s;
+                let t = w % s;
+                let si_ = s as isize;
+                let last = ((nf - 1) * s) as isize;
+                // full blocks: table strided by s
+                let wss = nc - s + 1;
+                let mut tss = count_field(&lo, &hi, nr, nc, s, s, opt.z0, hgt);
+                let nss = nr - s + 1;
+                for row in tss.chunks_mut(wss) {
+                    for v in s..wss {
+                        row[v] += row[v - s];
+                    }
+                }
+                for u in s..nss {
+                    let (done, cur) = tss.split_at_mut(u * wss);
+                    let prev = &done[(u - s) * wss..(u - s + 1) * wss];
+                    for (x, &y) in cur[..wss].iter_mut().zip(prev) {
+                        *x += y;
+                    }
+                }
+                // partial blocks: bottom row (t x s), right column (s x t), corner (t x t)
+                let partial = (t > 0 && opt.partial_blocks).then(|| {
+                    let mut pts = count_field(&lo, &hi, nr, nc, t, s, opt.z0, hgt);
+                    for u in 0..nr - t + 1 {
+                        for v in s..wss {
+                            pts[u * wss + v] += pts[u * wss + v - s];
+                        }
+                    }
+                    let wst = nc - t + 1;
+                    let mut pst = count_field(&lo, &hi, nr, nc, s, t, opt.z0, hgt);
+                    for u in s..nr - s + 1 {
+                        for v in 0..wst {
+                            pst[u * wst + v] += pst[(u - s) * wst + v];
+                        }
+                    }
+                    let ptt = count_field(&lo, &hi, nr, nc, t, t, opt.z0, hgt);
+                    (pts, pst, ptt, wst)
+                });
+                let out = &mut counts[si];
+                for k in k0..k1 {
+                    let u0 = ((k - k0) * step) as isize;
+                    for kc in 0..nq {
+                        let v0 = (kc * step) as isize;
+                        let (a, b) = (u0 + last, v0 + last);
+                        let mut n = at(&tss, wss, a, b)
+                            - at(&tss, wss, u0 - si_, b)
+                            - at(&tss, wss, a, v0 - si_)
+                            + at(&tss, wss, u0 - si_, v0 - si_);
+                        if let Some((pts, pst, ptt, wst)) = &partial {
+                            let (ue, ve) = (u0 + (nf * s) as isize, v0 + (nf * s) as isize);
+                            n += at(pts, wss, ue, b) - at(pts, wss, ue, v0 - si_);
+                            n += at(pst, *wst, a, ve) - at(pst, *wst, u0 - si_, ve);
+                            n += at(ptt, *wst, ue, ve);
+                        }
+                        out[(k - k0) * nq + kc] = n;
+                    }
+                }
+            }
+            let mut ys = vec![0.0f64; sizes.len()];
+            let sw = nc + 1;
+            for k in k0..k1 {
+                let u0 = (k - k0) * step;
+                for kc in 0..nq {
+                    let v0 = kc * step;
+                    if rect(&vsat, sw, u0, u0 + w, v0, v0 + w) < min_pixels {
+                        continue;
+                    }
+                    let p = (k - k0) * nq + kc;
+                    for (y, c) in ys.iter_mut().zip(&counts) {
+                        *y = c[p].ln();
+                    }
+                    fit.write(&ys, outs, (k - k0) * ocols + q0 + kc);
+                }
+            }
+        }
     })
 }
 
@@ -258,6 +231,7 @@ pub fn dbc_transform(
 mod tests {
     use super::*;
     use crate::dimension::dbc::dbc_count;
+    use crate::transform::sat::{line_fit, log_axis};
 
     fn image(rows: usize, cols: usize, seed: u64) -> Vec<f64> {
         let mut s = seed;
@@ -322,7 +296,7 @@ mod tests {
             for k in 0..m.rows {
                 for kc in 0..m.cols {
                     let e = direct(&z, rows, cols, k * step, kc * step, &o);
-                    let d = m.dim[k * m.cols + kc] as f64;
+                    let d = m.d[k * m.cols + kc] as f64;
                     assert!((d - e).abs() < 1e-5, "w={w} ({k},{kc}) {d} vs {e}");
                 }
             }
@@ -345,8 +319,7 @@ mod tests {
         let run = |t| {
             let m = crate::parallel::run_in_pool(Some(t), || dbc_transform(&z, rows, cols, &o))
                 .unwrap();
-            m.dim
-                .iter()
+            m.d.iter()
                 .zip(&m.r2)
                 .map(|(a, b)| (a.to_bits(), b.to_bits()))
                 .collect::<Vec<_>>()

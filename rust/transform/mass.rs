@@ -15,8 +15,9 @@
 //! point's mass does not depend on where the analysis window sits and the
 //! window sums come from summed-area tables: the cost per pixel is the box
 //! neighbourhood (`L_max^2`), independent of the window.
-use super::sat::{band_rows, check_window, line_fit, log_axis, rect, sat_into};
-use crate::checks::{positive_finite, step_grid};
+use super::driver::{valid_sat, Grid, LogFit, MapOut};
+use super::sat::{rect, sat_into};
+use crate::checks::positive_finite;
 use crate::dimension::dbc::Sample;
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
@@ -391,9 +392,9 @@ pub fn mass_transform<T: Sample>(
     rows: usize,
     cols: usize,
     opt: &MassOptions,
-) -> CoreResult<(Vec<f32>, Vec<f32>)> {
+) -> CoreResult<MapOut> {
     let w = opt.window;
-    let min_pixels = check_window(z.len(), rows, cols, w, opt.min_valid)?;
+    let grid = Grid::new(z.len(), rows, cols, w, opt.min_valid, opt.step)?;
     let mut sizes = opt.box_sizes.clone();
     sizes.sort_unstable();
     sizes.dedup();
@@ -407,16 +408,8 @@ pub fn mass_transform<T: Sample>(
         ));
     }
     positive_finite(opt.z_scale, "z_scale")?;
-    let step = opt.step;
-    step_grid(step, rows, cols)?;
     let ks: Vec<usize> = sizes.iter().map(|l| l / 2).collect();
-    let (xs, xm, sxx) = log_axis(&sizes);
-    let h = w / 2;
-    // output grid (pixels 0, step, 2 step, ...) and its rows per band
-    let (orows, ocols) = (rows.div_ceil(step), cols.div_ceil(step));
-    let ob = (band_rows(w) / step).max(1);
-    let mut dim = vec![f32::NAN; orows * ocols];
-    let mut r2 = vec![f32::NAN; orows * ocols];
+    let fit = LogFit::new(&sizes, |slope| -slope);
     // per-thread buffers, reused from band to band (fresh ones would be
     // page-faulted and zeroed by the OS for every band)
     #[derive(Default)]
@@ -425,73 +418,46 @@ pub fn mass_transform<T: Sample>(
         vsat: Vec<f64>,
         isats: Vec<Vec<f64>>,
     }
-    dim.par_chunks_mut(ob * ocols)
-        .zip(r2.par_chunks_mut(ob * ocols))
-        .enumerate()
-        .for_each_init(Scratch::default, |sc, (band, (dout, rout))| {
-            // output rows g0 .. g1 of the grid: image rows g0 step .. (g1 - 1) step
-            let g0 = band * ob;
-            let g1 = (g0 + ob).min(orows);
-            let i0 = (g0 * step).saturating_sub(h);
-            let i1 = ((g1 - 1) * step + h + 1).min(rows);
-            let nr = i1 - i0;
-            let sw = cols + 1;
-            let Scratch {
-                masses,
-                vsat,
-                isats,
-            } = sc;
-            let job = Band {
-                z,
-                rows,
-                cols,
-                r0: i0,
-                r1: i1,
-                ks: &ks,
-                z_scale: opt.z_scale,
-            };
-            box_masses_into(&job, masses);
-            let masses = &masses.planes;
-            let zb = &z[i0 * cols..i1 * cols];
-            sat_into(vsat, nr, cols, |r, c| {
-                (!zb[r * cols + c].to_f64().is_nan()) as u8 as f64
-            });
-            isats.resize_with(masses.len(), Vec::new);
-            for (s, m) in isats.iter_mut().zip(masses.iter()) {
-                sat_into(s, nr, cols, |r, c| {
-                    let v = m[r * cols + c];
-                    if v > 0.0 {
-                        1.0 / v
-                    } else {
-                        0.0
-                    }
-                });
-            }
-            let (vsat, isats) = (&*vsat, &*isats);
-            let mut ys = vec![0.0f64; sizes.len()];
-            for g in g0..g1 {
-                let i = g * step;
-                let r0 = i.saturating_sub(h) - i0;
-                let r1 = (i + h + 1).min(rows) - i0;
-                for q in 0..ocols {
-                    let j = q * step;
-                    let c0 = j.saturating_sub(h);
-                    let c1 = (j + h + 1).min(cols);
-                    let n = rect(vsat, sw, r0, r1, c0, c1);
-                    if n < min_pixels {
-                        continue;
-                    }
-                    for (l, s) in isats.iter().enumerate() {
-                        ys[l] = (rect(s, sw, r0, r1, c0, c1) / n).ln();
-                    }
-                    let (slope, fit_r2) = line_fit(&xs, xm, sxx, &ys);
-                    let k = (g - g0) * ocols + q;
-                    dout[k] = (-slope) as f32;
-                    rout[k] = fit_r2 as f32;
+    grid.drive_pair(|sc: &mut Scratch, band, outs| {
+        let (i0, i1, nr) = (band.i0, band.i1, band.nr());
+        let sw = cols + 1;
+        let Scratch {
+            masses,
+            vsat,
+            isats,
+        } = sc;
+        let job = Band {
+            z,
+            rows,
+            cols,
+            r0: i0,
+            r1: i1,
+            ks: &ks,
+            z_scale: opt.z_scale,
+        };
+        box_masses_into(&job, masses);
+        let masses = &masses.planes;
+        valid_sat(vsat, band, cols, |r, c| z[(i0 + r) * cols + c].to_f64());
+        isats.resize_with(masses.len(), Vec::new);
+        for (s, m) in isats.iter_mut().zip(masses.iter()) {
+            sat_into(s, nr, cols, |r, c| {
+                let v = m[r * cols + c];
+                if v > 0.0 {
+                    1.0 / v
+                } else {
+                    0.0
                 }
+            });
+        }
+        let (vsat, isats) = (&*vsat, &*isats);
+        let mut ys = vec![0.0f64; sizes.len()];
+        grid.valid_windows(band, vsat, |k, r0, r1, c0, c1, n| {
+            for (l, s) in isats.iter().enumerate() {
+                ys[l] = (rect(s, sw, r0, r1, c0, c1) / n).ln();
             }
+            fit.write(&ys, outs, k);
         });
-    Ok((dim, r2))
+    })
 }
 
 #[cfg(test)]
@@ -510,7 +476,7 @@ mod tests {
             min_valid: 0.5,
             step: 1,
         };
-        let (d, _) = mass_transform(&z, rows, cols, &opt).unwrap();
+        let d = mass_transform(&z, rows, cols, &opt).unwrap().d;
         // windows whose boxes stay inside the image
         for i in 10..rows - 10 {
             for j in 10..cols - 10 {

@@ -9,11 +9,14 @@
 //! * [`blanket`]: Peleg's covering blanket, image-wide areas and per-window map.
 //! * [`gls`]: GLS fit of H over the log quadratic variations of increment
 //!   filters (summed-area tables).
+//! * [`driver`]: the moving-window driver (grid, bands, gate, fit, result)
+//!   every map kernel runs on.
 //! * [`dbc`]: differential box counting per window (sliding min/max and
 //!   summed-area tables strided by the box size).
 
 pub mod blanket;
 pub mod dbc;
+pub mod driver;
 pub mod gls;
 pub mod lacunarity;
 pub mod mass;

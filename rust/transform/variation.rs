@@ -14,11 +14,11 @@
 //! increment powers and counts, built per band of rows at fixed positions,
 //! so the cost per pixel is independent of `w` and the result does not
 //! depend on the thread count.
-use super::sat::{band_rows, check_window, line_fit, log_axis, rect, sat_into, sats_into};
-use crate::checks::{positive_finite, step_grid};
+use super::driver::{valid_sat, Grid, LogFit, MapOut};
+use super::sat::{rect, sats_into};
+use crate::checks::positive_finite;
 use crate::dimension::dbc::Sample;
 use crate::error::{CoreError, CoreResult};
-use rayon::prelude::*;
 
 /// Which increments.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -48,9 +48,9 @@ pub fn variation_transform<T: Sample>(
     rows: usize,
     cols: usize,
     opt: &VariationOptions,
-) -> CoreResult<(Vec<f32>, Vec<f32>)> {
+) -> CoreResult<MapOut> {
     let w = opt.window;
-    let min_pixels = check_window(z.len(), rows, cols, w, opt.min_valid)?;
+    let grid = Grid::new(z.len(), rows, cols, w, opt.min_valid, opt.step)?;
     let mut lags = opt.lags.clone();
     lags.sort_unstable();
     lags.dedup();
@@ -63,15 +63,8 @@ pub fn variation_transform<T: Sample>(
             ),
         ));
     }
-    positive_finite(opt.p, "p")?;
-    let step = opt.step;
-    step_grid(step, rows, cols)?;
-    let h = w / 2;
-    let (xs, xm, sxx) = log_axis(&lags);
-    // output grid (pixels 0, step, 2 step, ...) and its rows per band
-    let (orows, ocols) = (rows.div_ceil(step), cols.div_ceil(step));
-    let ob = (band_rows(w) / step).max(1);
-    let p = opt.p;
+    let p = positive_finite(opt.p, "p")?;
+    let fit = LogFit::new(&lags, |slope| 3.0 - slope / p);
     let power = move |d: f64| -> f64 {
         if p == 2.0 {
             d * d
@@ -81,8 +74,6 @@ pub fn variation_transform<T: Sample>(
             d.abs().powf(p)
         }
     };
-    let mut dim = vec![f32::NAN; orows * ocols];
-    let mut r2 = vec![f32::NAN; orows * ocols];
     // the components (row and column offsets) of each lag's increments
     let comps: Vec<Vec<(usize, usize)>> = lags
         .iter()
@@ -98,92 +89,61 @@ pub fn variation_transform<T: Sample>(
         vsat: Vec<f64>,
         tables: Vec<Vec<(Vec<f64>, Vec<f64>)>>,
     }
-    dim.par_chunks_mut(ob * ocols)
-        .zip(r2.par_chunks_mut(ob * ocols))
-        .enumerate()
-        .for_each_init(Scratch::default, |sc, (band, (dout, rout))| {
-            // output rows g0 .. g1 of the grid: image rows g0 step .. (g1 - 1) step
-            let g0 = band * ob;
-            let g1 = (g0 + ob).min(orows);
-            // input rows a window of the band can touch
-            let i0 = (g0 * step).saturating_sub(h);
-            let i1 = ((g1 - 1) * step + h + 1).min(rows);
-            let nr = i1 - i0;
-            let sw = cols + 1;
-            let get = |r: usize, c: usize| z[(i0 + r) * cols + c].to_f64();
-            sat_into(&mut sc.vsat, nr, cols, |r, c| {
-                (!get(r, c).is_nan()) as u8 as f64
-            });
-            // per lag and component: (power SAT, count SAT) of the increments
-            // anchored at (r, c); 0 where the increment leaves the band or is NaN
-            sc.tables.resize_with(lags.len(), Vec::new);
-            for ((t, cs), &u) in sc.tables.iter_mut().zip(&comps).zip(&lags) {
-                t.resize_with(cs.len(), Default::default);
-                for ((ps, ct), &(du_r, du_c)) in t.iter_mut().zip(cs) {
-                    let inc = |r: usize, c: usize| -> f64 {
-                        if r + du_r >= nr || c + du_c >= cols {
-                            return f64::NAN;
+    grid.drive_pair(|sc: &mut Scratch, band, outs| {
+        let (i0, nr) = (band.i0, band.nr());
+        let sw = cols + 1;
+        let get = |r: usize, c: usize| z[(i0 + r) * cols + c].to_f64();
+        valid_sat(&mut sc.vsat, band, cols, get);
+        // per lag and component: (power SAT, count SAT) of the increments
+        // anchored at (r, c); 0 where the increment leaves the band or is NaN
+        sc.tables.resize_with(lags.len(), Vec::new);
+        for ((t, cs), &u) in sc.tables.iter_mut().zip(&comps).zip(&lags) {
+            t.resize_with(cs.len(), Default::default);
+            for ((ps, ct), &(du_r, du_c)) in t.iter_mut().zip(cs) {
+                let inc = |r: usize, c: usize| -> f64 {
+                    if r + du_r >= nr || c + du_c >= cols {
+                        return f64::NAN;
+                    }
+                    match opt.increments {
+                        Increments::First => get(r + du_r, c + du_c) - get(r, c),
+                        Increments::Square => {
+                            get(r + u, c + u) - get(r + u, c) - get(r, c + u) + get(r, c)
                         }
-                        match opt.increments {
-                            Increments::First => get(r + du_r, c + du_c) - get(r, c),
-                            Increments::Square => {
-                                get(r + u, c + u) - get(r + u, c) - get(r, c + u) + get(r, c)
-                            }
-                        }
-                    };
-                    // power and count of each increment, computed once
-                    sats_into([ps, ct], nr, cols, |r, c| {
-                        let d = inc(r, c);
-                        if d.is_nan() {
-                            [0.0, 0.0]
-                        } else {
-                            [power(d), 1.0]
-                        }
-                    });
-                }
+                    }
+                };
+                // power and count of each increment, computed once
+                sats_into([ps, ct], nr, cols, |r, c| {
+                    let d = inc(r, c);
+                    if d.is_nan() {
+                        [0.0, 0.0]
+                    } else {
+                        [power(d), 1.0]
+                    }
+                });
             }
-            let (vsat, tables) = (&sc.vsat, &sc.tables);
-            let mut ys = vec![0.0f64; lags.len()];
-            for g in g0..g1 {
-                let i = g * step;
-                let r0 = i.saturating_sub(h) - i0;
-                let r1 = (i + h + 1).min(rows) - i0;
-                for q in 0..ocols {
-                    let j = q * step;
-                    let c0 = j.saturating_sub(h);
-                    let c1 = (j + h + 1).min(cols);
-                    let k = (g - g0) * ocols + q;
-                    if rect(vsat, sw, r0, r1, c0, c1) < min_pixels {
-                        continue;
-                    }
-                    let mut ok = true;
-                    // per lag, the (power, count) tables of each component
-                    for (li, (t, offs)) in tables.iter().zip(&comps).enumerate() {
-                        let (mut sp, mut sc) = (0.0, 0.0);
-                        for ((ps, cs), &(du_r, du_c)) in t.iter().zip(offs) {
-                            // anchors whose partner lies in the window too
-                            let rr1 = r1.saturating_sub(du_r);
-                            let cc1 = c1.saturating_sub(du_c);
-                            sp += rect(ps, sw, r0, rr1, c0, cc1);
-                            sc += rect(cs, sw, r0, rr1, c0, cc1);
-                        }
-                        // counts are sums of ones: exact in f64
-                        if sc < 0.5 || sp <= 0.0 {
-                            ok = false;
-                            break;
-                        }
-                        ys[li] = (sp / sc / 2.0).ln();
-                    }
-                    if !ok {
-                        continue;
-                    }
-                    let (slope, fit_r2) = line_fit(&xs, xm, sxx, &ys);
-                    dout[k] = (3.0 - slope / opt.p) as f32;
-                    rout[k] = fit_r2 as f32;
+        }
+        let (vsat, tables) = (&sc.vsat, &sc.tables);
+        let mut ys = vec![0.0f64; lags.len()];
+        grid.valid_windows(band, vsat, |k, r0, r1, c0, c1, _| {
+            // per lag, the (power, count) tables of each component
+            for (li, (t, offs)) in tables.iter().zip(&comps).enumerate() {
+                let (mut sp, mut sc) = (0.0, 0.0);
+                for ((ps, cs), &(du_r, du_c)) in t.iter().zip(offs) {
+                    // anchors whose partner lies in the window too
+                    let rr1 = r1.saturating_sub(du_r);
+                    let cc1 = c1.saturating_sub(du_c);
+                    sp += rect(ps, sw, r0, rr1, c0, cc1);
+                    sc += rect(cs, sw, r0, rr1, c0, cc1);
                 }
+                // counts are sums of ones: exact in f64
+                if sc < 0.5 || sp <= 0.0 {
+                    return;
+                }
+                ys[li] = (sp / sc / 2.0).ln();
             }
+            fit.write(&ys, outs, k);
         });
-    Ok((dim, r2))
+    })
 }
 
 #[cfg(test)]
@@ -263,7 +223,7 @@ mod tests {
                 min_valid: 0.0,
                 step: 1,
             };
-            let (d, _) = variation_transform(&z, rows, cols, &opt).unwrap();
+            let d = variation_transform(&z, rows, cols, &opt).unwrap().d;
             for &(i, j) in &[
                 (0usize, 0usize),
                 (3, 40),
@@ -300,7 +260,7 @@ mod tests {
             crate::parallel::run_in_pool(Some(t), || variation_transform(&z, rows, cols, &opt))
                 .unwrap()
         };
-        let (a, _) = run(1);
+        let a = run(1).d;
         // interior (full windows): exactly a plane's D = 2; at the edges the
         // clipped window pools unequal numbers of row and column increments
         for i in 5..rows - 5 {
@@ -314,9 +274,9 @@ mod tests {
         }
         // a corner window holds 6 x 6 = 36 pixels, fewer than half of 11 x 11
         assert!(a[0].is_nan() && a[cols + 5].is_finite());
-        let bits = |(d, r): (Vec<f32>, Vec<f32>)| -> Vec<(u32, u32)> {
-            d.iter()
-                .zip(&r)
+        let bits = |m: MapOut| -> Vec<(u32, u32)> {
+            m.d.iter()
+                .zip(&m.r2)
                 .map(|(a, b)| (a.to_bits(), b.to_bits()))
                 .collect()
         };
@@ -327,7 +287,7 @@ mod tests {
         // the step grid is the full map's every step-th pixel (sums of the
         // same tables, from other band origins: equal to rounding)
         for step in [2usize, 3, 7] {
-            let (g, _) = variation_transform(
+            let g = variation_transform(
                 &z,
                 rows,
                 cols,
@@ -336,7 +296,8 @@ mod tests {
                     ..opt.clone()
                 },
             )
-            .unwrap();
+            .unwrap()
+            .d;
             let (orows, ocols) = (rows.div_ceil(step), cols.div_ceil(step));
             assert_eq!(g.len(), orows * ocols);
             for gi in 0..orows {
