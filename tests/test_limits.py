@@ -122,6 +122,8 @@ def _png_claiming(path, width, height):
     open(path, "wb").write(bytes(raw))
 
 
+# the test writes GeoTIFFs without georeferencing: rasterio says so on reading
+@pytest.mark.filterwarnings("ignore::rasterio.errors.NotGeoreferencedWarning")
 def test_readers_estimate_bytes_from_the_header(tmp_path):
     from fractalgeo_rs.io import RasterMemoryError
 
@@ -136,6 +138,8 @@ def test_readers_estimate_bytes_from_the_header(tmp_path):
         fg.read_raster(png)
 
 
+# the test writes GeoTIFFs without georeferencing: rasterio says so on reading
+@pytest.mark.filterwarnings("ignore::rasterio.errors.NotGeoreferencedWarning")
 def test_readers_follow_the_memory_limit(tmp_path, monkeypatch):
     rasterio = pytest.importorskip("rasterio")
     z = np.zeros((300, 200), dtype=np.float32)

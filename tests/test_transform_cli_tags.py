@@ -64,6 +64,7 @@ def test_fixed_z_scale_and_scale_free_methods(tmp_path, dem_tif):
     assert tags["Z_SCALE"] == "none" and "Z_SCALE_UNITS" not in tags
 
 
+@pytest.mark.filterwarnings("ignore::rasterio.errors.NotGeoreferencedWarning")  # a bare TIFF, on purpose
 def test_out_of_range_fraction_is_printed(tmp_path, capsys):
     p = tmp_path / "noise.tif"
     z = np.random.default_rng(0).standard_normal((64, 64)).astype(np.float32)

@@ -27,7 +27,7 @@ def test_z_scale_cell_uses_and_records_the_cell_size(tmp_path, capsys):
     with rasterio.open(out) as ds:
         tags = ds.tags()
         got = ds.read(1)
-    assert tags["Z_SCALE"] == "30" and tags["INPUT_CELL_SIZE"] == "30"
+    assert float(tags["Z_SCALE"]) == 30.0 and tags["INPUT_CELL_SIZE"] == "30"
     assert tags["FRACTAL_METHOD"] == "dbc" and tags["WINDOW_SIZE"] == "9"
     ref = fg.fractal_transform(z, 9, method="dbc", z_scale=30.0)
     np.testing.assert_array_equal(got, ref.astype(np.float32))

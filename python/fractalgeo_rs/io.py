@@ -46,7 +46,42 @@ __all__ = ["read_raster", "write_raster", "is_binary_mask", "RasterMemoryError"]
 
 class RasterMemoryError(OSError, MemoryError):
     """A raster whose header announces more data than the memory limit
-    allows (nothing was read)."""
+    allows (nothing was read).
+
+    Raised by :func:`~fractalgeo_rs.read_raster` before it reads: the
+    array's size is computed from the file's header (``.npy``, PNG, or the
+    rasterio profile) and compared with the memory limit of
+    ``docs/input_policy.md``. It is both an :class:`OSError` (the file
+    cannot be read as asked) and a :class:`MemoryError`, so either
+    ``except`` clause catches it.
+
+    Parameters
+    ----------
+    message : str
+        Names the path, the estimated bytes and the limit.
+
+    References
+    ----------
+    NumPy Enhancement Proposal 1, *A simple file format for NumPy arrays*
+    (the ``.npy`` header read for the estimate),
+    https://numpy.org/neps/nep-0001-npy-format.html.
+
+    Examples
+    --------
+    >>> import os, tempfile, numpy as np
+    >>> from fractalgeo_rs.io import RasterMemoryError, read_raster
+    >>> old = os.environ.get("FRACTALGEO_MAX_MEMORY")
+    >>> os.environ["FRACTALGEO_MAX_MEMORY"] = "100000"  # a 100 kB limit
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     path = os.path.join(d, "big.npy")
+    ...     np.save(path, np.zeros((256, 256)))  # 512 KiB of float64
+    ...     try:
+    ...         read_raster(path)
+    ...     except RasterMemoryError as e:
+    ...         print(isinstance(e, OSError), isinstance(e, MemoryError))
+    True True
+    >>> _ = os.environ.pop("FRACTALGEO_MAX_MEMORY") if old is None else os.environ.update(FRACTALGEO_MAX_MEMORY=old)
+    """
 
 
 def _check_raster_bytes(p, n_bytes, what: str) -> None:

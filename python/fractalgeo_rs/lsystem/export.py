@@ -46,11 +46,11 @@ def write_obj(mesh: Mesh, path: PathLike) -> None:
 
     Examples
     --------
-    >>> import os, tempfile
+    >>> import os, pathlib, tempfile
     >>> from fractalgeo_rs.lsystem import plant_mesh, write_obj
     >>> with tempfile.TemporaryDirectory() as d:
     ...     write_obj(plant_mesh("F", sides=3), os.path.join(d, "stem.obj"))
-    ...     lines = open(os.path.join(d, "stem.obj")).read().splitlines()
+    ...     lines = pathlib.Path(d, "stem.obj").read_text().splitlines()
     >>> [sum(ln.startswith(k + " ") for ln in lines) for k in ("v", "vt", "vn", "f")]
     [8, 8, 8, 6]
     >>> [ln for ln in lines if ln.startswith(("g ", "f "))][:3]
@@ -85,11 +85,11 @@ def write_ply(mesh: Mesh, path: PathLike) -> None:
 
     Examples
     --------
-    >>> import os, tempfile
+    >>> import os, pathlib, tempfile
     >>> from fractalgeo_rs.lsystem import plant_mesh, write_ply
     >>> with tempfile.TemporaryDirectory() as d:
     ...     write_ply(plant_mesh("F", sides=3), os.path.join(d, "stem.ply"))
-    ...     data = open(os.path.join(d, "stem.ply"), "rb").read()
+    ...     data = pathlib.Path(d, "stem.ply").read_bytes()
     >>> header, body = data.split(b"end_header" + bytes([10]))  # the header ends with a newline
     >>> header.splitlines()[:2], len(body) == 8 * 32 + 6 * 26
     ([b'ply', b'format binary_little_endian 1.0'], True)
@@ -134,11 +134,11 @@ def write_svg(drawing: Polylines, path: PathLike, *, size: float = 800.0, stroke
     A unit square drawn in a 100-pixel picture with a 10-pixel margin (y
     points down in SVG):
 
-    >>> import os, tempfile
+    >>> import os, pathlib, tempfile
     >>> from fractalgeo_rs.lsystem import turtle_2d, write_svg
     >>> with tempfile.TemporaryDirectory() as d:
     ...     write_svg(turtle_2d("F+F+F+F"), os.path.join(d, "square.svg"), size=100)
-    ...     svg = open(os.path.join(d, "square.svg")).read()
+    ...     svg = pathlib.Path(d, "square.svg").read_text()
     >>> svg.splitlines()[1].split('"')[1]
     '90.000,90.000 90.000,10.000 10.000,10.000 10.000,90.000 90.000,90.000'
     """

@@ -100,8 +100,8 @@ def _run(args: argparse.Namespace) -> int:
             shift = 0.5 - args.step / 2.0
             # Affine(a, b, c, d, e, f): x = a col + b row + c; the cell is step
             # pixels wide with its corner shifted by (1 - step) / 2 pixels
-            cell = Affine(args.step, 0.0, shift, 0.0, args.step, shift)
-            transform = transform @ cell if hasattr(transform, "__matmul__") else transform * cell
+            step_cell = Affine(args.step, 0.0, shift, 0.0, args.step, shift)
+            transform = transform @ step_cell if hasattr(transform, "__matmul__") else transform * step_cell
         if cell is not None:
             tags["INPUT_CELL_SIZE"] = f"{cell:.9g}"
         write_raster(args.output, dmap, crs=(profile or {}).get("crs"), transform=transform, nodata=float("nan"),
