@@ -29,6 +29,9 @@ pub mod synth;
 pub mod tin;
 pub mod transform;
 
+#[cfg(test)]
+mod testdata;
+
 #[cfg(feature = "python")]
 pub mod bindings;
 

@@ -647,15 +647,7 @@ mod tests {
     #[test]
     fn zero_error_on_random_is_every_sample() {
         let (rows, cols) = (9, 11);
-        let mut x = 12345u64;
-        let z: Vec<f64> = (0..rows * cols)
-            .map(|_| {
-                x = x
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                (x >> 11) as f64 / (1u64 << 53) as f64
-            })
-            .collect();
+        let z: Vec<f64> = crate::testdata::uniform(rows * cols, 12345);
         for shared in [false, true] {
             let t = greedy_tin(&z, rows, cols, 0.0, None, shared).unwrap();
             assert_eq!(t.grid.len(), rows * cols);

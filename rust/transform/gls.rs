@@ -630,15 +630,7 @@ mod tests {
     #[test]
     fn threads_step_and_holes() {
         let (rows, cols) = (90usize, 70usize);
-        let mut seed = 9u64;
-        let mut z: Vec<f64> = (0..rows * cols)
-            .map(|_| {
-                seed = seed
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                (seed >> 11) as f64 / (1u64 << 53) as f64
-            })
-            .collect();
+        let mut z: Vec<f64> = crate::testdata::uniform(rows * cols, 9);
         for k in (0..z.len()).step_by(53) {
             z[k] = f64::NAN;
         }
@@ -761,15 +753,7 @@ mod tests {
     #[test]
     fn sliding_sums_equal_direct_window_sums_with_holes_edges_and_a_spike() {
         let (rows, cols, w, k) = (150usize, 61usize, 15usize, 2usize);
-        let mut seed = 11u64;
-        let mut z: Vec<f64> = (0..rows * cols)
-            .map(|_| {
-                seed = seed
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                (seed >> 11) as f64 / (1u64 << 53) as f64
-            })
-            .collect();
+        let mut z: Vec<f64> = crate::testdata::uniform(rows * cols, 11);
         // a spike 1e9 times the background: windows it has left must not
         // keep its rounding; and missing samples
         z[40 * cols + 30] = 1e9;

@@ -202,15 +202,7 @@ mod tests {
     #[test]
     fn equals_direct_window_sums_with_holes_and_edges() {
         let (rows, cols) = (70usize, 45usize);
-        let mut seed = 5u64;
-        let mut z: Vec<f64> = (0..rows * cols)
-            .map(|_| {
-                seed = seed
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                (seed >> 11) as f64 / (1u64 << 53) as f64
-            })
-            .collect();
+        let mut z: Vec<f64> = crate::testdata::uniform(rows * cols, 5);
         for k in (0..z.len()).step_by(37) {
             z[k] = f64::NAN;
         }
