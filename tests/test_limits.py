@@ -3,6 +3,7 @@
 import subprocess
 import sys
 import textwrap
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -116,10 +117,10 @@ def _huge_npy(path, shape=(10**6, 10**6)):
 def _png_claiming(path, width, height):
     # a valid 4 x 4 PNG whose IHDR is rewritten to announce width x height
     fg.write_raster(path, np.zeros((4, 4), dtype=np.uint8))
-    raw = bytearray(open(path, "rb").read())
+    raw = bytearray(Path(path).read_bytes())
     raw[16:20] = width.to_bytes(4, "big")
     raw[20:24] = height.to_bytes(4, "big")
-    open(path, "wb").write(bytes(raw))
+    Path(path).write_bytes(bytes(raw))
 
 
 # the test writes GeoTIFFs without georeferencing: rasterio says so on reading
