@@ -214,7 +214,7 @@ class TIN:
         return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
 
     def to_mesh(self):
-        """The TIN as a :class:`fractalgeo_rs.lsystem.geometry.Mesh` for the
+        """The TIN as a :class:`~fractalgeo_rs.lsystem.Mesh` for the
         OBJ/PLY writers: float32 vertices (map coordinates relative to the
         lower-left vertex, so that float32 keeps centimetres in UTM),
         per-vertex normals, UVs = map ``x, y`` scaled to [0, 1] over the

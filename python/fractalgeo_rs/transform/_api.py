@@ -176,7 +176,7 @@ def fractal_transform(
     z_scale : float or "auto", default "auto"
         ``"mass"``, ``"dbc"``, ``"blanket"``: height units per pixel (e.g. 1
         grey level, 1 dB or 1 metre); the estimates depend on this unit.
-        ``"auto"``: :func:`default_z_scale` of the whole image, ``1.4826 *
+        ``"auto"``: :func:`~fractalgeo_rs.transform.default_z_scale` of the whole image, ``1.4826 *
         median |lag-1 increment|`` (one typical step per box), recorded in
         the xarray output's ``attrs["z_scale"]``; maps are comparable only
         at equal ``z_scale``, so pass a fixed number across scenes.
@@ -217,7 +217,7 @@ def fractal_transform(
         :class:`~fractalgeo_rs.transform.TransformFit` (a tuple of the maps) whose
         ``flags`` is the flag layer (uint8 bits: 1 ``D < 2``, 2 ``D > 3``,
         4 pinned at an end of the ``H`` grid, 8 too few valid pixels; 0 =
-        valid; :data:`~fractalgeo_rs.transform.FLAGS`) and ``params`` the method, window, step and
+        valid; ``fractalgeo_rs.transform.FLAGS``) and ``params`` the method, window, step and
         ``z_scale`` used. Without it an in-memory map with values outside
         ``[2, 3]`` raises one :class:`~fractalgeo_rs.FractalRangeWarning`
         giving their fractions.
@@ -229,7 +229,7 @@ def fractal_transform(
         ``[0, 180)`` from the column axis towards the row axis, the
         direction of fastest variation) and ratio (``>= 1``) of geometric
         anisotropy, fitted to the window's first-order directional
-        variations (:func:`fractalgeo_rs.dimension.gls.anisotropy_from_variations`),
+        variations (``anisotropy_from_variations``),
         after the dimension (and standard-error) maps.
 
     Returns

@@ -110,7 +110,7 @@ class TransformFit(tuple):
     Attributes
     ----------
     flags : ndarray of uint8 (or the input's dask/xarray type)
-        The flag layer (bits in :data:`FLAGS`: 1 below 2, 2 above 3,
+        The flag layer (bits in ``fractalgeo_rs.transform.FLAGS``: 1 below 2, 2 above 3,
         4 pinned, 8 too few valid; 0 = valid).
     params : dict
         ``method``, ``window_size``, ``step``, ``z_scale`` (the value used,
