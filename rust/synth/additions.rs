@@ -32,6 +32,7 @@
 //! noise; there is no padded copy of a whole grid and no grid of centres.
 use super::rng::StreamKey;
 use crate::error::{CoreError, CoreResult};
+use crate::progress::{add_total, tick, Progress};
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
 
@@ -451,6 +452,18 @@ pub fn refine_2d_levels_window(
     base: &AdditionsParams,
     shape: Option<(usize, usize)>,
 ) -> CoreResult<Array2<f64>> {
+    refine_2d_levels_counted(coarse, levels, base, shape, None)
+}
+
+/// [`refine_2d_levels_window`] ticking `progress` by the cells of each
+/// level's grid (the window at the last level) as the level completes.
+pub fn refine_2d_levels_counted(
+    coarse: ArrayView2<f64>,
+    levels: u32,
+    base: &AdditionsParams,
+    shape: Option<(usize, usize)>,
+    progress: Option<&Progress>,
+) -> CoreResult<Array2<f64>> {
     check(base)?;
     if levels == 0 {
         let Some(shape) = shape else {
@@ -459,6 +472,10 @@ pub fn refine_2d_levels_window(
         let (or, oc) = window_shape(Some(shape), coarse.dim())?;
         return Ok(coarse.slice(ndarray::s![..or, ..oc]).to_owned());
     }
+    add_total(
+        progress,
+        crate::synth::midpoint::refined_cells(coarse.dim(), levels, base.periodic, shape),
+    );
     let mut grid = coarse.to_owned();
     let mut p = *base;
     for l in 0..levels {
@@ -469,6 +486,7 @@ pub fn refine_2d_levels_window(
         p.origin = (0, 0);
         let window = if l + 1 == levels { shape } else { None };
         grid = refine_2d_window(grid.view(), &p, window)?;
+        tick(progress, grid.len() as u64);
         p.coarse_spacing /= 2.0;
     }
     Ok(grid)
@@ -565,6 +583,33 @@ mod tests {
             }
             assert!(refine_2d_window(coarse.view(), &p, Some((fr + 1, fc))).is_err());
             assert!(refine_2d_window(coarse.view(), &p, Some((0, fc))).is_err());
+        }
+    }
+
+    #[test]
+    fn counted_refinement_is_the_same_and_reaches_its_total() {
+        let coarse = Array2::from_shape_fn((3, 4), |(i, j)| (i * 4 + j) as f64);
+        for (periodic, shape) in [(false, Some((16, 20))), (false, None), (true, None)] {
+            let p = params(periodic);
+            let pr = Progress::new();
+            let a = run_in_pool(Some(2), || {
+                refine_2d_levels_counted(coarse.view(), 3, &p, shape, Some(&pr))
+            })
+            .unwrap();
+            let b = run_in_pool(Some(1), || {
+                refine_2d_levels_window(coarse.view(), 3, &p, shape)
+            })
+            .unwrap();
+            assert_eq!(a, b);
+            assert_eq!(pr.done(), pr.total());
+            // the levels' grids: 5 x 7, 9 x 13 and the last (window or whole)
+            let last = shape.unwrap_or(if periodic { (24, 32) } else { (17, 25) });
+            let first = if periodic {
+                6 * 8 + 12 * 16
+            } else {
+                5 * 7 + 9 * 13
+            };
+            assert_eq!(pr.total(), (first + last.0 * last.1) as u64);
         }
     }
 

@@ -26,6 +26,7 @@
 //! whichever tile (`origin`) computes it.
 use super::rng::StreamKey;
 use crate::error::{CoreError, CoreResult};
+use crate::progress::{add_total, tick, Progress};
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
 
@@ -329,6 +330,45 @@ pub fn refine_2d_levels(
     levels: u32,
     base: &RefineParams,
 ) -> CoreResult<Array2<f64>> {
+    refine_2d_levels_counted(coarse, levels, base, None)
+}
+
+/// Cells of the grids produced by `levels` refinements of an `(r, c)` grid
+/// (the work [`refine_2d_levels_counted`] announces).
+pub(crate) fn refined_cells(
+    (mut r, mut c): (usize, usize),
+    levels: u32,
+    periodic: bool,
+    last: Option<(usize, usize)>,
+) -> u64 {
+    let mut total = 0u64;
+    for l in 0..levels {
+        (r, c) = if periodic {
+            (2 * r, 2 * c)
+        } else {
+            (2 * r - 1, 2 * c - 1)
+        };
+        let (wr, wc) = match last {
+            Some(w) if l + 1 == levels => w,
+            _ => (r, c),
+        };
+        total = total.saturating_add((wr as u64).saturating_mul(wc as u64));
+    }
+    total
+}
+
+/// [`refine_2d_levels`] ticking `progress` by the cells of each level's
+/// grid as the level completes.
+pub fn refine_2d_levels_counted(
+    coarse: ArrayView2<f64>,
+    levels: u32,
+    base: &RefineParams,
+    progress: Option<&Progress>,
+) -> CoreResult<Array2<f64>> {
+    add_total(
+        progress,
+        refined_cells(coarse.dim(), levels, base.periodic, None),
+    );
     let mut grid = coarse.to_owned();
     let mut p = *base;
     for l in 0..levels {
@@ -343,6 +383,7 @@ pub fn refine_2d_levels(
         p.global_cols = fc as u64;
         p.origin = (0, 0);
         grid = refine_2d(grid.view(), &p)?;
+        tick(progress, grid.len() as u64);
         p.coarse_spacing /= 2.0;
     }
     Ok(grid)
@@ -378,6 +419,21 @@ mod tests {
             origin: (0, 0),
             global_cols: 0,
         }
+    }
+
+    #[test]
+    fn counted_refinement_is_the_same_and_reaches_its_total() {
+        let coarse = Array2::from_shape_fn((3, 3), |(i, j)| (i + 2 * j) as f64);
+        let p = params(true, false);
+        let pr = Progress::new();
+        let a = run_in_pool(Some(2), || {
+            refine_2d_levels_counted(coarse.view(), 3, &p, Some(&pr))
+        })
+        .unwrap();
+        let b = run_in_pool(Some(1), || refine_2d_levels(coarse.view(), 3, &p)).unwrap();
+        assert_eq!(a, b);
+        // 5 x 5, 9 x 9, 17 x 17
+        assert_eq!((pr.done(), pr.total()), (25 + 81 + 289, 25 + 81 + 289));
     }
 
     #[test]

@@ -239,8 +239,20 @@ pub fn inverse_normal_cdf(p: f64) -> f64 {
 /// `start .. start + out.len()`, in parallel (the result does not depend on
 /// the number of threads).
 pub fn fill_normal(out: &mut [f64], seed: u64, stream: u64, start: u64) {
+    fill_normal_counted(out, seed, stream, start, None);
+}
+
+/// [`fill_normal`] ticking `progress` by the values drawn (total: `out.len()`).
+pub fn fill_normal_counted(
+    out: &mut [f64],
+    seed: u64,
+    stream: u64,
+    start: u64,
+    progress: Option<&crate::progress::Progress>,
+) {
     use rayon::prelude::*;
     let key = StreamKey::new(seed, stream);
+    crate::progress::add_total(progress, out.len() as u64);
     out.par_chunks_mut(1 << 14)
         .enumerate()
         .for_each(|(ci, chunk)| {
@@ -248,6 +260,7 @@ pub fn fill_normal(out: &mut [f64], seed: u64, stream: u64, start: u64) {
             for (i, v) in chunk.iter_mut().enumerate() {
                 *v = key.normal(base + i as u64);
             }
+            crate::progress::tick(progress, chunk.len() as u64);
         });
 }
 
