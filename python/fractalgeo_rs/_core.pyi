@@ -11,6 +11,7 @@ __version__: str
 __all__ = [
     "LSystemCore",
     "ModuleString",
+    "ProgressCounter",
     "__version__",
     "additions_refine_2d",
     "blanket_areas_image",
@@ -98,8 +99,21 @@ def read_image(path: str | PathLike[str]) -> np.ndarray: ...
 def write_png(path: str | PathLike[str], image: np.ndarray) -> None: ...
 
 # ---- synth / dem ----
+@final
+class ProgressCounter:
+    def __new__(cls) -> ProgressCounter: ...
+    @property
+    def done(self) -> int: ...
+    @property
+    def total(self) -> int: ...
+
 def normal_noise(
-    n: int, seed: int, stream: int, start: int = 0, n_threads: Optional[int] = None
+    n: int,
+    seed: int,
+    stream: int,
+    start: int = 0,
+    n_threads: Optional[int] = None,
+    progress: Optional[ProgressCounter] = None,
 ) -> npt.NDArray[np.float64]: ...
 def midpoint_refine_1d(
     coarse: npt.NDArray[np.float64],
@@ -123,6 +137,7 @@ def midpoint_refine_2d(
     seed: int,
     first_level: int = 0,
     n_threads: Optional[int] = None,
+    progress: Optional[ProgressCounter] = None,
 ) -> npt.NDArray[np.float64]: ...
 def additions_refine_2d(
     coarse: npt.NDArray[np.float64],
@@ -137,6 +152,7 @@ def additions_refine_2d(
     first_level: int = 0,
     n_threads: Optional[int] = None,
     shape: Optional[Tuple[int, int]] = None,
+    progress: Optional[ProgressCounter] = None,
 ) -> npt.NDArray[np.float64]: ...
 def fgn_sqrt_eigenvalues(m: int, hurst: float, n_threads: Optional[int] = None) -> npt.NDArray[np.float64]: ...
 def davies_harte_fbm(

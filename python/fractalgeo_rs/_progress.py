@@ -10,14 +10,24 @@
 A bar needs tqdm (``pip install "fractalgeo_rs[progress]"``); without it no
 bar is drawn and nothing fails. Work computed by Dask reports through
 ``dask.diagnostics.ProgressBar`` (:func:`dask_bar`), which needs no tqdm.
+
+One long Rust call reports through a ``_core.ProgressCounter`` that the
+kernel ticks with the GIL released: :class:`Steps` runs the call on a worker
+thread and copies the counter into the bar every 0.1 s from the calling
+thread (:meth:`Steps.counted`). The counter never changes the work: results
+are the same with and without a bar.
 """
 from __future__ import annotations
 
 import contextlib
 import sys
+import threading
 from typing import Optional
 
-__all__ = ["resolve", "bar", "dask_bar"]
+__all__ = ["resolve", "bar", "dask_bar", "Steps"]
+
+#: Seconds between two reads of a running kernel's counter.
+POLL_SECONDS = 0.1
 
 
 def resolve(progress: Optional[bool], *, cli: bool = False) -> bool:
@@ -49,9 +59,10 @@ class _NoBar:
 
 
 @contextlib.contextmanager
-def bar(total: int, desc: str, enabled: bool):
-    """A tqdm bar of ``total`` steps on stderr when ``enabled`` and tqdm is
-    importable, else an object whose ``update`` does nothing."""
+def bar(total: int, desc: str, enabled: bool, unit: str = "it"):
+    """A tqdm bar of ``total`` steps (of ``unit``, scaled with k/M prefixes
+    unless ``"it"``) on stderr when ``enabled`` and tqdm is importable, else
+    an object whose ``update`` does nothing."""
     b = _NoBar()
     if enabled:
         try:
@@ -59,7 +70,8 @@ def bar(total: int, desc: str, enabled: bool):
         except ImportError:
             tqdm = None
         if tqdm is not None:
-            b = tqdm(total=total, desc=desc, file=sys.stderr, leave=False)
+            b = tqdm(total=total, desc=desc, file=sys.stderr, leave=False, unit=unit,
+                     unit_scale=unit != "it")
     try:
         yield b
     finally:
@@ -76,3 +88,70 @@ def dask_bar(enabled: bool):
     except ImportError:
         return contextlib.nullcontext()
     return ProgressBar(out=sys.stderr)
+
+
+class Steps:
+    """The steps of one computation on one bar of ``total`` units.
+
+    :meth:`step` advances the bar by work done in Python; :meth:`counted`
+    runs a ``_core`` call that takes a ``progress`` counter and moves the bar
+    through ``weight`` units as the kernel ticks. With ``enabled=False`` the
+    call runs on the calling thread with ``progress=None``.
+    """
+
+    def __init__(self, total: int, desc: str, enabled: bool):
+        self.total = int(total)
+        self.desc = desc
+        self.enabled = bool(enabled)
+        self._bar = _NoBar()
+        self._ctx = None
+
+    def __enter__(self) -> "Steps":
+        if self.enabled:
+            self._ctx = bar(self.total, self.desc, True, unit="cell")
+            self._bar = self._ctx.__enter__()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._ctx is not None:
+            self._ctx.__exit__(*exc)
+
+    def step(self, n: int) -> None:
+        """Advance the bar by ``n`` units."""
+        self._bar.update(int(n))
+
+    def counted(self, call, weight: int):
+        """``call(counter)`` (``counter`` a ``_core.ProgressCounter``, or
+        ``None`` when disabled), moving the bar through ``weight`` units.
+        The worker's exception is re-raised unchanged; a KeyboardInterrupt
+        reaches the calling thread between polls (the kernel then finishes
+        in the background, its result discarded)."""
+        if not self.enabled:
+            return call(None)
+        from . import _core
+
+        counter = _core.ProgressCounter()
+        box = {}
+
+        def work():
+            try:
+                box["value"] = call(counter)
+            except BaseException as e:  # re-raised on the calling thread
+                box["error"] = e
+
+        t = threading.Thread(target=work, name="fractalgeo-kernel", daemon=True)
+        shown = 0
+        t.start()
+        while True:
+            t.join(POLL_SECONDS)
+            finished = not t.is_alive()
+            total = counter.total
+            now = weight if finished else (weight * counter.done // total if total else 0)
+            if now > shown:
+                self._bar.update(now - shown)
+                shown = now
+            if finished:
+                break
+        if "error" in box:
+            raise box["error"]
+        return box["value"]

@@ -1,5 +1,6 @@
 //! Bindings of `crate::synth`.
 use super::convert::{array1, c_order, run};
+use crate::progress::Progress;
 use crate::synth::additions::{self, AdditionsParams};
 use crate::synth::davies_harte;
 use crate::synth::midpoint::{self, RefineParams};
@@ -7,10 +8,44 @@ use crate::synth::rng;
 use crate::synth::spectral;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
+use std::sync::Arc;
+
+/// A work counter a kernel ticks while it runs with the GIL released:
+/// `done` and `total` can be read from another Python thread meanwhile.
+#[pyclass(frozen, module = "fractalgeo_rs._core")]
+pub struct ProgressCounter {
+    inner: Arc<Progress>,
+}
+
+#[pymethods]
+impl ProgressCounter {
+    #[new]
+    fn new() -> Self {
+        Self {
+            inner: Arc::new(Progress::new()),
+        }
+    }
+
+    /// Units of work done so far.
+    #[getter]
+    fn done(&self) -> u64 {
+        self.inner.done()
+    }
+
+    /// Units of work announced so far by the kernels given this counter.
+    #[getter]
+    fn total(&self) -> u64 {
+        self.inner.total()
+    }
+}
+
+fn counter(p: Option<&Bound<'_, ProgressCounter>>) -> Option<Arc<Progress>> {
+    p.map(|c| Arc::clone(&c.get().inner))
+}
 
 /// `n` standard normals of stream `(seed, stream)` at indices `start ..`.
 #[pyfunction]
-#[pyo3(signature = (n, seed, stream, start=0, n_threads=None))]
+#[pyo3(signature = (n, seed, stream, start=0, n_threads=None, progress=None))]
 fn normal_noise<'py>(
     py: Python<'py>,
     n: usize,
@@ -18,10 +53,12 @@ fn normal_noise<'py>(
     stream: u64,
     start: u64,
     n_threads: Option<usize>,
+    progress: Option<&Bound<'py, ProgressCounter>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let pr = counter(progress);
     let v = run(py, n_threads, || {
         let mut v = crate::buffers::try_zeroed(n, "n")?;
-        rng::fill_normal(&mut v, seed, stream, start);
+        rng::fill_normal_counted(&mut v, seed, stream, start, pr.as_deref());
         Ok(v)
     })?;
     Ok(v.into_pyarray(py))
@@ -84,7 +121,7 @@ fn midpoint_refine_1d<'py>(
 /// Refine a 2D grid `levels` times by factors of 2 (diamond-square, optionally
 /// with random additions; periodic: torus).
 #[pyfunction]
-#[pyo3(signature = (coarse, levels, hurst, sigma, coarse_spacing, additions, periodic, seed, first_level=0, n_threads=None))]
+#[pyo3(signature = (coarse, levels, hurst, sigma, coarse_spacing, additions, periodic, seed, first_level=0, n_threads=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn midpoint_refine_2d<'py>(
     py: Python<'py>,
@@ -98,7 +135,9 @@ fn midpoint_refine_2d<'py>(
     seed: u64,
     first_level: u32,
     n_threads: Option<usize>,
+    progress: Option<&Bound<'py, ProgressCounter>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let pr = counter(progress);
     let c = coarse.as_array();
     let p = params(
         hurst,
@@ -109,7 +148,9 @@ fn midpoint_refine_2d<'py>(
         seed,
         first_level,
     );
-    let v = run(py, n_threads, || midpoint::refine_2d_levels(c, levels, &p))?;
+    let v = run(py, n_threads, || {
+        midpoint::refine_2d_levels_counted(c, levels, &p, pr.as_deref())
+    })?;
     Ok(v.into_pyarray(py))
 }
 
@@ -118,7 +159,7 @@ fn midpoint_refine_2d<'py>(
 /// units of `sigma^2 s^(2H)` (see `crate::synth::additions`). `shape`:
 /// keep only the top-left `(rows, cols)` of the result (computed alone).
 #[pyfunction]
-#[pyo3(signature = (coarse, levels, hurst, sigma, coarse_spacing, tension, variances, periodic, seed, first_level=0, n_threads=None, shape=None))]
+#[pyo3(signature = (coarse, levels, hurst, sigma, coarse_spacing, tension, variances, periodic, seed, first_level=0, n_threads=None, shape=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn additions_refine_2d<'py>(
     py: Python<'py>,
@@ -134,7 +175,9 @@ fn additions_refine_2d<'py>(
     first_level: u32,
     n_threads: Option<usize>,
     shape: Option<(usize, usize)>,
+    progress: Option<&Bound<'py, ProgressCounter>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let pr = counter(progress);
     let c = coarse.as_array();
     let p = AdditionsParams {
         hurst,
@@ -149,7 +192,7 @@ fn additions_refine_2d<'py>(
         global_cols: 0,
     };
     let v = run(py, n_threads, || {
-        additions::refine_2d_levels_window(c, levels, &p, shape)
+        additions::refine_2d_levels_counted(c, levels, &p, shape, pr.as_deref())
     })?;
     Ok(v.into_pyarray(py))
 }
@@ -204,6 +247,7 @@ fn davies_harte_fbm<'py>(
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<ProgressCounter>()?;
     m.add_function(wrap_pyfunction!(normal_noise, m)?)?;
     m.add_function(wrap_pyfunction!(midpoint_refine_1d, m)?)?;
     m.add_function(wrap_pyfunction!(midpoint_refine_2d, m)?)?;

@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 
 
-from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads
+from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads, add_progress
 
 
 def add_parsers(sub) -> None:
@@ -14,7 +14,8 @@ def add_parsers(sub) -> None:
         description="Synthesise fractional Brownian motion (1D, --size N) or a fractional Brownian "
         "surface (2D, --size ROWS COLS) and write it (.npy, .exr, .tif; 1D: .npy only). A GeoTIFF gets "
         "a transform of --cell-size square cells (upper-left corner at (0, ROWS * cell size)), the --crs "
-        "if given, and the tags CELL_SIZE, HURST, METHOD, SEED.",
+        "if given, and the tags CELL_SIZE, HURST, METHOD, SEED. A progress bar of a 2D synthesis is drawn "
+        "when stderr is a terminal (--progress / --no-progress).",
     )
     p.add_argument("output", help="output file (.npy, .exr, .tif)")
     p.add_argument("--hurst", type=float, required=True, help="Hurst exponent H in (0, 1); D = 3 - H for surfaces")
@@ -32,10 +33,12 @@ def add_parsers(sub) -> None:
     p.add_argument("--azimuth", type=float, default=315.0, help="light azimuth for --hillshade (degrees)")
     p.add_argument("--altitude", type=float, default=45.0, help="light altitude for --hillshade (degrees)")
     add_n_threads(p)
+    add_progress(p)
     p.set_defaults(func=_run_synth)
 
 
 def _run_synth(args: argparse.Namespace) -> int:
+    from fractalgeo_rs import _progress
     from fractalgeo_rs.dem import hillshade
     from fractalgeo_rs.io import write_raster
     from fractalgeo_rs.synth import fbm, fbm_surface
@@ -55,7 +58,8 @@ def _run_synth(args: argparse.Namespace) -> int:
         return 0
     shape = (args.size[0], args.size[-1])
     z = fbm_surface(shape, args.hurst, method=args.method, seed=args.seed, sigma=args.sigma,
-                    cell_size=args.cell_size, periodic=args.periodic, n_threads=args.n_threads)
+                    cell_size=args.cell_size, periodic=args.periodic, n_threads=args.n_threads,
+                    progress=_progress.resolve(args.progress, cli=True))
     geo = {}
     if str(args.output).lower().endswith((".tif", ".tiff")) or args.hillshade:
         from fractalgeo_rs._cli_common import georeference_of_grid

@@ -74,7 +74,7 @@ def expected_relief_std(shape, hurst, cell_size=1.0, sigma=1.0):
 
 
 def synthetic_dem(shape, hurst, *, cell_size, relief, relief_lag=None, mean_elevation=0.0,
-                  method="exact", seed=None, n_threads=None):
+                  method="exact", seed=None, n_threads=None, progress=None):
     r"""A fractal DEM in physical units (metres).
 
     The surface is fBm (:func:`fbm_surface`) of Hurst exponent ``H``; its
@@ -101,7 +101,7 @@ def synthetic_dem(shape, hurst, *, cell_size, relief, relief_lag=None, mean_elev
         Reference lag in metres.
     mean_elevation : float
         The output is shifted so that its mean is this (metres).
-    method, seed, n_threads
+    method, seed, n_threads, progress
         As in :func:`fbm_surface`. The scaling is exact for ``"exact"``; the
         other methods follow the target variogram approximately (see
         ``docs/synthesis.md``).
@@ -146,6 +146,6 @@ def synthetic_dem(shape, hurst, *, cell_size, relief, relief_lag=None, mean_elev
             raise ValueError(f"relief_lag: expected a positive number of metres, got {relief_lag!r}")
         sigma = relief / float(relief_lag) ** h
     z = fbm_surface((rows, cols), h, method=method, seed=seed, cell_size=cell, sigma=sigma,
-                    n_threads=n_threads)
+                    n_threads=n_threads, progress=progress)
     z += float(mean_elevation) - z.mean()
     return z

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import scipy.fft as sfft
 
-from fractalgeo_rs import _core
+from fractalgeo_rs import _core, _progress
 from fractalgeo_rs._validation import (
     MemoryLimitError,
     check_choice,
@@ -26,8 +26,10 @@ def _workers(n_threads):
     return n_threads if n_threads is not None else -1
 
 
-def _noise(n, seed, stream, n_threads):
-    return _core.normal_noise(int(n), seed, stream, 0, n_threads)
+def _noise(n, seed, stream, n_threads, steps=None):
+    if steps is None:
+        return _core.normal_noise(int(n), seed, stream, 0, n_threads)
+    return steps.counted(lambda pr: _core.normal_noise(int(n), seed, stream, 0, n_threads, pr), int(n))
 
 
 # --------------------------------------------------------------------- 1D
@@ -220,7 +222,7 @@ def _fbm_midpoint(n, h, seed, additions, n_threads):
 # --------------------------------------------------------------------- 2D
 
 def fbm_surface(shape, hurst, *, method="exact", seed=None, cell_size=1.0, sigma=1.0,
-                periodic=False, n_threads=None, max_memory=None):
+                periodic=False, n_threads=None, max_memory=None, progress=None):
     r"""Fractional Brownian surface (isotropic fBm on a grid).
 
     The target statistics are those of 2D fBm,
@@ -296,6 +298,12 @@ def fbm_surface(shape, hurst, *, method="exact", seed=None, cell_size=1.0, sigma
         ``MemoryError`` (also a ``ValueError``) naming ``shape`` is raised.
         ``None``: the package default (half the available memory,
         ``$FRACTALGEO_MAX_MEMORY`` to override; docs/input_policy.md).
+    progress : bool or None
+        A tqdm bar on stderr (``pip install "fractalgeo_rs[progress]"``)
+        over the work in grid cells: the random numbers drawn, each
+        refinement level, each FFT. The Rust kernels tick while they run
+        (GIL released, the bar is updated every 0.1 s). ``None``/``False``:
+        no bar. The field is the same with and without it.
 
     Returns
     -------
@@ -327,6 +335,7 @@ def fbm_surface(shape, hurst, *, method="exact", seed=None, cell_size=1.0, sigma
     n_threads = check_n_threads(n_threads)
     if not isinstance(periodic, (bool, np.bool_)):
         raise TypeError(f"periodic: expected a bool, got {periodic!r}")
+    show = _progress.resolve(progress)
     # All kernels work in units of cells with unit sigma; physical scale last.
     scale = sigma * cell**h
     if method == "exact":
@@ -334,28 +343,36 @@ def fbm_surface(shape, hurst, *, method="exact", seed=None, cell_size=1.0, sigma
             raise ValueError('periodic: fBm is not periodic; "exact" cannot give periodic output '
                              '(use method="spectral")')
         _check_exact_memory(rows, cols, h, max_memory)
-        z = _surface_exact(rows, cols, h, seed, n_threads)
+        n0, n1, _ = _stein_torus(rows, cols, h)
+        with _progress.Steps(5 * n0 * n1, "fbm_surface (exact)", show) as steps:
+            z = _surface_exact(rows, cols, h, seed, n_threads, steps)
         if scale != 1.0:
             z *= scale
         return z
     check_memory(surface_memory_bytes((rows, cols), h, method, bool(periodic)), "shape",
                  max_memory=max_memory, what=f"method={method!r} on a {rows} x {cols} grid")
     if method == "spectral":
-        z = _surface_spectral(rows, cols, h, seed, bool(periodic), n_threads)
+        n0, n1 = _spectral_grid(rows, cols, bool(periodic))
+        total = 2 * n0 * (n1 // 2 + 1) + n0 * n1
+        with _progress.Steps(total, "fbm_surface (spectral)", show) as steps:
+            z = _surface_spectral(rows, cols, h, seed, bool(periodic), n_threads, steps)
     else:
-        z = _surface_midpoint(rows, cols, h, seed, method == "additions", bool(periodic), n_threads)
+        fr, fc = _midpoint_grid(rows, cols, bool(periodic))
+        with _progress.Steps(fr * fc * 4 // 3, f"fbm_surface ({method})", show) as steps:
+            z = _surface_midpoint(rows, cols, h, seed, method == "additions", bool(periodic), n_threads,
+                                  steps)
     if scale != 1.0:  # x * 1.0 == x: skip a pass over the grid
         z *= scale
     return z
 
 
-def _surface_midpoint(rows, cols, h, seed, additions, periodic, n_threads):
+def _surface_midpoint(rows, cols, h, seed, additions, periodic, n_threads, steps=None):
     if periodic:
         k = int(round(math.log2(rows))) if rows > 0 else 0
         if rows != cols or 2**k != rows:
             raise ValueError(f"periodic: the midpoint methods give periodic output for shapes (2**k, 2**k) "
                              f"only, got {(rows, cols)}")
-        return _refine(np.zeros((1, 1)), k, h, float(rows), additions, True, seed, n_threads)
+        return _refine(np.zeros((1, 1)), k, h, float(rows), additions, True, seed, n_threads, steps=steps)
     levels = _levels_for(max(rows, cols) - 1)
     step = 2**levels
     nr = max(-(-(rows - 1) // step) + 1, 2)
@@ -363,18 +380,32 @@ def _surface_midpoint(rows, cols, h, seed, additions, periodic, n_threads):
     ii, jj = np.meshgrid(np.arange(nr), np.arange(nc), indexing="ij")
     pos = np.column_stack([ii.ravel(), jj.ravel()]).astype(np.float64) * step
     coarse = _exact_coarse(pos, h, seed, c.STREAM_COARSE_2D, n_threads).reshape(nr, nc)
-    return _refine(coarse, levels, h, float(step), additions, False, seed, n_threads, shape=(rows, cols))
+    return _refine(coarse, levels, h, float(step), additions, False, seed, n_threads, shape=(rows, cols),
+                   steps=steps)
 
 
-def _refine(coarse, levels, h, spacing, additions, periodic, seed, n_threads, shape=None):
+def _refine(coarse, levels, h, spacing, additions, periodic, seed, n_threads, shape=None, steps=None):
     """The refined grid, or its ``shape = (rows, cols)`` corner (the
-    additions kernel computes that corner only; midpoint is cropped)."""
+    additions kernel computes that corner only; midpoint is cropped).
+    ``steps``: a :class:`~fractalgeo_rs._progress.Steps` bar whose total
+    includes about 4/3 of the final grid's cells for this call."""
+    steps = steps if steps is not None else _progress.Steps(0, "", False)
+    fr, fc = _refined_shape(coarse.shape, levels, periodic)
+    weight = fr * fc * 4 // 3
     if additions:
         w, var = _additions.schedule(h)
-        return _core.additions_refine_2d(coarse, levels, h, 1.0, spacing, w, list(var), periodic, seed, 0,
-                                         n_threads, shape)
-    z = _core.midpoint_refine_2d(coarse, levels, h, 1.0, spacing, False, periodic, seed, 0, n_threads)
+        return steps.counted(lambda pr: _core.additions_refine_2d(
+            coarse, levels, h, 1.0, spacing, w, list(var), periodic, seed, 0, n_threads, shape, pr), weight)
+    z = steps.counted(lambda pr: _core.midpoint_refine_2d(
+        coarse, levels, h, 1.0, spacing, False, periodic, seed, 0, n_threads, pr), weight)
     return z if shape is None else np.ascontiguousarray(z[:shape[0], :shape[1]])
+
+
+def _refined_shape(shape, levels, periodic):
+    r, c_ = shape
+    for _ in range(levels):
+        r, c_ = (2 * r, 2 * c_) if periodic else (2 * r - 1, 2 * c_ - 1)
+    return r, c_
 
 
 @functools.lru_cache(maxsize=2)
@@ -389,7 +420,7 @@ def _spectral_amplitude(n0, n1, h):
     return amp
 
 
-def _white_noise_rfft2(n0, n1, seed, stream, n_threads):
+def _white_noise_rfft2(n0, n1, seed, stream, n_threads, steps=None):
     """A random matrix with the distribution of ``rfft2`` of an (n0, n1) white
     noise matrix (unit variance), drawn directly in the frequency domain.
 
@@ -400,7 +431,7 @@ def _white_noise_rfft2(n0, n1, seed, stream, n_threads):
     figure 3 without changing the distribution.
     """
     m = n1 // 2 + 1
-    z = _noise(2 * n0 * m, seed, stream, n_threads)
+    z = _noise(2 * n0 * m, seed, stream, n_threads, steps)
     spec = np.empty((n0, m), dtype=np.complex128)
     half = math.sqrt(n0 * n1 / 2.0)
     spec.real = z[: n0 * m].reshape(n0, m)
@@ -413,11 +444,13 @@ def _white_noise_rfft2(n0, n1, seed, stream, n_threads):
     return spec
 
 
-def _surface_spectral(rows, cols, h, seed, periodic, n_threads):
+def _surface_spectral(rows, cols, h, seed, periodic, n_threads, steps=None):
     n0, n1 = _spectral_grid(rows, cols, periodic)
-    spec = _white_noise_rfft2(n0, n1, seed, c.STREAM_SPECTRAL_2D, n_threads)
+    spec = _white_noise_rfft2(n0, n1, seed, c.STREAM_SPECTRAL_2D, n_threads, steps)
     spec *= _spectral_amplitude(n0, n1, h)
     z = sfft.irfft2(spec, s=(n0, n1), workers=_workers(n_threads), overwrite_x=True)
+    if steps is not None:
+        steps.step(n0 * n1)
     if not periodic:
         z = np.ascontiguousarray(z[:rows, :cols])
     return z
@@ -518,7 +551,10 @@ def _check_exact_memory(rows, cols, h, max_memory):
             f"or raise max_memory")
 
 
-def _surface_exact(rows, cols, h, seed, n_threads):
+def _surface_exact(rows, cols, h, seed, n_threads, steps=None):
+    """Stein's embedding; ``steps`` (total ``5 n0 n1``): covariance and its
+    FFT one unit each, the noise two, the final FFT one."""
+    steps = steps if steps is not None else _progress.Steps(0, "", False)
     alpha = 2.0 * h
     r_max, beta, c2, c0 = _stein_rho_params(alpha)
     n0, n1, unit = _stein_torus(rows, cols, h)
@@ -530,14 +566,16 @@ def _surface_exact(rows, cols, h, seed, n_threads):
         for s1 in (0.0, -n1):
             d = np.hypot((l0 + s0)[:, None] * unit, (l1 + s1)[None, :] * unit)
             row += _stein_rho(d, alpha, r_max, beta, c2, c0)
+    steps.step(n0 * n1 // 2)
     lam = sfft.fft2(row, workers=_workers(n_threads)).real
+    steps.step(n0 * n1 - n0 * n1 // 2)
     del row
     if lam.min() < -1e-9 * lam.max():  # pragma: no cover - guaranteed by Stein (2002)
         raise RuntimeError("circulant embedding is not non-negative definite")
     np.clip(lam, 0.0, None, out=lam)
     amp = np.sqrt(lam / (n0 * n1))
     del lam
-    z = _noise(2 * n0 * n1, seed, c.STREAM_EXACT_2D, n_threads)
+    z = _noise(2 * n0 * n1, seed, c.STREAM_EXACT_2D, n_threads, steps)
     w = np.empty((n0, n1), dtype=np.complex128)
     w.real = z[: n0 * n1].reshape(n0, n1)
     w.imag = z[n0 * n1 :].reshape(n0, n1)
@@ -545,6 +583,7 @@ def _surface_exact(rows, cols, h, seed, n_threads):
     w *= amp
     del amp
     y = sfft.fft2(w, workers=_workers(n_threads), overwrite_x=True)
+    steps.step(2 * n0 * n1)
     field = np.array(y.real[:rows, :cols])
     del y, w
     field -= field[0, 0]
