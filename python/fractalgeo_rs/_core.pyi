@@ -22,6 +22,7 @@ __all__ = [
     "davies_harte_fbm",
     "dbc_count",
     "dbc_transform_map",
+    "exr_header",
     "fgn_sqrt_eigenvalues",
     "fractal_resample",
     "gls_transform_map",
@@ -29,6 +30,7 @@ __all__ = [
     "hillshade_f64",
     "hillshade_gdal_byte",
     "ifs_chaos_game",
+    "image_header",
     "ifs_check",
     "ifs_iterate",
     "ifs_preset",
@@ -96,6 +98,8 @@ def column_ranges(
 
 # ---- io ----
 def read_image(path: str | PathLike[str]) -> np.ndarray: ...
+def image_header(path: str | PathLike[str]) -> Tuple[int, int, int, int]: ...
+def exr_header(path: str | PathLike[str]) -> Tuple[int, int, int]: ...
 def write_png(path: str | PathLike[str], image: np.ndarray) -> None: ...
 
 # ---- synth / dem ----

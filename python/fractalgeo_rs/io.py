@@ -25,8 +25,9 @@ Values are never rescaled; complex data is refused (write ``np.abs(z)`` or
 Every reader error is an ``OSError`` (``FileNotFoundError`` for a missing
 file) whose message names the path and the cause, so a corrupt, truncated or
 empty file never surfaces as a decoder's internal exception. The size of
-the array is estimated from the file's header (``.npy``, ``.png``, rasterio
-formats) before anything is read: above the memory limit of
+the array is estimated from the file's header (``.npy``, ``.png``,
+``.exr``, TIFF read without rasterio, rasterio formats) before anything is
+read: above the memory limit of
 ``_validation.check_memory`` (``$FRACTALGEO_MAX_MEMORY``, default half the
 available memory) the reader raises :class:`RasterMemoryError`, an
 ``OSError`` and a ``MemoryError``.
@@ -277,12 +278,24 @@ def read_raster(path, band: Optional[int] = None) -> Tuple[np.ndarray, Optional[
         if band not in (None, 1):
             raise ValueError(f"band: EXR files are read as one band (channel \"Y\"), asked for {band}")
         try:
+            rows, cols, ch = _core.exr_header(p)
+        except (OSError, ValueError, RuntimeError, MemoryError) as exc:
+            raise _unreadable(p, exc) from None
+        # every channel decoded as float32, then the float32 band
+        _check_raster_bytes(p, 4 * rows * cols * (ch + 1), f"a {rows} x {cols} EXR image of {ch} channel(s)")
+        try:
             return _core.read_exr(p), None
         except (OSError, ValueError, RuntimeError, MemoryError) as exc:
             raise _unreadable(p, exc) from None
     rio = _rasterio()
     if ext == ".png" or (rio is None and ext in (".tif", ".tiff")):
         head = _png_header(p) if ext == ".png" else None
+        if head is None and ext != ".png":
+            try:
+                h, w, ch, bpp = _core.image_header(p)
+            except (OSError, ValueError, RuntimeError, MemoryError) as exc:
+                raise _unreadable(p, exc) from None
+            head = w, h, ch, bpp // max(ch, 1)
         if head is not None:
             w, h, ch, bps = head
             # the decoded buffer and the array made of it

@@ -39,6 +39,18 @@ fn write_png(py: Python<'_>, path: PathBuf, image: &Bound<'_, PyAny>) -> PyResul
     })
 }
 
+/// `(rows, cols, channels, bytes_per_pixel)` of a PNG or TIFF from its header.
+#[pyfunction]
+fn image_header(py: Python<'_>, path: PathBuf) -> PyResult<(usize, usize, usize, usize)> {
+    run(py, Some(1), || image_io::image_header(&path))
+}
+
+/// `(rows, cols, channels)` of an EXR's first layer from its header.
+#[pyfunction]
+fn exr_header(py: Python<'_>, path: PathBuf) -> PyResult<(usize, usize, usize)> {
+    run(py, Some(1), || exr_io::exr_header(&path))
+}
+
 /// Read the "Y" (or only) channel of a float EXR as a 2D float32 array.
 #[pyfunction]
 fn read_exr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyArray2<f32>>> {
@@ -57,6 +69,8 @@ fn write_exr(py: Python<'_>, path: PathBuf, image: PyReadonlyArray2<'_, f32>) ->
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_image, m)?)?;
+    m.add_function(wrap_pyfunction!(image_header, m)?)?;
+    m.add_function(wrap_pyfunction!(exr_header, m)?)?;
     m.add_function(wrap_pyfunction!(write_png, m)?)?;
     m.add_function(wrap_pyfunction!(read_exr, m)?)?;
     m.add_function(wrap_pyfunction!(write_exr, m)?)?;

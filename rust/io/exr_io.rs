@@ -28,6 +28,27 @@ pub fn write_exr_gray(path: &Path, data: Vec<f32>, rows: usize, cols: usize) -> 
     finish_atomic(image.write().to_file(&tmp), &tmp, path)
 }
 
+/// `(rows, cols, channels)` of the first layer from the file's header,
+/// without reading the pixels (so a caller can check the memory a
+/// [`read_exr_gray`] would need first: it decodes every channel as f32).
+pub fn exr_header(path: &Path) -> CoreResult<(usize, usize, usize)> {
+    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| match e {
+        exr::error::Error::Io(io) => {
+            CoreError::from_io(format_args!("cannot read {}", path.display()), &io)
+        }
+        other => CoreError::Io(format!("cannot read {}: {other}", path.display())),
+    })?;
+    let h = meta
+        .headers
+        .first()
+        .ok_or_else(|| CoreError::Io(format!("{}: no layer", path.display())))?;
+    Ok((
+        h.layer_size.height(),
+        h.layer_size.width(),
+        h.channels.list.len(),
+    ))
+}
+
 /// Read the "Y" (or only) channel of the first layer: `(pixels, rows, cols)`.
 pub fn read_exr_gray(path: &Path) -> CoreResult<(Vec<f32>, usize, usize)> {
     let image = read()

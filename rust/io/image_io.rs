@@ -3,7 +3,7 @@
 //! `image` 0.25 does not decode single-band float TIFF (the usual GeoTIFF of
 //! DEMs and SAR) and keeps no georeferencing: such files go through rasterio.
 use crate::error::{CoreError, CoreResult};
-use image::{DynamicImage, ImageBuffer, ImageReader, Luma};
+use image::{DynamicImage, ImageBuffer, ImageDecoder, ImageReader, Luma};
 use std::path::Path;
 
 /// Decoded pixels, row-major `(rows, cols, channels)`.
@@ -21,6 +21,26 @@ pub struct Raster {
     pub rows: usize,
     pub cols: usize,
     pub channels: usize,
+}
+
+/// `(rows, cols, channels, bytes per pixel)` of a PNG or TIFF from its
+/// header, without decoding the pixels (so a caller can check the memory a
+/// [`read_image`] would need first).
+pub fn image_header(path: &Path) -> CoreResult<(usize, usize, usize, usize)> {
+    let decoder = ImageReader::open(path)
+        .map_err(|e| CoreError::from_io(format_args!("cannot open {}", path.display()), &e))?
+        .with_guessed_format()
+        .map_err(|e| CoreError::from_io(format_args!("cannot read {}", path.display()), &e))?
+        .into_decoder()
+        .map_err(|e| CoreError::Io(format!("cannot decode {}: {e}", path.display())))?;
+    let (cols, rows) = decoder.dimensions();
+    let color = decoder.color_type();
+    Ok((
+        rows as usize,
+        cols as usize,
+        color.channel_count() as usize,
+        color.bytes_per_pixel() as usize,
+    ))
 }
 
 /// Read a PNG or TIFF file, keeping its bit depth and channels.
