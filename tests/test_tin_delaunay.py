@@ -18,14 +18,9 @@ def edge_set(t):
     return set(map(tuple, e))
 
 
-def test_empty_circumcircles_and_euler_count_on_10k_points():
-    rng = np.random.default_rng(1)
-    p = rng.uniform(0, 1000, (10_000, 2))
-    t = delaunay(p)
-    assert t.dtype == np.int64 and t.shape[1] == 3
-    assert np.all(signed_area2(p, t) > 0)  # counter-clockwise
-    h = len(ConvexHull(p).vertices)
-    assert len(t) == 2 * len(p) - 2 - h
+def assert_empty_circumcircles(p, t):
+    """No point of ``p`` strictly inside the circumcircle of any triangle of ``t``
+    (points on the circle, as in cocircular sets, are allowed)."""
     # circumcentres and radii, then every point within the radius
     a, b, c = p[t[:, 0]], p[t[:, 1]], p[t[:, 2]]
     d = 2 * (a[:, 0] * (b[:, 1] - c[:, 1]) + b[:, 0] * (c[:, 1] - a[:, 1]) + c[:, 0] * (a[:, 1] - b[:, 1]))
@@ -37,6 +32,17 @@ def test_empty_circumcircles_and_euler_count_on_10k_points():
     inside = tree.query_ball_point(np.column_stack([ux, uy]), r * (1 - 1e-9))
     for k, pts in enumerate(inside):
         assert set(pts) <= set(t[k]), f"triangle {k} has points {set(pts) - set(t[k])} in its circumcircle"
+
+
+def test_empty_circumcircles_and_euler_count_on_10k_points():
+    rng = np.random.default_rng(1)
+    p = rng.uniform(0, 1000, (10_000, 2))
+    t = delaunay(p)
+    assert t.dtype == np.int64 and t.shape[1] == 3
+    assert np.all(signed_area2(p, t) > 0)  # counter-clockwise
+    h = len(ConvexHull(p).vertices)
+    assert len(t) == 2 * len(p) - 2 - h
+    assert_empty_circumcircles(p, t)
 
 
 def test_same_triangles_as_qhull_in_general_position():
@@ -115,6 +121,48 @@ def test_regular_grid_cocircular_points_and_duplicates():
     # -0.0 and 0.0 are the same point
     z = np.array([[0.0, 0.0], [-0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
     assert 1 not in delaunay(z)
+
+
+def lattice_points(nx, ny, seed):
+    """A rectilinear lattice with unequal, non-uniform spacings in x and y."""
+    rng = np.random.default_rng(seed)
+    xs = np.cumsum(rng.uniform(0.5, 3.0, nx))
+    ys = -40.0 + np.cumsum(rng.uniform(0.01, 0.2, ny))
+    yy, xx = np.meshgrid(ys, xs, indexing="ij")
+    return np.column_stack([xx.ravel(), yy.ravel()])
+
+
+def test_lattice_shuffled_with_unequal_spacing_is_delaunay():
+    nx, ny = 37, 23
+    rng = np.random.default_rng(11)
+    g = lattice_points(nx, ny, 7)[rng.permutation(nx * ny)]
+    p = np.vstack([g, g[::97]])  # later copies of some rows
+    t = delaunay(p)
+    assert np.all(signed_area2(p, t) > 0)
+    assert t.max() < len(g)  # duplicates index the first occurrence
+    h = 2 * (nx - 1) + 2 * (ny - 1)  # hull points, the collinear ones included
+    assert len(t) == 2 * len(g) - 2 - h
+    assert_empty_circumcircles(p, t)
+    # the triangles tile the lattice's rectangle exactly
+    area = (g[:, 0].max() - g[:, 0].min()) * (g[:, 1].max() - g[:, 1].min())
+    np.testing.assert_allclose(signed_area2(p, t).sum() / 2, area, rtol=1e-12)
+    assert len({tuple(sorted(x)) for x in t}) == len(t)
+    for n in (1, 3):
+        np.testing.assert_array_equal(delaunay(p, n_threads=n), t)
+
+
+@pytest.mark.parametrize("drop", [0, 5, 400])
+def test_lattice_with_one_point_missing_is_still_delaunay(drop):
+    nx, ny = 30, 20
+    g = np.delete(lattice_points(nx, ny, 8), drop, axis=0)
+    t = delaunay(g)
+    assert np.all(signed_area2(g, t) > 0)
+    assert set(np.unique(t)) == set(range(len(g)))
+    # h: points on the hull; a missing corner (0) or edge point (5) is one
+    # fewer, a missing interior point (400) changes nothing
+    hull = 2 * (nx - 1) + 2 * (ny - 1) - int(drop in (0, 5))
+    assert len(t) == 2 * len(g) - 2 - hull
+    assert_empty_circumcircles(g, t)
 
 
 @pytest.mark.parametrize(

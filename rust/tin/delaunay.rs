@@ -164,6 +164,80 @@ fn triangles_of<T: Triangulation<Vertex = Indexed> + Sync>(tri: &T) -> Vec<[i64;
         .collect()
 }
 
+/// Sorted distinct values of `v` (by `total_cmp`; no NaN here).
+fn distinct(mut v: Vec<f64>) -> Vec<f64> {
+    v.par_sort_unstable_by(|a, b| a.total_cmp(b));
+    v.dedup();
+    v
+}
+
+/// The triangles of a complete rectilinear lattice (see the module
+/// documentation), or `None` when the distinct points of `vertices` are not
+/// all of `xs x ys` for some `xs`, `ys` with at least two values each.
+///
+/// Counter-clockwise, cells in row-major order (y, then x ascending), each
+/// cell as `(a, b, c)`, `(a, c, d)` with `a, b, c, d` its lower-left,
+/// lower-right, upper-right, upper-left corners; a corner is the smallest
+/// input index among its exact duplicates. Cheap to reject: a lattice of
+/// `m <= n` distinct points has at most `sqrt(m)` values along one axis,
+/// so any `2 floor(sqrt(n)) + 2` of its points repeat a value on that
+/// axis; when the first ones do not, the input is no lattice.
+pub(crate) fn lattice_triangles(vertices: &[Indexed]) -> Option<Vec<[i64; 3]>> {
+    let n = vertices.len();
+    if n < 4 {
+        return None;
+    }
+    let m = (2 * (n as f64).sqrt() as usize + 2).min(n);
+    let head = &vertices[..m];
+    let nx_head = distinct(head.iter().map(|v| v.pos.x).collect()).len();
+    let ny_head = distinct(head.iter().map(|v| v.pos.y).collect()).len();
+    if nx_head == m && ny_head == m {
+        return None;
+    }
+    let xs = distinct(vertices.par_iter().map(|v| v.pos.x).collect());
+    let nx = xs.len();
+    if nx < 2 || nx > n / 2 {
+        return None;
+    }
+    let ys = distinct(vertices.par_iter().map(|v| v.pos.y).collect());
+    let ny = ys.len();
+    if ny < 2 || nx.checked_mul(ny)? > n {
+        return None;
+    }
+    let find = |s: &[f64], v: f64| s.binary_search_by(|a| a.total_cmp(&v)).ok();
+    // The cell of every input point, then the smallest index per node.
+    let node: Vec<usize> = vertices
+        .par_iter()
+        .map(|v| match (find(&xs, v.pos.x), find(&ys, v.pos.y)) {
+            (Some(i), Some(j)) => j * nx + i,
+            _ => usize::MAX,
+        })
+        .collect();
+    let mut first = vec![usize::MAX; nx * ny];
+    for (v, &k) in vertices.iter().zip(&node) {
+        let f = first.get_mut(k)?;
+        *f = (*f).min(v.idx);
+    }
+    if first.contains(&usize::MAX) {
+        return None;
+    }
+    let cells = (nx - 1) * (ny - 1);
+    let mut out = vec![[0i64; 3]; 2 * cells];
+    out.par_chunks_mut(2 * (nx - 1))
+        .enumerate()
+        .for_each(|(j, row)| {
+            for i in 0..nx - 1 {
+                let a = first[j * nx + i] as i64;
+                let b = first[j * nx + i + 1] as i64;
+                let c = first[(j + 1) * nx + i + 1] as i64;
+                let d = first[(j + 1) * nx + i] as i64;
+                row[2 * i] = [a, b, c];
+                row[2 * i + 1] = [a, c, d];
+            }
+        });
+    Some(out)
+}
+
 /// Delaunay triangulation of `points`, constrained by the point-index pairs
 /// `constraints` when given (a constrained Delaunay triangulation: every
 /// constraint segment is a union of triangle edges; a constraint through
@@ -186,6 +260,9 @@ pub fn delaunay<P: PointSource>(
     };
     match constraints {
         None | Some([]) => {
+            if let Some(t) = lattice_triangles(&vertices) {
+                return Ok(t);
+            }
             let tri: DelaunayTriangulation<Indexed> = bulk_load_merged(vertices, xy)?;
             check_size(&tri)?;
             Ok(triangles_of(&tri))
@@ -235,6 +312,59 @@ mod tests {
         let [a, b, c] = t.map(|i| i as usize);
         (p[[b, 0]] - p[[a, 0]]) * (p[[c, 1]] - p[[a, 1]])
             - (p[[b, 1]] - p[[a, 1]]) * (p[[c, 0]] - p[[a, 0]])
+    }
+
+    fn lattice(xs: &[f64], ys: &[f64]) -> Vec<Indexed> {
+        let mut v = Vec::new();
+        for &y in ys {
+            for &x in xs {
+                let idx = v.len();
+                v.push(Indexed {
+                    pos: Point2::new(x, y),
+                    idx,
+                });
+            }
+        }
+        v
+    }
+
+    #[test]
+    fn lattice_fast_path_only_for_complete_lattices() {
+        let xs = [0.0, 0.5, 2.0, 2.25, 7.0];
+        let ys = [-3.0, -1.0, 10.0];
+        let mut v = lattice(&xs, &ys);
+        // reverse the order and repeat two points with higher indices
+        v.reverse();
+        let n = v.len();
+        v.push(Indexed {
+            pos: Point2::new(2.0, 10.0),
+            idx: n,
+        });
+        v.push(Indexed {
+            pos: Point2::new(0.0, -3.0),
+            idx: n + 1,
+        });
+        let t = lattice_triangles(&v).expect("a complete lattice");
+        assert_eq!(t.len(), 2 * 4 * 2);
+        let pos = |i: i64| v.iter().find(|q| q.idx == i as usize).unwrap().pos;
+        for tr in &t {
+            assert!(tr.iter().all(|&i| (i as usize) < n));
+            let [a, b, c] = tr.map(pos);
+            assert!((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x) > 0.0);
+        }
+        // one node missing, or one point off the lattice: spade's path
+        let mut missing = lattice(&xs, &ys);
+        missing.remove(7);
+        assert!(lattice_triangles(&missing).is_none());
+        let mut off = lattice(&xs, &ys);
+        off.push(Indexed {
+            pos: Point2::new(1.0, 1.0),
+            idx: 15,
+        });
+        assert!(lattice_triangles(&off).is_none());
+        // a single row or column is no lattice (collinear)
+        assert!(lattice_triangles(&lattice(&xs, &[1.0])).is_none());
+        assert!(lattice_triangles(&lattice(&[1.0], &ys)).is_none());
     }
 
     #[test]
