@@ -22,7 +22,7 @@ from __future__ import annotations
 import contextlib
 import sys
 import threading
-from typing import Optional
+from typing import Any, ContextManager, Optional
 
 __all__ = ["resolve", "bar", "dask_bar", "Steps"]
 
@@ -103,13 +103,14 @@ class Steps:
         self.total = int(total)
         self.desc = desc
         self.enabled = bool(enabled)
-        self._bar = _NoBar()
-        self._ctx = None
+        self._bar: Any = _NoBar()
+        self._ctx: Optional[ContextManager[Any]] = None
 
     def __enter__(self) -> "Steps":
         if self.enabled:
-            self._ctx = bar(self.total, self.desc, True, unit="cell")
-            self._bar = self._ctx.__enter__()
+            ctx = bar(self.total, self.desc, True, unit="cell")
+            self._bar = ctx.__enter__()
+            self._ctx = ctx
         return self
 
     def __exit__(self, *exc) -> None:
