@@ -27,8 +27,7 @@ def _workers(n_threads):
 
 
 def _noise(n, seed, stream, n_threads, steps=None):
-    if steps is None:
-        return _core.normal_noise(int(n), seed, stream, 0, n_threads)
+    steps = steps if steps is not None else _progress.Steps(0, "", False)
     return steps.counted(lambda pr: _core.normal_noise(int(n), seed, stream, 0, n_threads, pr), int(n))
 
 
