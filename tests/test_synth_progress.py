@@ -133,3 +133,43 @@ def test_synth_cli_progress_flags(tmp_path, capsys):
         outs.append(np.load(out))
     np.testing.assert_array_equal(outs[0], outs[1])
     np.testing.assert_array_equal(outs[0], outs[2])
+
+
+@pytest.mark.parametrize("method", ["exact", "spectral", "midpoint", "additions"])
+@pytest.mark.parametrize("n_threads", [1, 2])
+def test_fbm_bit_identical_with_progress(method, n_threads, recorder):
+    # 50 001 samples: several noise blocks per kernel call
+    ref = fg.fbm(50_001, 0.3, method=method, seed=8, n_threads=1)
+    got = fg.fbm(50_001, 0.3, method=method, seed=8, n_threads=n_threads, progress=True)
+    np.testing.assert_array_equal(ref, got)
+    (b,) = recorder
+    assert b.n == b.total > 0 and all(u > 0 for u in b.updates)
+    assert f"fbm ({method})" == b.desc
+    fg.fbm(100, 0.3, method=method, seed=8, progress=False)
+    assert len(recorder) == 1
+    with pytest.raises(TypeError, match="^progress"):
+        fg.fbm(100, 0.3, method=method, progress=1)
+
+
+def test_1d_counters_count_every_sample():
+    # midpoint 1D: coarse 3 samples, 4 levels: 5 + 9 + 17 + 33 samples
+    pr = _core.ProgressCounter()
+    x = _core.midpoint_refine_1d(np.array([0.0, 1.0, -1.0]), 4, 0.5, 1.0, 16.0, True, 3, 0, 2, pr)
+    assert x.size == 33 and (pr.done, pr.total) == (5 + 9 + 17 + 33,) * 2
+    np.testing.assert_array_equal(x, _core.midpoint_refine_1d(np.array([0.0, 1.0, -1.0]), 4, 0.5, 1.0, 16.0,
+                                                              True, 3, 0, 1))
+    # Davies-Harte: m + 1 noise values, an FFT of 2m, the n path samples
+    m, n = 20_000, 19_001
+    s = _core.fgn_sqrt_eigenvalues(m, 0.6)
+    pr = _core.ProgressCounter()
+    a = _core.davies_harte_fbm(s, n, 4, 9, 2, pr)
+    assert (pr.done, pr.total) == (3 * m + 1 + n,) * 2
+    np.testing.assert_array_equal(a, _core.davies_harte_fbm(s, n, 4, 9, 1))
+
+
+def test_synth_cli_1d_progress_flag(tmp_path, capsys):
+    pytest.importorskip("tqdm")
+    out = tmp_path / "x.npy"
+    assert main(["synth", str(out), "--hurst", "0.6", "--size", "5000", "--seed", "2", "--progress"]) == 0
+    assert "fbm (exact)" in capsys.readouterr().err
+    np.testing.assert_array_equal(np.load(out), fg.fbm(5000, 0.6, seed=2))

@@ -129,6 +129,7 @@ def midpoint_refine_1d(
     seed: int,
     first_level: int = 0,
     n_threads: Optional[int] = None,
+    progress: Optional[ProgressCounter] = None,
 ) -> npt.NDArray[np.float64]: ...
 def midpoint_refine_2d(
     coarse: npt.NDArray[np.float64],
@@ -160,7 +161,12 @@ def additions_refine_2d(
 ) -> npt.NDArray[np.float64]: ...
 def fgn_sqrt_eigenvalues(m: int, hurst: float, n_threads: Optional[int] = None) -> npt.NDArray[np.float64]: ...
 def davies_harte_fbm(
-    sqrt_eig: npt.NDArray[np.float64], n: int, seed: int, stream: int, n_threads: Optional[int] = None
+    sqrt_eig: npt.NDArray[np.float64],
+    n: int,
+    seed: int,
+    stream: int,
+    n_threads: Optional[int] = None,
+    progress: Optional[ProgressCounter] = None,
 ) -> npt.NDArray[np.float64]: ...
 def spectral_filter_2d(n0: int, n1: int, hurst: float, n_threads: Optional[int] = None) -> npt.NDArray[np.float64]: ...
 def hillshade_f64(

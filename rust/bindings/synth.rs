@@ -58,7 +58,7 @@ fn normal_noise<'py>(
     let pr = counter(progress);
     let v = run(py, n_threads, || {
         let mut v = crate::buffers::try_zeroed(n, "n")?;
-        rng::fill_normal_counted(&mut v, seed, stream, start, pr.as_deref());
+        rng::fill_normal(&mut v, seed, stream, start, pr.as_deref());
         Ok(v)
     })?;
     Ok(v.into_pyarray(py))
@@ -90,7 +90,7 @@ fn params(
 /// Refine a 1D profile `levels` times by factors of 2 (midpoint displacement,
 /// optionally with random additions).
 #[pyfunction]
-#[pyo3(signature = (coarse, levels, hurst, sigma, coarse_spacing, additions, seed, first_level=0, n_threads=None))]
+#[pyo3(signature = (coarse, levels, hurst, sigma, coarse_spacing, additions, seed, first_level=0, n_threads=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn midpoint_refine_1d<'py>(
     py: Python<'py>,
@@ -103,7 +103,9 @@ fn midpoint_refine_1d<'py>(
     seed: u64,
     first_level: u32,
     n_threads: Option<usize>,
+    progress: Option<&Bound<'py, ProgressCounter>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let pr = counter(progress);
     let c: Vec<f64> = coarse.as_array().to_vec();
     let p = params(
         hurst,
@@ -114,7 +116,9 @@ fn midpoint_refine_1d<'py>(
         seed,
         first_level,
     );
-    let v = run(py, n_threads, || midpoint::refine_1d_levels(&c, levels, &p))?;
+    let v = run(py, n_threads, || {
+        midpoint::refine_1d_levels(&c, levels, &p, pr.as_deref())
+    })?;
     Ok(v.into_pyarray(py))
 }
 
@@ -149,7 +153,7 @@ fn midpoint_refine_2d<'py>(
         first_level,
     );
     let v = run(py, n_threads, || {
-        midpoint::refine_2d_levels_counted(c, levels, &p, pr.as_deref())
+        midpoint::refine_2d_levels(c, levels, &p, pr.as_deref())
     })?;
     Ok(v.into_pyarray(py))
 }
@@ -192,7 +196,7 @@ fn additions_refine_2d<'py>(
         global_cols: 0,
     };
     let v = run(py, n_threads, || {
-        additions::refine_2d_levels_counted(c, levels, &p, shape, pr.as_deref())
+        additions::refine_2d_levels(c, levels, &p, shape, pr.as_deref())
     })?;
     Ok(v.into_pyarray(py))
 }
@@ -230,7 +234,7 @@ fn spectral_filter_2d<'py>(
 
 /// Exact fBm path of `n` samples (Davies-Harte) from `fgn_sqrt_eigenvalues`.
 #[pyfunction]
-#[pyo3(signature = (sqrt_eig, n, seed, stream, n_threads=None))]
+#[pyo3(signature = (sqrt_eig, n, seed, stream, n_threads=None, progress=None))]
 fn davies_harte_fbm<'py>(
     py: Python<'py>,
     sqrt_eig: PyReadonlyArray1<'py, f64>,
@@ -238,10 +242,12 @@ fn davies_harte_fbm<'py>(
     seed: u64,
     stream: u64,
     n_threads: Option<usize>,
+    progress: Option<&Bound<'py, ProgressCounter>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let pr = counter(progress);
     let s = c_order(&sqrt_eig);
     let v = run(py, n_threads, || {
-        davies_harte::fbm_from_eigenvalues(&s.data, n, seed, stream)
+        davies_harte::fbm_from_eigenvalues(&s.data, n, seed, stream, pr.as_deref())
     })?;
     Ok(array1(py, v))
 }

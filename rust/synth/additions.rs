@@ -355,17 +355,16 @@ impl Level<'_> {
     }
 }
 
-/// One level: `(r, c) -> (2r - 1, 2c - 1)` (periodic: `(2r, 2c)`).
-pub fn refine_2d(coarse: ArrayView2<f64>, p: &AdditionsParams) -> CoreResult<Array2<f64>> {
-    refine_2d_window(coarse, p, None)
-}
-
-/// One level, keeping only the first `shape = (rows, cols)` of the fine grid
-/// (`None`: all of it); the samples are those of [`refine_2d`].
-pub fn refine_2d_window(
+/// One level: `(r, c) -> (2r - 1, 2c - 1)` (periodic: `(2r, 2c)`), keeping
+/// only the first `shape = (rows, cols)` of the fine grid (`None`: all of
+/// it; a window's samples are those of the whole grid). `progress` is ticked
+/// by the cells kept, block of rows by block (the caller announces the
+/// total).
+pub fn refine_2d(
     coarse: ArrayView2<f64>,
     p: &AdditionsParams,
     shape: Option<(usize, usize)>,
+    progress: Option<&Progress>,
 ) -> CoreResult<Array2<f64>> {
     check(p)?;
     let (r, c) = coarse.dim();
@@ -414,7 +413,10 @@ pub fn refine_2d_window(
         .enumerate()
         .for_each_init(
             || (Vec::new(), Vec::new()),
-            |(co, ce), (bi, out)| lv.block(2 * BLOCK_PAIRS * bi, oc, out, co, ce),
+            |(co, ce), (bi, out)| {
+                lv.block(2 * BLOCK_PAIRS * bi, oc, out, co, ce);
+                tick(progress, out.len() as u64);
+            },
         );
     Array2::from_shape_vec((or, oc), fine).map_err(|e| CoreError::Internal(e.to_string()))
 }
@@ -435,29 +437,12 @@ fn window_shape(shape: Option<(usize, usize)>, full: (usize, usize)) -> CoreResu
 
 /// Refine `levels` times (levels numbered from `base.level`), halving the
 /// spacing each time; keys use the final grid of each level (origin 0).
+/// `shape = (rows, cols)`: keep only the first rows and columns of the final
+/// grid (`None`: all of it); the last level computes no sample outside it,
+/// and the samples are those of the whole grid. `progress` gets the cells of
+/// every level's grid (the window at the last level) as total and is ticked
+/// block of rows by block.
 pub fn refine_2d_levels(
-    coarse: ArrayView2<f64>,
-    levels: u32,
-    base: &AdditionsParams,
-) -> CoreResult<Array2<f64>> {
-    refine_2d_levels_window(coarse, levels, base, None)
-}
-
-/// [`refine_2d_levels`] keeping only the first `shape = (rows, cols)` of the
-/// final grid (`None`: all of it): the last level computes no sample outside
-/// it, and the samples are those of the whole grid.
-pub fn refine_2d_levels_window(
-    coarse: ArrayView2<f64>,
-    levels: u32,
-    base: &AdditionsParams,
-    shape: Option<(usize, usize)>,
-) -> CoreResult<Array2<f64>> {
-    refine_2d_levels_counted(coarse, levels, base, shape, None)
-}
-
-/// [`refine_2d_levels_window`] ticking `progress` by the cells of each
-/// level's grid (the window at the last level) as the level completes.
-pub fn refine_2d_levels_counted(
     coarse: ArrayView2<f64>,
     levels: u32,
     base: &AdditionsParams,
@@ -485,8 +470,7 @@ pub fn refine_2d_levels_counted(
         p.global_cols = fc as u64;
         p.origin = (0, 0);
         let window = if l + 1 == levels { shape } else { None };
-        grid = refine_2d_window(grid.view(), &p, window)?;
-        tick(progress, grid.len() as u64);
+        grid = refine_2d(grid.view(), &p, window, progress)?;
         p.coarse_spacing /= 2.0;
     }
     Ok(grid)
@@ -518,7 +502,7 @@ mod tests {
         let coarse = Array2::from_shape_fn((4, 5), |(i, j)| 2.0 * i as f64 - 3.0 * j as f64 + 1.0);
         let mut p = params(false);
         p.sigma = 0.0;
-        let f = refine_2d(coarse.view(), &p).unwrap();
+        let f = refine_2d(coarse.view(), &p, None, None).unwrap();
         assert_eq!(f.dim(), (7, 9));
         for ((i, j), v) in f.indexed_iter() {
             let want = 2.0 * (i as f64 / 2.0) - 3.0 * (j as f64 / 2.0) + 1.0;
@@ -531,7 +515,7 @@ mod tests {
         let coarse = Array2::from_shape_fn((3, 4), |(i, j)| ((i * 7 + j * 3) % 5) as f64);
         let mut p = params(true);
         p.sigma = 0.0;
-        let f = refine_2d(coarse.view(), &p).unwrap();
+        let f = refine_2d(coarse.view(), &p, None, None).unwrap();
         assert_eq!(f.dim(), (6, 8));
         for i in 0..3 {
             for j in 0..4 {
@@ -540,7 +524,7 @@ mod tests {
         }
         // A constant field stays constant on the torus.
         let k = Array2::from_elem((4, 4), 2.5);
-        let g = refine_2d(k.view(), &p).unwrap();
+        let g = refine_2d(k.view(), &p, None, None).unwrap();
         assert!(g.iter().all(|v| (v - 2.5).abs() < 1e-12));
     }
 
@@ -548,11 +532,11 @@ mod tests {
     fn thread_count_does_not_matter() {
         let coarse = Array2::<f64>::zeros((3, 3));
         let a = run_in_pool(Some(1), || {
-            refine_2d_levels(coarse.view(), 5, &params(false))
+            refine_2d_levels(coarse.view(), 5, &params(false), None, None)
         })
         .unwrap();
         let b = run_in_pool(Some(2), || {
-            refine_2d_levels(coarse.view(), 5, &params(false))
+            refine_2d_levels(coarse.view(), 5, &params(false), None, None)
         })
         .unwrap();
         assert_eq!(a, b);
@@ -567,7 +551,7 @@ mod tests {
                 ((i * 13 + j * 7) % 11) as f64 - 5.0
             });
             let p = params(periodic);
-            let whole = refine_2d(coarse.view(), &p).unwrap();
+            let whole = refine_2d(coarse.view(), &p, None, None).unwrap();
             let (fr, fc) = whole.dim();
             for (rows, cols) in [
                 (fr, fc),
@@ -576,13 +560,13 @@ mod tests {
                 (1, fc),
             ] {
                 let w = run_in_pool(Some(2), || {
-                    refine_2d_window(coarse.view(), &p, Some((rows, cols)))
+                    refine_2d(coarse.view(), &p, Some((rows, cols)), None)
                 })
                 .unwrap();
                 assert_eq!(w, whole.slice(ndarray::s![..rows, ..cols]));
             }
-            assert!(refine_2d_window(coarse.view(), &p, Some((fr + 1, fc))).is_err());
-            assert!(refine_2d_window(coarse.view(), &p, Some((0, fc))).is_err());
+            assert!(refine_2d(coarse.view(), &p, Some((fr + 1, fc)), None).is_err());
+            assert!(refine_2d(coarse.view(), &p, Some((0, fc)), None).is_err());
         }
     }
 
@@ -593,11 +577,11 @@ mod tests {
             let p = params(periodic);
             let pr = Progress::new();
             let a = run_in_pool(Some(2), || {
-                refine_2d_levels_counted(coarse.view(), 3, &p, shape, Some(&pr))
+                refine_2d_levels(coarse.view(), 3, &p, shape, Some(&pr))
             })
             .unwrap();
             let b = run_in_pool(Some(1), || {
-                refine_2d_levels_window(coarse.view(), 3, &p, shape)
+                refine_2d_levels(coarse.view(), 3, &p, shape, None)
             })
             .unwrap();
             assert_eq!(a, b);
@@ -617,14 +601,14 @@ mod tests {
     fn levels_window_is_the_top_left_of_the_whole() {
         let coarse = Array2::from_shape_fn((3, 4), |(i, j)| (i as f64) - 0.5 * j as f64);
         let p = params(false);
-        let whole = refine_2d_levels(coarse.view(), 3, &p).unwrap();
+        let whole = refine_2d_levels(coarse.view(), 3, &p, None, None).unwrap();
         assert_eq!(whole.dim(), (17, 25));
-        let w = refine_2d_levels_window(coarse.view(), 3, &p, Some((16, 20))).unwrap();
+        let w = refine_2d_levels(coarse.view(), 3, &p, Some((16, 20)), None).unwrap();
         assert_eq!(w, whole.slice(ndarray::s![..16, ..20]));
-        let w0 = refine_2d_levels_window(coarse.view(), 0, &p, Some((2, 3))).unwrap();
+        let w0 = refine_2d_levels(coarse.view(), 0, &p, Some((2, 3)), None).unwrap();
         assert_eq!(w0, coarse.slice(ndarray::s![..2, ..3]));
-        assert!(refine_2d_levels_window(coarse.view(), 0, &p, Some((4, 3))).is_err());
-        assert!(refine_2d_levels_window(coarse.view(), 3, &p, Some((18, 3))).is_err());
+        assert!(refine_2d_levels(coarse.view(), 0, &p, Some((4, 3)), None).is_err());
+        assert!(refine_2d_levels(coarse.view(), 3, &p, Some((18, 3)), None).is_err());
     }
 
     #[test]
@@ -633,13 +617,13 @@ mod tests {
         let mut p = params(false);
         p.variances[2] = -1.0;
         assert!(matches!(
-            refine_2d(coarse.view(), &p),
+            refine_2d(coarse.view(), &p, None, None),
             Err(CoreError::InvalidArgument { .. })
         ));
         let mut p = params(false);
         p.tension = f64::NAN;
-        assert!(refine_2d(coarse.view(), &p).is_err());
+        assert!(refine_2d(coarse.view(), &p, None, None).is_err());
         let one = Array2::<f64>::zeros((1, 3));
-        assert!(refine_2d(one.view(), &params(false)).is_err());
+        assert!(refine_2d(one.view(), &params(false), None, None).is_err());
     }
 }

@@ -17,6 +17,7 @@
 //! seed gives the same path up to rounding.
 use super::rng::StreamKey;
 use crate::error::{CoreError, CoreResult};
+use crate::progress::{add_total, tick, Progress};
 use rayon::prelude::*;
 use realfft::num_complex::Complex;
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
@@ -89,11 +90,15 @@ pub fn fgn_sqrt_eigenvalues(m: usize, hurst: f64) -> CoreResult<Vec<f64>> {
 /// Exact fBm `x[0..n]` (`x[0] = 0`, unit-variance unit-lag increments) from
 /// the square-root eigenvalues `sqrt_eig` (length `m + 1`, `m >= n - 1`) of
 /// [`fgn_sqrt_eigenvalues`] and the noise stream `(seed, stream)`.
+/// `progress` gets `3 m + 1 + n` units as total: the `m + 1` noise values
+/// (ticked by blocks as they are drawn), the FFT of length `2 m` and the `n`
+/// samples of the path.
 pub fn fbm_from_eigenvalues(
     sqrt_eig: &[f64],
     n: usize,
     seed: u64,
     stream: u64,
+    progress: Option<&Progress>,
 ) -> CoreResult<Vec<f64>> {
     if sqrt_eig.len() < 2 {
         return Err(CoreError::invalid(
@@ -118,25 +123,31 @@ pub fn fbm_from_eigenvalues(
     let half = std::f64::consts::FRAC_1_SQRT_2;
     let mut spec: Vec<Complex<f64>> =
         crate::buffers::try_filled(m + 1, Complex::new(0.0, 0.0), "n")?;
-    spec.par_iter_mut()
-        .with_min_len(1 << 13)
+    add_total(progress, (3 * m + 1 + n) as u64);
+    const BLOCK: usize = 1 << 13;
+    spec.par_chunks_mut(BLOCK)
         .enumerate()
-        .for_each(|(k, w)| {
-            let s = sqrt_eig[k];
-            *w = if k == 0 {
-                Complex::new(s * key.normal(0), 0.0)
-            } else if k == m {
-                Complex::new(s * key.normal(1), 0.0)
-            } else {
-                let a = s * half;
-                Complex::new(a * key.normal(k as u64 + 1), a * key.normal((m + k) as u64))
-            };
+        .for_each(|(ci, chunk)| {
+            for (i, w) in chunk.iter_mut().enumerate() {
+                let k = ci * BLOCK + i;
+                let s = sqrt_eig[k];
+                *w = if k == 0 {
+                    Complex::new(s * key.normal(0), 0.0)
+                } else if k == m {
+                    Complex::new(s * key.normal(1), 0.0)
+                } else {
+                    let a = s * half;
+                    Complex::new(a * key.normal(k as u64 + 1), a * key.normal((m + k) as u64))
+                };
+            }
+            tick(progress, chunk.len() as u64);
         });
     let len = 2 * m;
     let c2r = inverse(len);
     let mut inc = c2r.make_output_vec();
     c2r.process(&mut spec, &mut inc)
         .map_err(|e| CoreError::Internal(format!("fft: {e}")))?;
+    tick(progress, len as u64);
     let mut x = crate::buffers::try_with_capacity(n, "n")?;
     x.push(0.0);
     let mut acc = 0.0;
@@ -144,6 +155,7 @@ pub fn fbm_from_eigenvalues(
         acc += v;
         x.push(acc);
     }
+    tick(progress, n as u64);
     Ok(x)
 }
 
@@ -175,10 +187,29 @@ mod tests {
         // H = 1/2: increments are iid N(0, 1): mean square 1 over 2^16 of them
         // (standard error sqrt(2 / 65536) = 0.0055).
         let s = fgn_sqrt_eigenvalues(1 << 16, 0.5).unwrap();
-        let x = fbm_from_eigenvalues(&s, (1 << 16) + 1, 3, 12).unwrap();
+        let x = fbm_from_eigenvalues(&s, (1 << 16) + 1, 3, 12, None).unwrap();
         assert_eq!(x[0], 0.0);
         let ms: f64 = x.windows(2).map(|w| (w[1] - w[0]).powi(2)).sum::<f64>() / 65536.0;
         assert!((ms - 1.0).abs() < 4.0 * 0.0055, "{ms}");
+    }
+
+    #[test]
+    fn counted_path_is_the_same_and_reaches_its_total() {
+        // m = 40 000: several noise blocks of 8192, drawn by 2 threads.
+        let s = fgn_sqrt_eigenvalues(40_000, 0.3).unwrap();
+        let pr = Progress::new();
+        let a = crate::parallel::run_in_pool(Some(2), || {
+            fbm_from_eigenvalues(&s, 35_001, 7, 2, Some(&pr))
+        })
+        .unwrap();
+        let b =
+            crate::parallel::run_in_pool(Some(1), || fbm_from_eigenvalues(&s, 35_001, 7, 2, None))
+                .unwrap();
+        assert_eq!(a, b);
+        assert_eq!(
+            (pr.done(), pr.total()),
+            (3 * 40_000 + 1 + 35_001, 3 * 40_000 + 1 + 35_001)
+        );
     }
 
     #[test]
@@ -186,9 +217,9 @@ mod tests {
         assert!(fgn_sqrt_eigenvalues(8, 1.0).is_err());
         assert!(fgn_sqrt_eigenvalues(0, 0.5).is_err());
         let s = fgn_sqrt_eigenvalues(8, 0.5).unwrap();
-        assert!(fbm_from_eigenvalues(&s, 9, 0, 0).is_ok());
-        assert!(fbm_from_eigenvalues(&s, 10, 0, 0).is_err());
-        assert!(fbm_from_eigenvalues(&s, 1, 0, 0).is_err());
-        assert!(fbm_from_eigenvalues(&[1.0, f64::NAN], 2, 0, 0).is_err());
+        assert!(fbm_from_eigenvalues(&s, 9, 0, 0, None).is_ok());
+        assert!(fbm_from_eigenvalues(&s, 10, 0, 0, None).is_err());
+        assert!(fbm_from_eigenvalues(&s, 1, 0, 0, None).is_err());
+        assert!(fbm_from_eigenvalues(&[1.0, f64::NAN], 2, 0, 0, None).is_err());
     }
 }

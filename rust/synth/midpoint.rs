@@ -99,7 +99,13 @@ pub fn k2(hurst: f64, additions: bool) -> f64 {
 }
 
 /// Refine a 1D profile by a factor 2: samples `i` of `coarse` go to `2 i`.
-pub fn refine_1d(coarse: &[f64], p: &RefineParams) -> CoreResult<Vec<f64>> {
+/// `progress` is ticked by the output samples, block by block (the caller
+/// announces the total).
+pub fn refine_1d(
+    coarse: &[f64],
+    p: &RefineParams,
+    progress: Option<&Progress>,
+) -> CoreResult<Vec<f64>> {
     check(p)?;
     let n = coarse.len();
     if n < 1 || (!p.periodic && n < 2) {
@@ -139,6 +145,7 @@ pub fn refine_1d(coarse: &[f64], p: &RefineParams) -> CoreResult<Vec<f64>> {
                 }
                 *v = x;
             }
+            tick(progress, chunk.len() as u64);
         });
     Ok(out)
 }
@@ -148,8 +155,14 @@ pub fn refine_1d(coarse: &[f64], p: &RefineParams) -> CoreResult<Vec<f64>> {
 /// Non-periodic: `(r, c)` -> `(2r - 1, 2c - 1)`; periodic: `(2r, 2c)`. The
 /// sample `(i, j)` of `coarse` goes to `(2i, 2j)` and is kept unchanged unless
 /// `additions` is set. Edge samples of the square step average the 3
-/// neighbours that exist (non-periodic).
-pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2<f64>> {
+/// neighbours that exist (non-periodic). `progress` is ticked by the fine
+/// grid's cells, row by row within each pass (the caller announces the
+/// total).
+pub fn refine_2d(
+    coarse: ArrayView2<f64>,
+    p: &RefineParams,
+    progress: Option<&Progress>,
+) -> CoreResult<Array2<f64>> {
     check(p)?;
     let (r, c) = coarse.dim();
     if !p.periodic && (r < 2 || c < 2) {
@@ -187,6 +200,11 @@ pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2
         p.global_cols.max((p.origin.1) + fc as u64),
     );
     let add = p.additions;
+    // Each fine row ticks its fc cells in parts over the 2 (3 with
+    // additions) passes, so a level's bar moves row by row.
+    let part = (fc / if add { 3 } else { 2 }) as u64;
+    let (tick_a, tick_b) = (part, if add { part } else { fc as u64 - part });
+    let tick_c = fc as u64 - tick_a - tick_b;
 
     // Pass A (diamond step): old samples and cell centres, row by row.
     let mut fine =
@@ -221,6 +239,7 @@ pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2
                 j += 2;
             }
         }
+        tick(progress, tick_a);
     });
 
     // Pass B (square step), in place: it writes only the samples with i + j
@@ -308,6 +327,7 @@ pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2
             unsafe { *base.add(i * fc + j) = v };
             j += 2;
         }
+        tick(progress, tick_b);
     });
 
     // Pass C: Voss's additions to every sample after the square step.
@@ -317,24 +337,14 @@ pub fn refine_2d(coarse: ArrayView2<f64>, p: &RefineParams) -> CoreResult<Array2
             for (j, v) in row.iter_mut().enumerate() {
                 *v += delta_s * kas.normal(gbase + j as u64);
             }
+            tick(progress, tick_c);
         });
     }
     Array2::from_shape_vec((fr, fc), fine).map_err(|e| CoreError::Internal(e.to_string()))
 }
 
-/// Refine `levels` times (levels numbered `first_level ..`), each time halving
-/// the spacing. The global column count used for the keys is that of the
-/// final grid, so a window computed with its origin agrees with the whole.
-pub fn refine_2d_levels(
-    coarse: ArrayView2<f64>,
-    levels: u32,
-    base: &RefineParams,
-) -> CoreResult<Array2<f64>> {
-    refine_2d_levels_counted(coarse, levels, base, None)
-}
-
 /// Cells of the grids produced by `levels` refinements of an `(r, c)` grid
-/// (the work [`refine_2d_levels_counted`] announces).
+/// (the work [`refine_2d_levels`] announces).
 pub(crate) fn refined_cells(
     (mut r, mut c): (usize, usize),
     levels: u32,
@@ -357,9 +367,11 @@ pub(crate) fn refined_cells(
     total
 }
 
-/// [`refine_2d_levels`] ticking `progress` by the cells of each level's
-/// grid as the level completes.
-pub fn refine_2d_levels_counted(
+/// Refine `levels` times (levels numbered `base.level ..`), each time
+/// halving the spacing. The global column count used for the keys is that of
+/// each level's grid (origin 0). `progress` gets the cells of every level's
+/// grid as total and is ticked row by row as they are computed.
+pub fn refine_2d_levels(
     coarse: ArrayView2<f64>,
     levels: u32,
     base: &RefineParams,
@@ -382,21 +394,36 @@ pub fn refine_2d_levels_counted(
         p.level = base.level + l;
         p.global_cols = fc as u64;
         p.origin = (0, 0);
-        grid = refine_2d(grid.view(), &p)?;
-        tick(progress, grid.len() as u64);
+        grid = refine_2d(grid.view(), &p, progress)?;
         p.coarse_spacing /= 2.0;
     }
     Ok(grid)
 }
 
-/// 1D counterpart of [`refine_2d_levels`].
-pub fn refine_1d_levels(coarse: &[f64], levels: u32, base: &RefineParams) -> CoreResult<Vec<f64>> {
+/// 1D counterpart of [`refine_2d_levels`]: `progress` gets the samples of
+/// every level as total, ticked by blocks of samples.
+pub fn refine_1d_levels(
+    coarse: &[f64],
+    levels: u32,
+    base: &RefineParams,
+    progress: Option<&Progress>,
+) -> CoreResult<Vec<f64>> {
+    let (mut n, mut total) = (coarse.len() as u64, 0u64);
+    for _ in 0..levels {
+        n = if base.periodic {
+            n.saturating_mul(2)
+        } else {
+            n.saturating_mul(2).saturating_sub(1)
+        };
+        total = total.saturating_add(n);
+    }
+    add_total(progress, total);
     let mut x = coarse.to_vec();
     let mut p = *base;
     for l in 0..levels {
         p.level = base.level + l;
         p.origin = (0, 0);
-        x = refine_1d(&x, &p)?;
+        x = refine_1d(&x, &p, progress)?;
         p.coarse_spacing /= 2.0;
     }
     Ok(x)
@@ -427,26 +454,51 @@ mod tests {
         let p = params(true, false);
         let pr = Progress::new();
         let a = run_in_pool(Some(2), || {
-            refine_2d_levels_counted(coarse.view(), 3, &p, Some(&pr))
+            refine_2d_levels(coarse.view(), 3, &p, Some(&pr))
         })
         .unwrap();
-        let b = run_in_pool(Some(1), || refine_2d_levels(coarse.view(), 3, &p)).unwrap();
+        let b = run_in_pool(Some(1), || refine_2d_levels(coarse.view(), 3, &p, None)).unwrap();
         assert_eq!(a, b);
         // 5 x 5, 9 x 9, 17 x 17
         assert_eq!((pr.done(), pr.total()), (25 + 81 + 289, 25 + 81 + 289));
     }
 
     #[test]
+    fn one_level_ticks_every_cell_once() {
+        // The per-pass parts of a row add up to its cells, with and without
+        // additions, for odd and even widths; 1D likewise.
+        for (additions, periodic) in [(false, false), (true, false), (true, true), (false, true)] {
+            let coarse = Array2::from_shape_fn((4, 6), |(i, j)| (i * j) as f64);
+            let pr = Progress::new();
+            let f = run_in_pool(Some(2), || {
+                refine_2d(coarse.view(), &params(additions, periodic), Some(&pr))
+            })
+            .unwrap();
+            assert_eq!(pr.done(), f.len() as u64);
+            let pr = Progress::new();
+            let x = refine_1d_levels(&[0.0, 1.0, 3.0], 4, &params(additions, periodic), Some(&pr))
+                .unwrap();
+            // 5, 9, 17, 33 samples (periodic: 6, 12, 24, 48)
+            let (last, want) = if periodic {
+                (48, 6 + 12 + 24 + 48)
+            } else {
+                (33, 5 + 9 + 17 + 33)
+            };
+            assert_eq!((x.len() as u64, pr.done(), pr.total()), (last, want, want));
+        }
+    }
+
+    #[test]
     fn midpoint_keeps_coarse_samples() {
         let coarse = Array2::from_shape_fn((5, 7), |(i, j)| (i * 10 + j) as f64);
-        let f = refine_2d(coarse.view(), &params(false, false)).unwrap();
+        let f = refine_2d(coarse.view(), &params(false, false), None).unwrap();
         assert_eq!(f.dim(), (9, 13));
         for i in 0..5 {
             for j in 0..7 {
                 assert_eq!(f[[2 * i, 2 * j]], coarse[[i, j]]);
             }
         }
-        let x = refine_1d(&[1.0, 2.0, 5.0], &params(false, false)).unwrap();
+        let x = refine_1d(&[1.0, 2.0, 5.0], &params(false, false), None).unwrap();
         assert_eq!((x.len(), x[0], x[2], x[4]), (5, 1.0, 2.0, 5.0));
     }
 
@@ -455,7 +507,7 @@ mod tests {
         let coarse = Array2::from_shape_fn((3, 3), |(i, j)| (2 * i + 3 * j) as f64);
         let mut p = params(true, false);
         p.sigma = 0.0;
-        let f = refine_2d(coarse.view(), &p).unwrap();
+        let f = refine_2d(coarse.view(), &p, None).unwrap();
         // A plane is reproduced exactly by the 4-point means (interior).
         assert!((f[[1, 1]] - (1.0 + 1.5)).abs() < 1e-12);
         assert!((f[[2, 1]] - (2.0 + 1.5)).abs() < 1e-12);
@@ -465,11 +517,11 @@ mod tests {
     fn thread_count_does_not_matter() {
         let coarse = Array2::<f64>::zeros((3, 3));
         let a = run_in_pool(Some(1), || {
-            refine_2d_levels(coarse.view(), 6, &params(true, false))
+            refine_2d_levels(coarse.view(), 6, &params(true, false), None)
         })
         .unwrap();
         let b = run_in_pool(Some(2), || {
-            refine_2d_levels(coarse.view(), 6, &params(true, false))
+            refine_2d_levels(coarse.view(), 6, &params(true, false), None)
         })
         .unwrap();
         assert_eq!(a, b);
@@ -479,7 +531,7 @@ mod tests {
     #[test]
     fn periodic_sizes() {
         let coarse = Array2::<f64>::zeros((1, 1));
-        let f = refine_2d_levels(coarse.view(), 4, &params(false, true)).unwrap();
+        let f = refine_2d_levels(coarse.view(), 4, &params(false, true), None).unwrap();
         assert_eq!(f.dim(), (16, 16));
     }
 
@@ -496,7 +548,7 @@ mod tests {
             p.hurst = h;
             p.seed = seed;
             p.coarse_spacing = 1024.0;
-            let x = refine_1d_levels(&[0.0, end], 10, &p).unwrap();
+            let x = refine_1d_levels(&[0.0, end], 10, &p, None).unwrap();
             for w in x.windows(2) {
                 acc += (w[1] - w[0]).powi(2);
                 n += 1.0;
@@ -514,7 +566,7 @@ mod tests {
         let mut p = params(false, false);
         p.hurst = 1.0;
         assert!(matches!(
-            refine_2d(coarse.view(), &p),
+            refine_2d(coarse.view(), &p, None),
             Err(CoreError::InvalidArgument { .. })
         ));
     }

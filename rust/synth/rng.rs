@@ -237,13 +237,9 @@ pub fn inverse_normal_cdf(p: f64) -> f64 {
 
 /// Fill `out` with standard normals of stream `(seed, stream)` at indices
 /// `start .. start + out.len()`, in parallel (the result does not depend on
-/// the number of threads).
-pub fn fill_normal(out: &mut [f64], seed: u64, stream: u64, start: u64) {
-    fill_normal_counted(out, seed, stream, start, None);
-}
-
-/// [`fill_normal`] ticking `progress` by the values drawn (total: `out.len()`).
-pub fn fill_normal_counted(
+/// the number of threads), ticking `progress` by the values drawn (total:
+/// `out.len()`).
+pub fn fill_normal(
     out: &mut [f64],
     seed: u64,
     stream: u64,
@@ -346,12 +342,12 @@ mod tests {
         let mut a = vec![0.0; 100_000];
         let mut b = vec![0.0; 100_000];
         crate::parallel::run_in_pool(Some(1), || {
-            fill_normal(&mut a, 9, 3, 10);
+            fill_normal(&mut a, 9, 3, 10, None);
             Ok(())
         })
         .unwrap();
         crate::parallel::run_in_pool(Some(2), || {
-            fill_normal(&mut b, 9, 3, 10);
+            fill_normal(&mut b, 9, 3, 10, None);
             Ok(())
         })
         .unwrap();

@@ -14,7 +14,7 @@ def add_parsers(sub) -> None:
         description="Synthesise fractional Brownian motion (1D, --size N) or a fractional Brownian "
         "surface (2D, --size ROWS COLS) and write it (.npy, .exr, .tif; 1D: .npy only). A GeoTIFF gets "
         "a transform of --cell-size square cells (upper-left corner at (0, ROWS * cell size)), the --crs "
-        "if given, and the tags CELL_SIZE, HURST, METHOD, SEED. A progress bar of a 2D synthesis is drawn "
+        "if given, and the tags CELL_SIZE, HURST, METHOD, SEED. A progress bar of the synthesis is drawn "
         "when stderr is a terminal (--progress / --no-progress).",
     )
     p.add_argument("output", help="output file (.npy, .exr, .tif)")
@@ -50,7 +50,7 @@ def _run_synth(args: argparse.Namespace) -> int:
         if args.hillshade:
             raise ValueError("hillshade: only for 2D surfaces")
         x = fbm(args.size[0], args.hurst, method=args.method, seed=args.seed, sigma=args.sigma,
-                n_threads=args.n_threads)
+                n_threads=args.n_threads, progress=_progress.resolve(args.progress, cli=True))
         if not str(args.output).lower().endswith(".npy"):
             raise ValueError("output: 1D fBm is written as .npy")
         write_raster(args.output, x)

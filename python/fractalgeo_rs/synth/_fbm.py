@@ -33,7 +33,8 @@ def _noise(n, seed, stream, n_threads, steps=None):
 
 # --------------------------------------------------------------------- 1D
 
-def fbm(n, hurst, *, method="exact", seed=None, sigma=1.0, n_threads=None, max_memory=None):
+def fbm(n, hurst, *, method="exact", seed=None, sigma=1.0, n_threads=None, max_memory=None,
+        progress=None):
     r"""Sample fractional Brownian motion :math:`B_H` at ``n`` equally spaced times.
 
     The output starts at 0: ``x[0] = 0`` and ``x[k] = B_H(k)`` for
@@ -84,6 +85,11 @@ def fbm(n, hurst, *, method="exact", seed=None, sigma=1.0, n_threads=None, max_m
         ``ValueError``) naming ``n`` is raised. ``None``: the package default
         (half the available memory, ``$FRACTALGEO_MAX_MEMORY`` to override;
         docs/input_policy.md).
+    progress : bool or None
+        A tqdm bar on stderr (``pip install "fractalgeo_rs[progress]"``)
+        moved by the Rust kernels as they draw and refine the samples;
+        ``None`` or ``False``: no bar. The samples are the same with and
+        without a bar.
 
     Returns
     -------
@@ -112,12 +118,17 @@ def fbm(n, hurst, *, method="exact", seed=None, sigma=1.0, n_threads=None, max_m
     sigma = c.check_sigma(sigma)
     n_threads = check_n_threads(n_threads)
     check_memory(fbm_memory_bytes(n), "n", max_memory=max_memory, what=f"n={n} samples")
-    if method == "exact":
-        x = _fbm_exact(n, h, seed, n_threads)
-    elif method == "spectral":
-        x = _fbm_spectral(n, h, seed, n_threads)
-    else:
-        x = _fbm_midpoint(n, h, seed, method == "additions", n_threads)
+    show = _progress.resolve(progress)
+    # Bar units: samples, n per pass (exact: eigenvalues and path; spectral:
+    # noise, forward and inverse FFT; midpoint: the refinement).
+    passes = {"exact": 2, "spectral": 3}.get(method, 1)
+    with _progress.Steps(passes * n, f"fbm ({method})", show) as steps:
+        if method == "exact":
+            x = _fbm_exact(n, h, seed, n_threads, steps)
+        elif method == "spectral":
+            x = _fbm_spectral(n, h, seed, n_threads, steps)
+        else:
+            x = _fbm_midpoint(n, h, seed, method == "additions", n_threads, steps)
     x = x * sigma
     x -= x[0]
     return x
@@ -150,7 +161,7 @@ def _davies_harte_sqrt_eig(m: int, hurst: float) -> np.ndarray:
     return out
 
 
-def _fbm_exact(n, h, seed, n_threads):
+def _fbm_exact(n, h, seed, n_threads, steps=None):
     # Davies & Harte (1987) in the form of Wood & Chan (1994): a Hermitian
     # random vector W with E|W_k|^2 = lambda_k / (2m) (lambda: eigenvalues of
     # the circulant of size 2m holding the fGn autocovariance), whose inverse
@@ -158,8 +169,10 @@ def _fbm_exact(n, h, seed, n_threads):
     # FFT and cumulative sum run in Rust (rust/synth/davies_harte.rs).
     m = sfft.next_fast_len(n - 1, real=True)
     m += m % 2
+    steps = steps if steps is not None else _progress.Steps(0, "", False)
     s = _davies_harte_sqrt_eig(m, h)
-    return _core.davies_harte_fbm(s, n, seed, c.STREAM_EXACT_1D, n_threads)
+    steps.step(n)
+    return steps.counted(lambda pr: _core.davies_harte_fbm(s, n, seed, c.STREAM_EXACT_1D, n_threads, pr), n)
 
 
 def _spectral_lag1_variance_1d(amp2: np.ndarray, n: int) -> float:
@@ -172,14 +185,17 @@ def _spectral_lag1_variance_1d(amp2: np.ndarray, n: int) -> float:
     return float(np.sum(weight * amp2 * 2 * (1 - np.cos(2 * np.pi * k / n))) / n)
 
 
-def _fbm_spectral(n, h, seed, n_threads):
-    w = _noise(n, seed, c.STREAM_SPECTRAL_1D, n_threads)
+def _fbm_spectral(n, h, seed, n_threads, steps=None):
+    steps = steps if steps is not None else _progress.Steps(0, "", False)
+    w = _noise(n, seed, c.STREAM_SPECTRAL_1D, n_threads, steps)
     spec = sfft.rfft(w, workers=_workers(n_threads))
+    steps.step(n)
     f = np.arange(spec.size) / n
     amp = np.zeros(spec.size)
     amp[1:] = f[1:] ** (-(2 * h + 1) / 2)
     scale = 1.0 / math.sqrt(_spectral_lag1_variance_1d(amp**2, n))
     x = sfft.irfft(spec * (amp * scale), n, workers=_workers(n_threads))
+    steps.step(n)
     return x
 
 
@@ -208,13 +224,15 @@ def _levels_for(span: int, max_coarse: int = 8) -> int:
     return int(math.ceil(math.log2(span / max_coarse)))
 
 
-def _fbm_midpoint(n, h, seed, additions, n_threads):
+def _fbm_midpoint(n, h, seed, additions, n_threads, steps=None):
     levels = _levels_for(n - 1)
     step = 2**levels
     n_coarse = -(-(n - 1) // step) + 1
     pos = np.arange(n_coarse, dtype=np.float64)[:, None] * step
     coarse = _exact_coarse(pos, h, seed, c.STREAM_COARSE_1D, n_threads)
-    x = _core.midpoint_refine_1d(coarse, levels, h, 1.0, float(step), additions, seed, 0, n_threads)
+    steps = steps if steps is not None else _progress.Steps(0, "", False)
+    x = steps.counted(lambda pr: _core.midpoint_refine_1d(coarse, levels, h, 1.0, float(step), additions,
+                                                         seed, 0, n_threads, pr), n)
     return np.ascontiguousarray(x[:n])
 
 
