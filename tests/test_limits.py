@@ -170,16 +170,20 @@ def test_grid_from_points_output_is_estimated():
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="RLIMIT_AS semantics are Linux's")
 def test_lsystem_and_readers_under_an_address_space_limit(tmp_path):
     # A doubling L-system with max_length out of the way outgrows the 3 GiB
-    # address space: the derived string's buffer is allocated fallibly
-    # (MemoryError naming max_length), never an abort; a file announcing
-    # 8 TB is refused from its header.
+    # address space: its length is counted from the productions and refused
+    # before expanding (MemoryLimitError naming n); when a condition hides
+    # the growth from the count, the derived string's buffer is allocated
+    # fallibly (MemoryError naming max_length), never an abort; a file
+    # announcing 8 TB is refused from its header.
     npy = tmp_path / "huge.npy"
     _huge_npy(npy)
     calls = ["fg.lsystem.LSystem('A', {'A': 'AA'}, max_length=2**62).derive(40)",
              "fg.lsystem.LSystem('A', {'A': 'AB', 'B': 'A'}, max_length=2**62).derive(80)",
+             "fg.lsystem.LSystem('A(1)', ['A(x): x > 0 -> A(x)A(x)'], max_length=2**62).derive(40)",
              f"fg.read_raster({str(npy)!r})"]
     r = _run_child(calls)
     assert r.returncode == 0, (r.returncode, r.stdout[-2000:], r.stderr[-2000:])
     assert r.stdout.count("ok ") == len(calls)
     lines = [ln for ln in r.stdout.splitlines() if ln.startswith("ok ")]
-    assert all("MemoryError" in ln for ln in lines), r.stdout
+    assert [ln.split()[1] for ln in lines] == ["MemoryLimitError", "MemoryLimitError", "MemoryError",
+                                               "RasterMemoryError"], r.stdout

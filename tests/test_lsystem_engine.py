@@ -124,10 +124,17 @@ def test_bad_input_names_the_parameter(axiom, rules, kw, param):
 def test_runaway_growth_is_a_value_error():
     s = LSystem("F", {"F": "FF"}, max_length=10_000)
     assert len(s.derive(13)) == 8192
-    with pytest.raises(ValueError, match="^max_length:"):
+    # counted before expanding: a MemoryError that is a ValueError, naming n
+    with pytest.raises(MemoryError, match=r"^n: 14 derivation steps give exactly 16384 modules .*max_length=10000"):
         s.derive(14)
-    with pytest.raises(ValueError, match="^max_length:"):
+    with pytest.raises(ValueError, match=r"^n: 40 derivation steps give more than 3.4e\+38 modules"):
         LSystem("F", {"F": "F" * 50}).derive(40)  # default limit, no hang
+    # a condition hides the growth from the count (lower bound 1): the
+    # expansion itself stops at max_length
+    cond = LSystem("A(1)", ["A(x): x > 0 -> A(x)A(x)"], max_length=1000)
+    assert cond.length_bounds(12) == (1, 4096) and len(cond.derive(9)) == 512
+    with pytest.raises(ValueError, match="^max_length: derivation step 10 "):
+        cond.derive(12)
     with pytest.raises(ValueError, match="^n:"):
         LSystem("F", {"F": "F"}).derive(10**7)  # would never end otherwise
     with pytest.raises(ValueError, match="^rules:.*nesting"):
@@ -147,3 +154,36 @@ def test_type_errors():
         LSystem("F", {}).derive(-1)
     with pytest.raises(ValueError, match="^text:"):
         LSystem.from_string("F -> FF")
+
+
+def test_length_is_counted_before_expanding():
+    import time
+
+    from fractalgeo_rs._validation import MemoryLimitError
+
+    ten = LSystem("F", {"F": "FFFFFFFFFF"})
+    t0 = time.perf_counter()
+    with pytest.raises(MemoryLimitError) as e:
+        ten.derive(30)
+    assert time.perf_counter() - t0 < 0.5
+    msg = str(e.value)
+    assert msg.startswith("n: 30 derivation steps give exactly 1e+30 modules"), msg
+    assert "max_length=100000000" in msg
+    assert ten.length_bounds(30) == (10**30, 10**30)
+    # within max_length but above the memory limit: the memory policy's message
+    big = LSystem("F", {"F": "FF"}, max_length=2**62)
+    with pytest.raises(MemoryLimitError, match=r"^n: needs about .* for n=60 derivation steps \(exactly"):
+        big.derive(60)
+    # Koch snowflake 7 * 4**n, dragon 2**(n+2) - 2: closed forms = real lengths
+    koch = LSystem("F++F++F", {"F": "F-F++F-F"})
+    dragon = LSystem("FX", {"X": "X+YF+", "Y": "-FX-Y"})
+    for n in range(7):
+        assert koch.length_bounds(n) == (7 * 4**n,) * 2 == (len(koch.derive(n)),) * 2
+        assert dragon.length_bounds(n) == (2 ** (n + 2) - 2,) * 2 == (len(dragon.derive(n)),) * 2
+    # stochastic: bounds from the smallest and largest alternative
+    st = LSystem("F", ["F -(1)-> FF", "F -(1)-> F", "F -(1)-> F[+F]"])
+    lo, hi = st.length_bounds(5)
+    assert (lo, hi) == (1, 2**5 + 3 * (2**5 - 1))
+    assert all(lo <= len(st.derive(5, seed=k)) <= hi for k in range(10))
+    with pytest.raises(ValueError, match="^n:"):
+        ten.length_bounds(10**7)

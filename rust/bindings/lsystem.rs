@@ -106,6 +106,23 @@ impl LSystemCore {
         Ok(ModuleString { inner: Arc::new(s) })
     }
 
+    /// `(lower, upper)` bounds on the number of modules after `n` steps,
+    /// counted from the productions without expanding (equal when exact).
+    fn length_bounds(&self, py: Python<'_>, n: usize) -> PyResult<(u128, u128)> {
+        if n > crate::lsystem::derive::MAX_STEPS {
+            return Err(crate::error::CoreError::invalid(
+                "n",
+                format!(
+                    "at most {} derivation steps, got {n}",
+                    crate::lsystem::derive::MAX_STEPS
+                ),
+            )
+            .into());
+        }
+        let l = self.inner.clone();
+        Ok(py.detach(move || l.length_bounds(n)))
+    }
+
     #[getter]
     fn is_stochastic(&self) -> bool {
         self.inner.is_stochastic()

@@ -499,6 +499,116 @@ impl LSystem {
         })
     }
 
+    /// Bounds `(lower, upper)` on the number of modules after `n` steps,
+    /// from the productions alone (nothing is expanded): the count of each
+    /// symbol evolves as `v_{k+1} = M v_k`, where column `c` of `M` holds the
+    /// symbol counts of the successor of `c`. Where the successor is not
+    /// fixed (stochastic alternatives; a production that may not apply
+    /// because of a context, a condition or the number of parameters, in
+    /// which case the module is copied), `lower` uses the smallest count of
+    /// each symbol over the possible successors and `upper` the largest, so
+    /// `lower <= length <= upper` (non-negative matrices are monotone);
+    /// `lower == upper` is the exact length (deterministic context-free
+    /// systems). Saturating arithmetic (`u128::MAX` stands for "at least
+    /// that"); `O(n * nnz)` time for the `nnz` non-zero entries of `M`, less
+    /// when the counts stop changing.
+    pub fn length_bounds(&self, n: usize) -> (u128, u128) {
+        // Symbols of the axiom and of every successor, indexed.
+        fn id(c: char, index: &mut HashMap<char, usize>) -> usize {
+            let k = index.len();
+            *index.entry(c).or_insert(k)
+        }
+        let mut index: HashMap<char, usize> = HashMap::new();
+        let v0: Vec<usize> = self.axiom.syms.iter().map(|&c| id(c, &mut index)).collect();
+        for r in &self.rules {
+            for succ in &r.successors {
+                for &c in &succ.syms {
+                    id(c, &mut index);
+                }
+            }
+        }
+        let k = index.len();
+        // Sparse columns (target symbol, count) of the min and max matrices.
+        let mut lo_cols: Vec<Vec<(usize, u128)>> = vec![Vec::new(); k];
+        let mut hi_cols: Vec<Vec<(usize, u128)>> = vec![Vec::new(); k];
+        for (&c, &ci) in &index {
+            let mut options: Vec<Vec<u128>> = Vec::new();
+            let mut always = false;
+            let cands: Vec<u32> = match &self.simple {
+                Some((ascii, other)) => {
+                    let r = if (c as u32) < 128 {
+                        ascii[c as usize]
+                    } else {
+                        other.get(&c).copied().unwrap_or(u32::MAX)
+                    };
+                    if r == u32::MAX {
+                        vec![]
+                    } else {
+                        vec![r]
+                    }
+                }
+                None => self.candidates(c).to_vec(),
+            };
+            for r in cands {
+                let rule = &self.rules[r as usize];
+                for succ in &rule.successors {
+                    let mut cnt = vec![0u128; k];
+                    for s in &succ.syms {
+                        cnt[index[s]] += 1;
+                    }
+                    options.push(cnt);
+                }
+                if self.simple.is_some()
+                    || (!rule.has_context() && rule.cond.is_none() && rule.pred.arity.is_none())
+                {
+                    always = true; // this production applies whenever it is reached
+                    break;
+                }
+            }
+            if !always {
+                let mut copy = vec![0u128; k];
+                copy[ci] = 1;
+                options.push(copy);
+            }
+            for t in 0..k {
+                let lo = options.iter().map(|o| o[t]).min().unwrap_or(0);
+                let hi = options.iter().map(|o| o[t]).max().unwrap_or(0);
+                if lo > 0 {
+                    lo_cols[ci].push((t, lo));
+                }
+                if hi > 0 {
+                    hi_cols[ci].push((t, hi));
+                }
+            }
+        }
+        let mut v = vec![0u128; k];
+        for &i in &v0 {
+            v[i] += 1;
+        }
+        let apply = |cols: &[Vec<(usize, u128)>], v: &[u128]| -> Vec<u128> {
+            let mut w = vec![0u128; v.len()];
+            for (c, col) in cols.iter().enumerate() {
+                if v[c] == 0 {
+                    continue;
+                }
+                for &(t, m) in col {
+                    w[t] = w[t].saturating_add(v[c].saturating_mul(m));
+                }
+            }
+            w
+        };
+        let (mut lo, mut hi) = (v.clone(), v);
+        for _ in 0..n {
+            let (nlo, nhi) = (apply(&lo_cols, &lo), apply(&hi_cols, &hi));
+            if nlo == lo && nhi == hi {
+                break; // a fixed point: every later step gives the same counts
+            }
+            (lo, hi) = (nlo, nhi);
+        }
+        let sum = |v: &[u128]| v.iter().fold(0u128, |a, &b| a.saturating_add(b));
+        (sum(&lo), sum(&hi))
+    }
+
     /// Derive `n` steps from the axiom with the system's seed.
     pub fn derive(&self, n: usize) -> CoreResult<ModString> {
         self.derive_with_seed(n, self.seed)
@@ -534,6 +644,67 @@ mod tests {
             DEFAULT_MAX_LENGTH,
         )
         .unwrap()
+    }
+
+    #[test]
+    fn length_bounds_are_the_closed_forms_and_the_real_lengths() {
+        // Koch snowflake: 3 * 4^n F and 4^(n+1) turns; dragon curve:
+        // 2^(n+2) - 2 modules; algae (eq. 23): Fibonacci lengths.
+        let koch = ls("F++F++F", &["F -> F-F++F-F"]);
+        let dragon = ls("FX", &["X -> X+YF+", "Y -> -FX-Y"]);
+        let algae = ls("b", &["b -> a", "a -> ab"]);
+        let mut fib = (1u128, 1u128);
+        for n in 0..9usize {
+            let k = 7 * 4u128.pow(n as u32);
+            let d = (1u128 << (n + 2)) - 2;
+            assert_eq!(koch.length_bounds(n), (k, k));
+            assert_eq!(dragon.length_bounds(n), (d, d));
+            assert_eq!(algae.length_bounds(n), (fib.0, fib.0));
+            assert_eq!(koch.derive(n).unwrap().len() as u128, k);
+            assert_eq!(dragon.derive(n).unwrap().len() as u128, d);
+            assert_eq!(algae.derive(n).unwrap().len() as u128, fib.0);
+            fib = (fib.1, fib.0 + fib.1);
+        }
+        // 10^30 modules counted at once; past u128 it saturates.
+        let ten = ls("F", &["F -> FFFFFFFFFF"]);
+        assert_eq!(ten.length_bounds(30), (10u128.pow(30), 10u128.pow(30)));
+        assert_eq!(ten.length_bounds(40), (u128::MAX, u128::MAX));
+        // a string that stops changing: a fixed point after one step
+        let still = ls("AB", &["A -> C"]);
+        assert_eq!(still.length_bounds(MAX_STEPS), (2, 2));
+    }
+
+    #[test]
+    fn length_bounds_bracket_stochastic_and_conditional_systems() {
+        // F -> FF, F or F+F: per symbol at least 1 F, at most 2 F and one
+        // + (which is copied): 1 .. 2^n F's and 2^n - 1 turns.
+        let st = ls("F", &["F -(1)-> FF", "F -(1)-> F", "F -(1)-> F+F"]);
+        let (lo, hi) = st.length_bounds(6);
+        assert_eq!((lo, hi), (1, 127));
+        for seed in 0..20 {
+            let len = st.derive_with_seed(6, seed).unwrap().len() as u128;
+            assert!(lo <= len && len <= hi, "{lo} {len} {hi}");
+        }
+        // ABOP 1.10: conditions decide; the bounds hold at every step.
+        let p = ls(
+            "B(2)A(4,4)",
+            &[
+                "A(x,y): y <= 3 -> A(x*2, x+y)",
+                "A(x,y): y > 3 -> B(x)A(x/y, 0)",
+                "B(x): x < 1 -> C",
+                "B(x): x >= 1 -> B(x-1)",
+            ],
+        );
+        for n in 0..12 {
+            let (lo, hi) = p.length_bounds(n);
+            let len = p.derive(n).unwrap().len() as u128;
+            assert!(lo <= len && len <= hi, "n={n}: {lo} {len} {hi}");
+        }
+        // context: "a < b -> bb" may or may not apply (copy): 1 .. 2 per b;
+        // only the b next to the a doubles: ab, abb, abbb, abbbb.
+        let c = ls("ab", &["a < b -> bb"]);
+        assert_eq!(c.length_bounds(3), (2, 9));
+        assert_eq!(c.derive(3).unwrap().len(), 5);
     }
 
     #[test]

@@ -12,14 +12,28 @@ from typing import Any, Mapping, Optional, Sequence, Union
 
 
 from fractalgeo_rs import _core
-from fractalgeo_rs._validation import check_n_threads
+from fractalgeo_rs._validation import MemoryLimitError, check_memory, check_n_threads
 
 __all__ = ["LSystem", "LString", "DEFAULT_MAX_LENGTH"]
 
 #: Default limit on the number of modules of a derived string.
 DEFAULT_MAX_LENGTH = 100_000_000
 
+#: Bytes per module of a derived string at the peak of a derivation step
+#: (the previous and the new string, one 4-byte symbol each; parameters come
+#: on top).
+BYTES_PER_MODULE = 8
+
 RulesLike = Union[str, Mapping[str, Any], Sequence[str]]
+
+
+def _modules(lower: int, upper: int) -> str:
+    """The module count of a derivation for messages (exact below 10**12,
+    else 3 digits; ``2**128 - 1`` is a saturated count)."""
+    if lower >= 2**128 - 1:
+        return f"more than {float(lower):.3g}"
+    n = str(lower) if lower < 10**12 else f"{float(lower):.3g}"
+    return f"exactly {n}" if lower == upper else f"at least {n}"
 
 
 def _check_seed(seed, name: str = "seed") -> int:
@@ -179,7 +193,7 @@ class LSystem:
         gives the same strings on any number of threads.
     max_length : int
         Largest allowed number of modules; a longer derivation raises
-        ``ValueError`` instead of exhausting memory.
+        ``ValueError`` instead of exhausting memory (see :meth:`derive`).
     defaults : mapping of str to str, optional
         Settings for the caller (``n``, ``angle``, ``step``, ...; the
         ``key: value`` lines of the text format), kept as the dict attribute
@@ -328,13 +342,70 @@ class LSystem:
 
         Raises
         ------
+        MemoryError
+            Before anything is expanded, when the length after ``n`` steps,
+            counted from the productions (:meth:`length_bounds`), is above
+            ``max_length`` or needs more than the memory limit
+            (``BYTES_PER_MODULE = 8`` bytes per module; docs/input_policy.md).
+            The error is a ``ValueError`` too and its message starts with
+            ``n:``.
         ValueError
-            When the string would exceed ``max_length`` modules, or a
+            When the string would exceed ``max_length`` modules during the
+            expansion (only possible when the count is not exact), or a
             parametric production gives a non-finite value.
         """
         n = _check_n(n)
         s = None if seed is None else _check_seed(seed)
-        return LString(self._core.derive(n, seed=s, n_threads=check_n_threads(n_threads)))
+        n_threads = check_n_threads(n_threads)
+        lower, upper = self._core.length_bounds(n)
+        what = _modules(lower, upper)
+        if lower > self._max_length:
+            raise MemoryLimitError(
+                f"n: {n} derivation steps give {what} modules (counted from the productions, nothing "
+                f"expanded), more than max_length={self._max_length}; lower n or raise max_length")
+        check_memory(lower * BYTES_PER_MODULE, "n", what=f"n={n} derivation steps ({what} modules)")
+        return LString(self._core.derive(n, seed=s, n_threads=n_threads))
+
+    def length_bounds(self, n: int) -> tuple:
+        """Bounds ``(lower, upper)`` on the number of modules after ``n``
+        steps, counted from the productions without expanding anything.
+
+        The count of each symbol evolves as :math:`v_{k+1} = M v_k` (column
+        ``c`` of ``M``: the symbol counts of the successor of ``c``;
+        Prusinkiewicz & Lindenmayer 1990, growth functions of DOL-systems).
+        Where the successor is not fixed (stochastic alternatives, or a
+        production that may not apply because of a context, a condition or
+        the number of parameters, the module then being copied), ``lower``
+        takes the smallest count of each symbol over the possible successors
+        and ``upper`` the largest, so ``lower <= len(derive(n)) <= upper``;
+        for deterministic context-free systems ``lower == upper`` is the
+        exact length. Counts saturate at ``2**128 - 1``.
+
+        Parameters
+        ----------
+        n : int
+            Number of derivation steps (at most 1 000 000).
+
+        Returns
+        -------
+        tuple of int
+            ``(lower, upper)`` numbers of modules.
+
+        References
+        ----------
+        P. Prusinkiewicz and A. Lindenmayer, *The Algorithmic Beauty of Plants*,
+        Springer, 1990, section 1.2.
+
+        Examples
+        --------
+        >>> from fractalgeo_rs.lsystem import LSystem
+        >>> koch = LSystem("F++F++F", {"F": "F-F++F-F"})
+        >>> koch.length_bounds(3), len(koch.derive(3))  # 7 * 4**n
+        ((448, 448), 448)
+        >>> LSystem("F", {"F": "F" * 10}).length_bounds(30)[0] == 10**30
+        True
+        """
+        return self._core.length_bounds(_check_n(n))
 
     def generations(self, n: int, *, n_threads: Optional[int] = None) -> list:
         """The strings of steps 0, 1, ..., n (each with the same seed)."""
