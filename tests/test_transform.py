@@ -164,6 +164,23 @@ def test_bad_arguments(kwargs, exc, param):
         fg.fractal_transform(np.zeros((50, 50)), **kwargs)
 
 
+def test_dbc_map_and_whole_image_dbc_refuse_one_pixel_blocks():
+    # one rule: no 1-pixel blocks; windows under 5 have no default sizes
+    z = fg.fbm_surface((40, 40), 0.5, seed=2)
+    with pytest.raises(ValueError, match="^window_size: method 'dbc' needs a window of at least 5 pixels.*got 3$"):
+        fg.fractal_transform(z, 3, method="dbc")
+    with pytest.raises(ValueError, match=r"^box_sizes: DBC needs block sides of at least 2 pixels.*\[1, 2, 3\]$") as m:
+        fg.fractal_transform(z, 9, method="dbc", box_sizes=[1, 2, 3])
+    with pytest.raises(ValueError) as whole:
+        fg.differential_box_counting(z, box_sizes=[1, 2, 3])
+    assert str(m.value) == str(whole.value)
+    # the smallest valid window: defaults 2, 3, 4, the map equals the per-window estimator
+    d = fg.fractal_transform(z, 5, method="dbc", z_scale=0.5)
+    ref = fg.differential_box_counting(z[10:15, 20:25], box_sizes=[2, 3, 4], z_scale=0.5, z0=0.0,
+                                       edge_blocks="drop").dimension
+    assert abs(d[12, 22] - ref) < 1e-5
+
+
 def test_bad_images():
     with pytest.raises(ValueError, match="band"):
         fg.fractal_transform(np.zeros((2, 50, 50)), 9)

@@ -101,9 +101,17 @@ def _configure_mass(w: int, o: MapOptions, opts: Opts) -> int:
 
 
 def _configure_dbc(w: int, o: MapOptions, opts: Opts) -> int:
+    # One rule with the whole-image differential_box_counting: no 1-pixel
+    # blocks (a 1-pixel block spans no height range: it always holds one box).
+    if o.box_sizes is None and w < 5:
+        raise ValueError(f"window_size: method 'dbc' needs a window of at least 5 pixels (default block "
+                         f"sides 2, 3, 4; 1-pixel blocks carry no height information), got {w}")
     sizes = dbc_default_sizes(w) if o.box_sizes is None else int_list(o.box_sizes, "box_sizes", "ints")
-    if len(sizes) < 3 or sizes[0] < 1 or sizes[-1] > w:
-        raise ValueError(f"box_sizes: need at least 3 distinct block sides in [1, {w}], got {sizes}")
+    if sizes and sizes[0] < 2:
+        raise ValueError(f"box_sizes: DBC needs block sides of at least 2 pixels (a 1-pixel block spans no "
+                         f"height range: it always holds one box), got {sizes}")
+    if len(sizes) < 3 or sizes[-1] > w:
+        raise ValueError(f"box_sizes: need at least 3 distinct block sides in [2, {w}], got {sizes}")
     opts["sizes"] = sizes
     opts["partial"] = o.edge_blocks == "count"
     return 0
