@@ -8,12 +8,12 @@ from typing import Any
 
 import numpy as np
 
-from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads
+from fractalgeo_rs._cli_common import HelpFormatter, add_cell_size, add_n_threads, add_raster_io
 
 
 def add_parsers(sub) -> None:
     p = sub.add_parser(
-        "resample",
+        "resample", formatter_class=HelpFormatter,
         help="resample a DEM on a finer grid with fractal detail",
         description="Fractal resampling (fractalgeo_rs.fractal_resample): the DEM is analysed for "
         "its local Hurst exponent and roughness and refined by --factor (a power of 2) with "
@@ -22,16 +22,18 @@ def add_parsers(sub) -> None:
     )
     p.add_argument("input", help="input DEM (GeoTIFF or any format rasterio reads)")
     p.add_argument("output", help="output GeoTIFF (float32, nodata NaN)")
-    p.add_argument("--factor", type=int, default=2, help="power of 2 (default 2)")
+    p.add_argument("--factor", type=int, default=2, help="refinement factor, a power of 2")
     p.add_argument("--min-scale", type=float, default=None,
                    help="no random detail in cells smaller than this (ground units)")
-    p.add_argument("--seed", type=int, default=None)
-    p.add_argument("--hurst", default="local", help="'local' (default) or a number in (0, 1)")
-    p.add_argument("--sigma", default="local", help="'local' (default) or a number >= 0")
+    p.add_argument("--seed", type=int, default=None, help="seed in [0, 2**64); None draws one")
+    p.add_argument("--hurst", default="local",
+                   help="Hurst exponent: 'local' (estimated in each window) or a number in (0, 1)")
+    p.add_argument("--sigma", default="local",
+                   help="detail scale: 'local' (estimated in each window) or a number >= 0")
     p.add_argument("--window", type=int, default=33, help="analysis window (cells, odd)")
     p.add_argument("--support", default="point", choices=("point", "area"))
     p.add_argument("--chunks", type=int, default=2048, help="block side in input cells")
-    p.add_argument("--n-threads", type=int, default=None)
+    add_n_threads(p)
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_run_resample)
 
@@ -43,13 +45,11 @@ def add_parsers(sub) -> None:
         "nodata come from the file's georeferencing when it has any. A .tif output keeps the DEM's CRS and "
         "transform with nodata 0; a .png output gets a world file (.pgw) and the CRS in .prj.",
     )
-    h.add_argument("dem", help="DEM (.tif, .npy, .exr, .png, any GDAL format with rasterio)")
-    h.add_argument("output", help="output .png or .tif")
-    h.add_argument("--band", type=int, default=None, help="1-based band of the DEM (None: its only band)")
+    add_raster_io(h, input="dem", output_help="output .png or .tif")
     h.add_argument("--azimuth", type=float, default=315.0, help="light azimuth, degrees clockwise from north")
     h.add_argument("--altitude", type=float, default=45.0, help="light altitude, degrees above the horizon")
     h.add_argument("--z-factor", type=float, default=1.0, help="vertical exaggeration, > 0")
-    h.add_argument("--cell-size", type=float, default=None, help="override the file's cell size")
+    add_cell_size(h)
     h.add_argument("--multidirectional", action="store_true", help="GDAL's multidirectional shading")
     add_n_threads(h)
     h.set_defaults(func=_run_hillshade)

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import argparse
 
-from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads
+from fractalgeo_rs._cli_common import HelpFormatter, add_band, add_n_threads, add_raster_io
 
 
 def add_parsers(sub) -> None:
@@ -16,11 +16,11 @@ def add_parsers(sub) -> None:
             "a binary set (nonzero = foreground, or --threshold); dbc and affine read it as a surface."
         ),
     )
-    p.add_argument("path", help="raster file (.tif, .tiff, .png, .npy, .exr)")
+    add_raster_io(p, input="path", band=False)
     p.add_argument("--method", default=None, choices=["box", "dbc", "affine"],
                    help="estimator (default: box for a binary mask: bool, or integers with 0 and at most one "
                         "other value such as 0/1 and 0/255 PNGs; else dbc)")
-    p.add_argument("--band", type=int, default=None, help="band to read (1-based; None: the file's only band)")
+    add_band(p)
     p.add_argument("--threshold", type=float, default=None,
                    help="for --method box: foreground is value > THRESHOLD")
     p.add_argument("--box-sizes", default=None, help="comma-separated box sizes in samples")

@@ -4,23 +4,24 @@ from __future__ import annotations
 import argparse
 import time
 
+from fractalgeo_rs._cli_common import HelpFormatter, add_cell_size, add_raster_io
+
 
 def add_parsers(sub) -> None:
     p = sub.add_parser(
-        "tin",
+        "tin", formatter_class=HelpFormatter,
         help="error-bounded triangulated mesh (TIN) of a DEM as PLY or OBJ",
         description="Greedy error-bounded TIN of a DEM (Garland-Heckbert): every valid sample is within "
         "--max-error of the mesh (unless --max-triangles stops it first). Georeferencing and nodata come "
         "from the file when it has them; nodata areas become holes. Prints vertex and triangle counts and "
         "the achieved maximum error.",
     )
-    p.add_argument("dem", help="DEM (.tif, .npy, .exr, .png, any GDAL format with rasterio)")
-    p.add_argument("output", help="output mesh (.ply or .obj)")
+    add_raster_io(p, input="dem", output_help="output mesh (.ply or .obj)", band=False)
     p.add_argument("--max-error", type=float, default=None,
                    help="largest vertical error in DEM units (default: 0.5%% of the 2-98%% relief)")
     p.add_argument("--max-triangles", type=int, default=None, help="triangle budget")
     p.add_argument("--tile-edges", choices=("shared", "free"), default="shared")
-    p.add_argument("--cell-size", type=float, default=None, help="sample spacing when the file has no transform")
+    add_cell_size(p)
     p.add_argument("--preview", metavar="PNG", default=None, help="also write a shaded-relief PNG of the mesh")
     p.set_defaults(func=_run_tin)
 
@@ -38,6 +39,10 @@ def _run_tin(args: argparse.Namespace) -> int:
         transform = prof.get("transform")
         nodata = prof.get("nodata")
     cell = args.cell_size if transform is None else None
+    if transform is not None and args.cell_size is not None:
+        # the given cell size with the file's origin (north up)
+        cs = float(args.cell_size)
+        transform = type(transform)(cs, 0.0, transform.c, 0.0, -cs, transform.f)
     t0 = time.perf_counter()
     tin = tin_from_dem(z, max_error=args.max_error, max_triangles=args.max_triangles, transform=transform,
                        cell_size=cell, nodata=nodata, tile_edges=args.tile_edges)

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import argparse
 
-from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads, add_progress
+from fractalgeo_rs._cli_common import HelpFormatter, add_band, add_n_threads, add_progress, add_raster_io
 
 
 def add_parsers(sub) -> None:
@@ -16,8 +16,7 @@ def add_parsers(sub) -> None:
                     "With --chunks the scene is processed by Dask in blocks for scenes larger than memory. A "
                     "progress bar is drawn when stderr is a terminal (--progress / --no-progress).",
     )
-    p.add_argument("input", help="input raster")
-    p.add_argument("output", help="output map (.tif or .npy)")
+    add_raster_io(p, output_help="output map (.tif or .npy)", band=False)
     p.add_argument("--window", type=int, default=33, help="odd window side in pixels (default 33)")
     from fractalgeo_rs.transform._methods import METHODS
 
@@ -31,7 +30,7 @@ def add_parsers(sub) -> None:
     p.add_argument("--step", type=int, default=1,
                    help="compute every STEP-th row and column only (output cells STEP pixels wide, "
                         "centred on the input pixels they sample; default 1)")
-    p.add_argument("--band", type=int, default=None, help="1-based band (None: the file's only band)")
+    add_band(p)
     p.add_argument("--chunks", type=int, default=None,
                    help="process with Dask in chunks of this side, with a progress bar (needs the dask extra)")
     add_n_threads(p)
@@ -39,9 +38,10 @@ def add_parsers(sub) -> None:
     p.set_defaults(func=_run)
 
 
-def map_tags(params: dict, input_units=None) -> dict:
+def map_tags(params: dict, input_units=None, input_cell_size=None) -> dict:
     """GeoTIFF metadata tags of a transform map: what makes maps comparable
-    and reproducible (method, window, step, the ``z_scale`` used, units)."""
+    and reproducible (method, window, step, the ``z_scale`` used, units, and
+    the input's cell size when it has one)."""
     z = params.get("z_scale")
     tags = {
         "FRACTAL_METHOD": params["method"],
@@ -52,6 +52,8 @@ def map_tags(params: dict, input_units=None) -> dict:
     }
     if z is not None:
         tags["Z_SCALE_UNITS"] = f"{input_units} per pixel" if input_units else "input units per pixel"
+    if input_cell_size is not None:
+        tags["INPUT_CELL_SIZE"] = f"{input_cell_size:.9g}"
     return tags
 
 
@@ -90,7 +92,7 @@ def _run(args: argparse.Namespace) -> int:
         fit = fractal_transform(data, args.window, progress=show, **opts)
         dmap, flags = fit[0], fit.flags
     dmap = np.asarray(dmap, dtype=np.float32)
-    tags = map_tags(fit.params, (profile or {}).get("units"))
+    tags = map_tags(fit.params, (profile or {}).get("units"), cell)
     if args.output.lower().endswith((".tif", ".tiff")):
         transform = (profile or {}).get("transform")
         if transform is not None and args.step > 1:
@@ -102,8 +104,6 @@ def _run(args: argparse.Namespace) -> int:
             # pixels wide with its corner shifted by (1 - step) / 2 pixels
             step_cell = Affine(args.step, 0.0, shift, 0.0, args.step, shift)
             transform = transform @ step_cell if hasattr(transform, "__matmul__") else transform * step_cell
-        if cell is not None:
-            tags["INPUT_CELL_SIZE"] = f"{cell:.9g}"
         write_raster(args.output, dmap, crs=(profile or {}).get("crs"), transform=transform, nodata=float("nan"),
                      tags=tags)
     else:
