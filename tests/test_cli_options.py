@@ -13,6 +13,7 @@ SHARED = {
     "--band": cc.BAND_HELP,
     "--n-threads": cc.N_THREADS_HELP,
     "--cell-size": cc.CELL_SIZE_HELP,
+    "--progress": cc.PROGRESS_HELP,
 }
 #: ``synth --cell-size`` is the spacing of the grid it writes, not a
 #: replacement for an input's: its own text.
@@ -42,6 +43,7 @@ def test_shared_options_have_one_help_text():
     assert {"hillshade", "transform", "dimension"} <= set(seen["--band"])
     assert {"hillshade", "tin"} <= set(seen["--cell-size"])
     assert len(seen["--n-threads"]) >= 5
+    assert {"synth", "transform"} <= set(seen["--progress"])
 
 
 @pytest.mark.parametrize("name", sorted(_subcommands()))

@@ -21,6 +21,9 @@ BAND_HELP = "1-based band of the input (None: its only band)"
 #: Help of ``--cell-size`` on subcommands that read a raster.
 CELL_SIZE_HELP = ("cell size of the input in map units, replacing its transform's (None: the transform's, "
                   "1 without one)")
+#: Help of ``--progress`` / ``--no-progress``.
+PROGRESS_HELP = ("progress bar on stderr (None: on when stderr is a terminal; needs tqdm, "
+                 "pip install \"fractalgeo_rs[progress]\", except with --chunks)")
 #: Help of ``--n-threads``.
 N_THREADS_HELP = "threads of the Rust kernels (None: one per core)"
 
@@ -68,6 +71,4 @@ def georeference_of_grid(rows: int, cell_size: float):
 def add_progress(parser: argparse.ArgumentParser) -> None:
     """``--progress`` / ``--no-progress`` (default: a bar when stderr is a
     terminal; tqdm draws it, Dask's own bar with ``--chunks``)."""
-    parser.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
-                        help="progress bar on stderr (None: on when stderr is a terminal; needs tqdm, "
-                             "pip install \"fractalgeo_rs[progress]\", except with --chunks)")
+    parser.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None, help=PROGRESS_HELP)
