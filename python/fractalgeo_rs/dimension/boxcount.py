@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 import numbers
 import warnings
-from typing import Optional, Sequence, Tuple
+from typing import Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -33,9 +33,9 @@ from fractalgeo_rs._validation import (
     check_memory,
     check_n_threads,
     check_nodata,
-    check_positive_float,
     check_positive_int,
 )
+from fractalgeo_rs._zscale import resolve_z_scale
 from fractalgeo_rs.dimension._common import (
     check_box_sizes,
     default_lattice_counts,
@@ -425,7 +425,7 @@ def differential_box_counting(
     data,
     *,
     box_sizes: Optional[Sequence[int]] = None,
-    z_scale: Optional[float] = None,
+    z_scale: Union[float, str] = "range",
     z0: Optional[float] = None,
     edge_blocks: str = "count",
     nodata: Optional[float] = None,
@@ -516,10 +516,7 @@ def differential_box_counting(
     n_threads = check_n_threads(n_threads)
     zmin, zmax = _nan_range(z)
     rows, cols = z.shape
-    if z_scale is None:
-        z_unit = (zmax - zmin) / max(rows, cols) if zmax > zmin else 1.0
-    else:
-        z_unit = check_positive_float(z_scale, "z_scale")
+    z_unit = resolve_z_scale(z_scale, z)
     if z0 is None:
         z0 = zmin
     else:
