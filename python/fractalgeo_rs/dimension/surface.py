@@ -221,7 +221,7 @@ def mass_dimension(
         ok = ~np.isnan(z)
         if not ok.any():
             raise ValueError("data: no valid value (all NaN)")
-        zmin, zmax = float(z[ok].min()), float(z[ok].max())
+        zmin = float(z[ok].min())
         z_unit = resolve_z_scale(z_scale, z)
         extent = float(max(z.shape))
     if box_sizes is None:
