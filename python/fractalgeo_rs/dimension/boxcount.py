@@ -454,13 +454,16 @@ def differential_box_counting(
         Block sides in pixels, at least 2. Default ``2, 4, 8, ...`` up to a
         quarter of the shorter side (``s = 1`` carries no height information
         in DBC: it raises ``ValueError``).
-    z_scale : float, optional
+    z_scale : float, "auto" or "range", default "range"
         Box height per pixel of box size, in data units (e.g. metres per
-        pixel). Default: ``(zmax - zmin) / max(rows, cols)``, which puts the
+        pixel). ``"range"``: ``(zmax - zmin) / max(rows, cols)``, which puts the
         surface in a cube as in Sarkar and Chaudhuri (G gray levels over an
         M x M image); for a DEM, ``z_scale = cell_size`` gives cubic boxes in
-        physical units. Estimates depend on this choice: compare surfaces with
-        the same convention.
+        physical units; ``"auto"``: ``1.4826 * median |lag-1 increment|``.
+        Both data-derived units scale with the data, so D does not depend on
+        the height unit; the measured choice is in ``docs/conventions.md``.
+        Estimates depend on this choice: compare surfaces with the same
+        convention.
     z0 : float, optional
         Base height of the box stacks, in data units. Default: the lowest
         valid value. A fixed ``z0`` (with a fixed ``z_scale``) makes a

@@ -168,9 +168,10 @@ def mass_dimension(
         ``3, 5, 9, 17, ...`` up to an eighth of the extent (for grayscale
         images at most 33: each box costs L^2 comparisons per pixel, done in
         Rust).
-    z_scale : float, optional
-        Grayscale only: intensity units per pixel; default ``(max - min) /
-        max(rows, cols)`` as in DBC. NaN pixels are not points.
+    z_scale : float, "auto" or "range", default "range"
+        Grayscale only: intensity units per pixel. ``"range"``: ``(max - min)
+        / max(rows, cols)`` as in DBC; ``"auto"``: ``1.4826 * median |lag-1
+        increment|``. NaN pixels are not points.
     scale_range : None, "auto" or (float, float)
         Range of box sides fitted (see :func:`~fractalgeo_rs.box_counting`).
     n_threads : int, optional
