@@ -272,14 +272,13 @@ pub(crate) mod tests {
     }
 
     pub(crate) fn image(rows: usize, cols: usize) -> Vec<f64> {
-        let mut s = 17u64;
+        let u = crate::testdata::uniform(rows * cols, 17);
         (0..rows * cols)
             .map(|k| {
-                s = s.wrapping_mul(6364136223846793005).wrapping_add(3);
                 if k % 19 == 4 {
                     f64::NAN
                 } else {
-                    ((s >> 40) % 9) as f64 + (k % cols) as f64 * 0.2
+                    (u[k] * 9.0).floor() + (k % cols) as f64 * 0.2
                 }
             })
             .collect()

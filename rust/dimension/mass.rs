@@ -396,18 +396,18 @@ mod tests {
 
     #[test]
     fn masses_match_naive_pairs_on_bands_and_box_lists() {
-        let mut seed = 5u64;
-        for &(rows, cols) in &[(1usize, 1usize), (7, 40), (31, 17), (40, 53), (5, 3)] {
+        for (seed, &(rows, cols)) in [(1usize, 1usize), (7, 40), (31, 17), (40, 53), (5, 3)]
+            .iter()
+            .enumerate()
+        {
+            let u = crate::testdata::uniform(rows * cols, 5 + seed as u64);
             let z: Vec<f64> = (0..rows * cols)
-                .map(|k| {
-                    seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
-                    match k % 23 {
-                        4 => f64::NAN,
-                        9 => f64::INFINITY,
-                        15 => f64::NEG_INFINITY,
-                        11 => -0.0,
-                        _ => ((seed >> 40) % 11) as f64 * 0.37 - 1.0,
-                    }
+                .map(|k| match k % 23 {
+                    4 => f64::NAN,
+                    9 => f64::INFINITY,
+                    15 => f64::NEG_INFINITY,
+                    11 => -0.0,
+                    _ => (u[k] * 11.0).floor() * 0.37 - 1.0,
                 })
                 .collect();
             let lists: [&[usize]; 6] = [
@@ -461,14 +461,13 @@ mod tests {
     #[test]
     fn masses_match_brute_force() {
         let (rows, cols) = (23usize, 19usize);
-        let mut seed = 9u64;
+        let u = crate::testdata::uniform(rows * cols, 9);
         let z: Vec<f64> = (0..rows * cols)
             .map(|k| {
-                seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
                 if k % 17 == 3 {
                     f64::NAN
                 } else {
-                    ((seed >> 40) % 13) as f64
+                    (u[k] * 13.0).floor()
                 }
             })
             .collect();
