@@ -231,7 +231,7 @@ def test_blanket_and_mass_equal_independent_numpy():
     rng = np.random.default_rng(4)
     for shape in [(17, 23), (30, 30)]:
         z = np.round(rng.normal(0, 8, size=shape).cumsum(axis=1))
-        fit = fg.blanket(z, epsilons=range(1, 9))
+        fit = fg.blanket(z, epsilons=range(1, 9), z_scale=1.0)
         assert fit.measures.tolist() == pytest.approx(numpy_blanket_areas(z, 8), rel=1e-12)
         zn = z.copy()
         zn[3:6, 4:9] = np.nan
@@ -241,9 +241,10 @@ def test_blanket_and_mass_equal_independent_numpy():
 
 def test_height_unit_conventions():
     """Grayscale estimators and the units of heights (docs/estimators.md):
-    DBC and mass default to the data's own range, so scaling heights changes
-    nothing; the blanket counts in z_scale units per step, so heights times c
-    with z_scale = c is the same surface; increment estimators are invariant."""
+    DBC, mass and blanket default to the data's own range (z_scale="range"),
+    so scaling heights changes nothing; a fixed z_scale counts in data units
+    per step, so heights times c with z_scale = c is the same surface;
+    increment estimators are invariant."""
     z = spectral_surface(64, 0.5, 2)
     z = 2.0 * z / z.std()  # a few grey levels of relief: the blanket's unit step matters
     c = 50.0
@@ -251,10 +252,12 @@ def test_height_unit_conventions():
     m1 = fg.mass_dimension(z, box_sizes=[3, 5, 9])
     m2 = fg.mass_dimension(c * z, box_sizes=[3, 5, 9])
     assert np.allclose(m1.measures, m2.measures, rtol=1e-12)
-    b1 = fg.blanket(z)
+    b1 = fg.blanket(z, z_scale=1.0)
     assert fg.blanket(c * z, z_scale=c).measures == pytest.approx(b1.measures, rel=1e-9)
-    # ... and without telling the blanket about the units, the answer changes
-    assert abs(fg.blanket(c * z).dimension - b1.dimension) > 0.05
+    # ... a fixed unit that does not follow the data changes the answer ...
+    assert abs(fg.blanket(c * z, z_scale=1.0).dimension - b1.dimension) > 0.05
+    # ... and the default unit follows the data
+    assert fg.blanket(c * z).measures == pytest.approx(fg.blanket(z).measures, rel=1e-9)
     assert fg.surface_variation(c * z).dimension == pytest.approx(fg.surface_variation(z).dimension, abs=1e-12)
 
 

@@ -486,7 +486,7 @@ def test_blanket_map_real_sar_window_and_step():
     vv, _ = fg.data.sentinel1_vv_db()
     z = vv[100:150, 200:240]
     d = fg.fractal_transform(z, 11, method="blanket", step=2, z_scale=1.0)  # default is "auto"
-    ref = per_window_estimator(z, 11, fg.blanket, step=2, epsilons=[1, 2, 3, 4])
+    ref = per_window_estimator(z, 11, fg.blanket, step=2, epsilons=[1, 2, 3, 4], z_scale=1.0)
     assert d.shape == (25, 20)
     assert np.allclose(d, ref, atol=1e-5, equal_nan=True)
 

@@ -1,5 +1,7 @@
 //! Bindings of `crate::dimension`.
 use super::convert::{array1, c_order, rows_array, run, FloatArray2};
+use crate::dimension::blanket::blanket_areas;
+use crate::dimension::mass::mass_curve;
 use crate::dimension::{affine, boxcount, dbc, higuchi, points};
 use crate::with_float;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray2, PyReadonlyArrayDyn};
@@ -125,11 +127,52 @@ fn higuchi_lengths<'py>(
     Ok(array1(py, l))
 }
 
+/// Image-wide P(m, L) curve N(L) of a grayscale image (NaN = no point).
+#[pyfunction]
+#[pyo3(signature = (image, box_sizes, z_scale, n_threads=None))]
+fn mass_curve_image<'py>(
+    py: Python<'py>,
+    image: PyReadonlyArray2<'py, f64>,
+    box_sizes: Vec<usize>,
+    z_scale: f64,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let img = c_order(&image);
+    let (rows, cols) = img.rows_cols();
+    let z = &img.data[..];
+    let n = run(py, n_threads, || {
+        mass_curve(z, rows, cols, &box_sizes, z_scale)
+    })?;
+    Ok(array1(py, n))
+}
+
+/// Image-wide covering-blanket areas A(e), e = 1 ..= eps_max, and the number
+/// of valid pixels.
+#[pyfunction]
+#[pyo3(signature = (image, eps_max, z_scale, n_threads=None))]
+fn blanket_areas_image<'py>(
+    py: Python<'py>,
+    image: PyReadonlyArray2<'py, f64>,
+    eps_max: usize,
+    z_scale: f64,
+    n_threads: Option<usize>,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, usize)> {
+    let img = c_order(&image);
+    let (rows, cols) = img.rows_cols();
+    let z = &img.data[..];
+    let (a, n) = run(py, n_threads, || {
+        blanket_areas(z, rows, cols, eps_max, z_scale)
+    })?;
+    Ok((array1(py, a), n))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(higuchi_lengths, m)?)?;
     m.add_function(wrap_pyfunction!(box_count_binary, m)?)?;
     m.add_function(wrap_pyfunction!(box_count_points, m)?)?;
     m.add_function(wrap_pyfunction!(dbc_count, m)?)?;
     m.add_function(wrap_pyfunction!(column_ranges, m)?)?;
+    m.add_function(wrap_pyfunction!(mass_curve_image, m)?)?;
+    m.add_function(wrap_pyfunction!(blanket_areas_image, m)?)?;
     Ok(())
 }

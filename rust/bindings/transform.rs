@@ -1,14 +1,14 @@
 //! Bindings of `crate::transform`.
-use super::convert::{array1, array2, array3, c_order, run, FloatArray2};
-use crate::transform::blanket::{blanket_areas, blanket_transform, BlanketMapOptions};
+use super::convert::{array2, array3, c_order, run, FloatArray2};
+use crate::transform::blanket::{blanket_transform, BlanketMapOptions};
 use crate::transform::dbc::{dbc_transform, DbcMapOptions};
 use crate::transform::driver::MapOut;
 use crate::transform::gls::{gls_transform, GlsOptions, GlsTables};
 use crate::transform::lacunarity::lacunarity_transform;
-use crate::transform::mass::{mass_curve, mass_transform, MassOptions};
+use crate::transform::mass::{mass_transform, MassOptions};
 use crate::transform::variation::{variation_transform, Increments, VariationOptions};
 use crate::with_float;
-use numpy::{PyArray1, PyArray2, PyArray3, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{PyArray2, PyArray3, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
 type MapPair<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>);
@@ -212,26 +212,6 @@ fn blanket_transform_map<'py>(
     map_pair(py, m)
 }
 
-/// Image-wide covering-blanket areas A(e), e = 1 ..= eps_max, and the number
-/// of valid pixels.
-#[pyfunction]
-#[pyo3(signature = (image, eps_max, z_scale, n_threads=None))]
-fn blanket_areas_image<'py>(
-    py: Python<'py>,
-    image: PyReadonlyArray2<'py, f64>,
-    eps_max: usize,
-    z_scale: f64,
-    n_threads: Option<usize>,
-) -> PyResult<(Bound<'py, PyArray1<f64>>, usize)> {
-    let img = c_order(&image);
-    let (rows, cols) = img.rows_cols();
-    let z = &img.data[..];
-    let (a, n) = run(py, n_threads, || {
-        blanket_areas(z, rows, cols, eps_max, z_scale)
-    })?;
-    Ok((array1(py, a), n))
-}
-
 /// Moving-window gliding-box lacunarity, shape (n_sizes, rows, cols) float32.
 #[pyfunction]
 #[pyo3(signature = (image, window_size, box_sizes, min_valid, n_threads=None))]
@@ -253,33 +233,12 @@ fn lacunarity_transform_map<'py>(
     array3(py, (n, rows, cols), l)
 }
 
-/// Image-wide P(m, L) curve N(L) of a grayscale image (NaN = no point).
-#[pyfunction]
-#[pyo3(signature = (image, box_sizes, z_scale, n_threads=None))]
-fn mass_curve_image<'py>(
-    py: Python<'py>,
-    image: PyReadonlyArray2<'py, f64>,
-    box_sizes: Vec<usize>,
-    z_scale: f64,
-    n_threads: Option<usize>,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let img = c_order(&image);
-    let (rows, cols) = img.rows_cols();
-    let z = &img.data[..];
-    let n = run(py, n_threads, || {
-        mass_curve(z, rows, cols, &box_sizes, z_scale)
-    })?;
-    Ok(array1(py, n))
-}
-
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(mass_curve_image, m)?)?;
     m.add_function(wrap_pyfunction!(lacunarity_transform_map, m)?)?;
     m.add_function(wrap_pyfunction!(variation_transform_map, m)?)?;
     m.add_function(wrap_pyfunction!(gls_transform_map, m)?)?;
     m.add_function(wrap_pyfunction!(mass_transform_map, m)?)?;
     m.add_function(wrap_pyfunction!(dbc_transform_map, m)?)?;
     m.add_function(wrap_pyfunction!(blanket_transform_map, m)?)?;
-    m.add_function(wrap_pyfunction!(blanket_areas_image, m)?)?;
     Ok(())
 }

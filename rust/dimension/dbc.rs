@@ -231,18 +231,13 @@ mod tests {
 
     #[test]
     fn matches_naive_with_nan_holes() {
-        let mut seed = 11u64;
-        for (rows, cols) in [(17usize, 23usize), (32, 32), (5, 40), (64, 33)] {
-            let data: Vec<f64> = (0..rows * cols)
-                .map(|_| {
-                    seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
-                    let u = (seed >> 11) as f64 / (1u64 << 53) as f64;
-                    if u < 0.1 {
-                        f64::NAN
-                    } else {
-                        u * 50.0
-                    }
-                })
+        for (seed, (rows, cols)) in [(17usize, 23usize), (32, 32), (5, 40), (64, 33)]
+            .into_iter()
+            .enumerate()
+        {
+            let data: Vec<f64> = crate::testdata::uniform(rows * cols, 11 + seed as u64)
+                .into_iter()
+                .map(|u| if u < 0.1 { f64::NAN } else { u * 50.0 })
                 .collect();
             let sizes = [1usize, 2, 3, 4, 6, 8, 12, 16];
             let sizes: Vec<usize> = sizes.into_iter().filter(|&s| s <= rows.max(cols)).collect();

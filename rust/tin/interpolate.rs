@@ -188,18 +188,8 @@ mod tests {
 
     #[test]
     fn linear_function_is_reproduced() {
-        let mut x = 7u64;
-        let mut rnd = || {
-            x = x
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (x >> 11) as f64 / (1u64 << 53) as f64
-        };
         let mut pts = vec![0., 0., 10., 0., 10., 10., 0., 10.];
-        for _ in 0..200 {
-            pts.push(10.0 * rnd());
-            pts.push(10.0 * rnd());
-        }
+        pts.extend(crate::testdata::uniform(400, 7).iter().map(|u| 10.0 * u));
         let p = Array2::from_shape_vec((pts.len() / 2, 2), pts).unwrap();
         let vals: Vec<f64> = p
             .rows()

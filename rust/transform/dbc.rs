@@ -234,14 +234,12 @@ mod tests {
     use crate::transform::sat::{line_fit, log_axis};
 
     fn image(rows: usize, cols: usize, seed: u64) -> Vec<f64> {
-        let mut s = seed;
         let mut acc = 0.0;
-        (0..rows * cols)
-            .map(|k| {
-                s = s
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                acc += ((s >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 3.0;
+        crate::testdata::uniform(rows * cols, seed)
+            .into_iter()
+            .enumerate()
+            .map(|(k, u)| {
+                acc += (u - 0.5) * 3.0;
                 if k % 23 == 5 {
                     f64::NAN
                 } else {

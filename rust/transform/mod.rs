@@ -5,8 +5,10 @@
 //!   increments) with summed-area tables, so the cost per pixel does not grow
 //!   with the window.
 //! * [`lacunarity`]: gliding-box lacunarity per window.
-//! * [`mass`]: Voss's P(m, L) mass dimension, boxes counted over the image.
-//! * [`blanket`]: Peleg's covering blanket, image-wide areas and per-window map.
+//! * [`mass`]: Voss's P(m, L) mass dimension per window (the box masses are
+//!   `crate::dimension::mass`'s).
+//! * [`blanket`]: Peleg's covering blanket per window (the growth step is
+//!   `crate::dimension::blanket`'s).
 //! * [`gls`]: GLS fit of H over the log quadratic variations of increment
 //!   filters (summed-area tables).
 //! * [`driver`]: the moving-window driver (grid, bands, gate, fit, result)

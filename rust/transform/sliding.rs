@@ -108,12 +108,10 @@ mod tests {
     #[test]
     fn matches_brute_force() {
         let (rows, cols) = (13usize, 11usize);
-        let mut seed = 3u64;
-        let v: Vec<f64> = (0..rows * cols)
-            .map(|_| {
-                seed = seed.wrapping_mul(6364136223846793005).wrapping_add(7);
-                ((seed >> 33) % 1000) as f64
-            })
+        // integers 0..999: every window sum is exact in either order
+        let v: Vec<f64> = crate::testdata::uniform(rows * cols, 3)
+            .into_iter()
+            .map(|u| (u * 1000.0).floor())
             .collect();
         let lo: Vec<f64> = v
             .iter()

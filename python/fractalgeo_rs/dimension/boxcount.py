@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 import numbers
 import warnings
-from typing import Optional, Sequence, Tuple
+from typing import Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -33,9 +33,9 @@ from fractalgeo_rs._validation import (
     check_memory,
     check_n_threads,
     check_nodata,
-    check_positive_float,
     check_positive_int,
 )
+from fractalgeo_rs._zscale import resolve_z_scale
 from fractalgeo_rs.dimension._common import (
     check_box_sizes,
     default_lattice_counts,
@@ -425,7 +425,7 @@ def differential_box_counting(
     data,
     *,
     box_sizes: Optional[Sequence[int]] = None,
-    z_scale: Optional[float] = None,
+    z_scale: Union[float, str] = "range",
     z0: Optional[float] = None,
     edge_blocks: str = "count",
     nodata: Optional[float] = None,
@@ -454,13 +454,16 @@ def differential_box_counting(
         Block sides in pixels, at least 2. Default ``2, 4, 8, ...`` up to a
         quarter of the shorter side (``s = 1`` carries no height information
         in DBC: it raises ``ValueError``).
-    z_scale : float, optional
+    z_scale : float, "auto" or "range", default "range"
         Box height per pixel of box size, in data units (e.g. metres per
-        pixel). Default: ``(zmax - zmin) / max(rows, cols)``, which puts the
+        pixel). ``"range"``: ``(zmax - zmin) / max(rows, cols)``, which puts the
         surface in a cube as in Sarkar and Chaudhuri (G gray levels over an
         M x M image); for a DEM, ``z_scale = cell_size`` gives cubic boxes in
-        physical units. Estimates depend on this choice: compare surfaces with
-        the same convention.
+        physical units; ``"auto"``: ``1.4826 * median |lag-1 increment|``.
+        Both data-derived units scale with the data, so D does not depend on
+        the height unit; the measured choice is in ``docs/conventions.md``.
+        Estimates depend on this choice: compare surfaces with the same
+        convention.
     z0 : float, optional
         Base height of the box stacks, in data units. Default: the lowest
         valid value. A fixed ``z0`` (with a fixed ``z_scale``) makes a
@@ -516,10 +519,7 @@ def differential_box_counting(
     n_threads = check_n_threads(n_threads)
     zmin, zmax = _nan_range(z)
     rows, cols = z.shape
-    if z_scale is None:
-        z_unit = (zmax - zmin) / max(rows, cols) if zmax > zmin else 1.0
-    else:
-        z_unit = check_positive_float(z_scale, "z_scale")
+    z_unit = resolve_z_scale(z_scale, z)
     if z0 is None:
         z0 = zmin
     else:

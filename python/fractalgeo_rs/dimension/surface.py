@@ -12,11 +12,12 @@ texture analysis and classification. *IEEE Trans. PAMI* 6(4), 518-523.
 """
 from __future__ import annotations
 
-from typing import Optional, Sequence
+from typing import Optional, Sequence, Union
 
 import numpy as np
 
-from fractalgeo_rs._validation import as_array, check_choice, check_n_threads, check_positive_float, check_positive_int
+from fractalgeo_rs._validation import as_array, check_choice, check_n_threads, check_positive_int
+from fractalgeo_rs._zscale import resolve_z_scale
 from fractalgeo_rs.dimension.boxcount import _binary_bytes
 from fractalgeo_rs.dimension.variation import _real_array, _with_nodata
 from fractalgeo_rs.fit import DimensionFit, ScaleRange, fit_loglog
@@ -143,7 +144,7 @@ def mass_dimension(
     *,
     box_sizes: Optional[Sequence[int]] = None,
     kind: str = "auto",
-    z_scale: Optional[float] = None,
+    z_scale: Union[float, str] = "range",
     scale_range: ScaleRange = None,
     n_threads: Optional[int] = None,
 ) -> DimensionFit:
@@ -167,9 +168,10 @@ def mass_dimension(
         ``3, 5, 9, 17, ...`` up to an eighth of the extent (for grayscale
         images at most 33: each box costs L^2 comparisons per pixel, done in
         Rust).
-    z_scale : float, optional
-        Grayscale only: intensity units per pixel; default ``(max - min) /
-        max(rows, cols)`` as in DBC. NaN pixels are not points.
+    z_scale : float, "auto" or "range", default "range"
+        Grayscale only: intensity units per pixel. ``"range"``: ``(max - min)
+        / max(rows, cols)`` as in DBC; ``"auto"``: ``1.4826 * median |lag-1
+        increment|``. NaN pixels are not points.
     scale_range : None, "auto" or (float, float)
         Range of box sides fitted (see :func:`~fractalgeo_rs.box_counting`).
     n_threads : int, optional
@@ -220,10 +222,8 @@ def mass_dimension(
         ok = ~np.isnan(z)
         if not ok.any():
             raise ValueError("data: no valid value (all NaN)")
-        zmin, zmax = float(z[ok].min()), float(z[ok].max())
-        if z_scale is None:
-            z_scale = (zmax - zmin) / max(z.shape) if zmax > zmin else 1.0
-        z_scale = check_positive_float(z_scale, "z_scale")
+        zmin = float(z[ok].min())
+        z_unit = resolve_z_scale(z_scale, z)
         extent = float(max(z.shape))
     if box_sizes is None:
         # grayscale boxes cost L^2 per pixel: up to 33 pixels by default
@@ -245,8 +245,7 @@ def mass_dimension(
         # Rust kernel (shared with the fractal transform): box masses per pixel
         from fractalgeo_rs import _core
 
-        assert z_scale is not None  # set above for grayscale data
-        N = _core.mass_curve_image(np.ascontiguousarray(z - zmin), sizes, z_scale, check_n_threads(n_threads)).tolist()
+        N = _core.mass_curve_image(np.ascontiguousarray(z - zmin), sizes, z_unit, check_n_threads(n_threads)).tolist()
     else:
         from scipy.spatial import cKDTree
 
@@ -256,7 +255,7 @@ def mass_dimension(
             N.append(float(np.mean(1.0 / np.asarray(m, dtype=float))))
     dom = (2.0, 3.0) if kind == "grayscale" else (0.0, float(mask.ndim if kind == "binary" else pts.shape[1]))
     return fit_loglog(sizes, N, method="mass", domain=dom, dim_offset=0.0, dim_factor=-1.0, scale_range=scale_range,
-                      x_label="box side L", y_label="N(L) = sum P(m,L)/m", extra={"kind": kind})
+                      x_label="box side L", y_label="N(L) = sum P(m,L)/m", extra={"kind": kind, **({"z_scale": z_unit} if kind == "grayscale" else {})})
 
 
 #: Fewest rows and columns (and ``BLANKET_MIN_SIDE**2`` valid samples) of a
@@ -264,7 +263,7 @@ def mass_dimension(
 BLANKET_MIN_SIDE = 3
 
 
-def blanket(data, *, epsilons: Optional[Sequence[int]] = None, z_scale: float = 1.0,
+def blanket(data, *, epsilons: Optional[Sequence[int]] = None, z_scale: Union[float, str] = "range",
             nodata: Optional[float] = None, scale_range: ScaleRange = None,
             n_threads: Optional[int] = None) -> DimensionFit:
     """Covering-blanket dimension of a grayscale surface (Peleg et al. 1984).
@@ -291,9 +290,11 @@ def blanket(data, *, epsilons: Optional[Sequence[int]] = None, z_scale: float = 
     epsilons : sequence of int, optional
         Blanket thicknesses used in the fit; default ``1 .. 16`` (every
         thickness up to the largest is computed).
-    z_scale : float, default 1
-        Value units per blanket step (e.g. grey levels): the blanket grows by
-        ``z_scale`` data units per step and the result depends on this unit.
+    z_scale : float, "auto" or "range", default "range"
+        Value units per blanket step: the blanket grows by ``z_scale`` data
+        units per step. ``"range"``: ``(max - min) / max(rows, cols)``;
+        ``"auto"``: 1.4826 x median |lag-1 increment| (both scale with the
+        data, so D does not depend on the height unit).
     nodata : float, optional
         Value marking missing data, in addition to NaN.
     scale_range : None, "auto" or (float, float)
@@ -339,7 +340,7 @@ def blanket(data, *, epsilons: Optional[Sequence[int]] = None, z_scale: float = 
         raise ValueError(f"data: the covering blanket needs a surface of at least {BLANKET_MIN_SIDE} x "
                          f"{BLANKET_MIN_SIDE} valid samples, got shape {z.shape} with {n_ok} valid (a smaller "
                          f"surface is all edge: its blanket measures the border, not the surface)")
-    zs = check_positive_float(z_scale, "z_scale")
+    zs = resolve_z_scale(z_scale, z)
     eps = list(range(1, 17)) if epsilons is None else sorted(set(check_positive_int(e, "epsilons") for e in epsilons))
     if len(eps) < 3:
         raise ValueError(f"epsilons: need at least 3 distinct thicknesses, got {eps}")
@@ -347,4 +348,4 @@ def blanket(data, *, epsilons: Optional[Sequence[int]] = None, z_scale: float = 
                                                check_n_threads(n_threads))
     return fit_loglog(eps, [float(areas[e - 1]) for e in eps], method="blanket", domain=(2.0, 3.0), dim_offset=2.0, dim_factor=-1.0,
                       scale_range=scale_range, x_label="epsilon", y_label="blanket area A(epsilon)",
-                      extra={"z_scale": z_scale, "n_valid": int(n_valid)})
+                      extra={"z_scale": zs, "n_valid": int(n_valid)})

@@ -17,10 +17,9 @@ from fractalgeo_rs._validation import (
     check_fraction,
     check_n_threads,
     check_nodata,
-    check_positive_float,
     check_positive_int,
 )
-from fractalgeo_rs.transform._defaults import default_z_scale
+from fractalgeo_rs._zscale import check_z_scale, resolve_z_scale
 from fractalgeo_rs.transform._methods import METHODS, MapOptions
 from fractalgeo_rs.transform._result import TransformFit, flag_map, warn_out_of_range
 
@@ -173,11 +172,14 @@ def fractal_transform(
     epsilons : sequence of int, optional
         ``"blanket"``: blanket thicknesses, at least three, default
         ``1, 2, 3, 4``.
-    z_scale : float or "auto", default "auto"
+    z_scale : float, "auto" or "range", default "auto"
         ``"mass"``, ``"dbc"``, ``"blanket"``: height units per pixel (e.g. 1
         grey level, 1 dB or 1 metre); the estimates depend on this unit.
         ``"auto"``: :func:`~fractalgeo_rs.transform.default_z_scale` of the whole image, ``1.4826 *
-        median |lag-1 increment|`` (one typical step per box), recorded in
+        median |lag-1 increment|`` (one typical step per box); ``"range"``:
+        ``(max - min) / max(rows, cols)`` of the whole image (Sarkar and
+        Chaudhuri 1994). The same spellings as the whole-image estimators
+        (see ``docs/conventions.md``). The value used is recorded in
         the xarray output's ``attrs["z_scale"]``; maps are comparable only
         at equal ``z_scale``, so pass a fixed number across scenes.
     edge_blocks : {"drop", "count"}, default "drop"
@@ -277,11 +279,8 @@ def fractal_transform(
     spec = METHODS[method]
     check_choice(edge_blocks, "edge_blocks", ("drop", "count"))
     nodata = check_nodata(nodata)
-    auto_z = isinstance(z_scale, str)
-    if auto_z and z_scale != "auto":
-        raise TypeError(f"z_scale: expected a positive number or 'auto', got {z_scale!r}")
-    if not auto_z and spec.uses_z_scale:
-        z_scale = check_positive_float(z_scale, "z_scale")
+    if spec.uses_z_scale:
+        z_scale = check_z_scale(z_scale)
     n_threads = check_n_threads(n_threads)
     step = check_positive_int(step, "step")
     min_valid = check_fraction(min_valid, "min_valid")
@@ -294,7 +293,7 @@ def fractal_transform(
     w = _check_window(window_size, arr.shape)
     z_used: Optional[float] = None  # the height unit of the box and mass methods
     if spec.uses_z_scale:
-        z_used = default_z_scale(arr, nodata) if auto_z else float(z_scale)
+        z_used = resolve_z_scale(z_scale, arr, nodata)
     opts: Dict[str, Any] = {"lags": lags, "z_scale": z_used, "dilations": dilations, "anisotropy": bool(anisotropy)}
     half = w // 2 + spec.configure(w, MapOptions(lags, box_sizes, epsilons, edge_blocks, dilations, anisotropy), opts)
 

@@ -24,9 +24,9 @@ def add_parsers(sub) -> None:
                    help="estimator (default mass: Voss's P(m, L), the paper's method)")
     p.add_argument("--z-scale", type=_z_scale, default="auto",
                    help="mass, dbc, blanket: height units per pixel (e.g. 1 dB or 1 grey level); default auto: "
-                        "1.4826 x median |lag-1 increment| of the whole image, printed; 'cell': the file's cell "
-                        "size (cubic boxes for a DEM whose heights and cells share a unit); pass a fixed value "
-                        "to compare maps across scenes")
+                        "1.4826 x median |lag-1 increment| of the whole image, printed; 'range': (max - min) / "
+                        "max(rows, cols); 'cell': the file's cell size (cubic boxes for a DEM whose heights and "
+                        "cells share a unit); pass a fixed value to compare maps across scenes")
     p.add_argument("--step", type=int, default=1,
                    help="compute every STEP-th row and column only (output cells STEP pixels wide, "
                         "centred on the input pixels they sample; default 1)")
@@ -58,7 +58,7 @@ def map_tags(params: dict, input_units=None, input_cell_size=None) -> dict:
 
 
 def _z_scale(text: str):
-    return text if text in ("auto", "cell") else float(text)
+    return text if text in ("auto", "range", "cell") else float(text)
 
 
 def _run(args: argparse.Namespace) -> int:
