@@ -11,7 +11,9 @@
 //!   pool of `n_threads` threads with panics caught, and maps a
 //!   [`CoreError`](crate::error::CoreError) to the Python exception;
 //! * arrays out: [`array1`], [`array2`] and [`array3`] hand a Rust `Vec` to
-//!   NumPy without a copy.
+//!   NumPy without a copy;
+//! * the common case of all three: [`run_on_grid`] runs
+//!   `kernel(data, rows, cols)` on a 2D array off the GIL.
 use std::borrow::Cow;
 
 use crate::error::{CoreError, CoreResult};
@@ -63,6 +65,26 @@ where
     F: FnOnce() -> CoreResult<T> + Send,
 {
     Ok(py.detach(|| run_in_pool(n_threads, f))?)
+}
+
+/// Release the GIL and run `kernel(data, rows, cols)` in the pool on a 2D
+/// array read in row-major order ([`c_order`]: borrowed when C-contiguous,
+/// copied once otherwise); returns the kernel's result and `(rows, cols)`.
+pub fn run_on_grid<T, R, F>(
+    py: Python<'_>,
+    a: &PyReadonlyArray2<'_, T>,
+    n_threads: Option<usize>,
+    kernel: F,
+) -> PyResult<(R, (usize, usize))>
+where
+    T: Element + Clone + Sync,
+    R: Send,
+    F: FnOnce(&[T], usize, usize) -> CoreResult<R> + Send,
+{
+    let z = c_order(a);
+    let (rows, cols) = z.rows_cols();
+    let r = run(py, n_threads, || kernel(&z.data, rows, cols))?;
+    Ok((r, (rows, cols)))
 }
 
 fn shape_error(what: &str, len: usize, shape: &[usize]) -> PyErr {

@@ -1,5 +1,5 @@
 //! Bindings of `crate::dimension`.
-use super::convert::{array1, c_order, rows_array, run, FloatArray2};
+use super::convert::{array1, c_order, rows_array, run, run_on_grid, FloatArray2};
 use crate::dimension::blanket::blanket_areas;
 use crate::dimension::mass::mass_curve;
 use crate::dimension::{affine, boxcount, dbc, higuchi, points};
@@ -84,11 +84,10 @@ fn dbc_count<'py>(
     n_threads: Option<usize>,
 ) -> PyResult<(Bound<'py, PyArray1<u64>>, Bound<'py, PyArray2<f64>>)> {
     let r = with_float!(FloatArray2::extract(data, "data")?, |a| {
-        let z = c_order(&a);
-        let (rows, cols) = z.rows_cols();
-        run(py, n_threads, || {
-            dbc::dbc_count(&z.data, rows, cols, &box_sizes, offsets, z0, z_unit)
+        run_on_grid(py, &a, n_threads, |z, rows, cols| {
+            dbc::dbc_count(z, rows, cols, &box_sizes, offsets, z0, z_unit)
         })?
+        .0
     });
     let sizes: Vec<u64> = r.box_sizes.iter().map(|&s| s as u64).collect();
     Ok((array1(py, sizes), rows_array(py, &r.counts)?))
@@ -105,10 +104,8 @@ fn column_ranges<'py>(
     box_sizes: Vec<usize>,
     n_threads: Option<usize>,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<u64>>)> {
-    let z = c_order(&data);
-    let (rows, cols) = z.rows_cols();
-    let (m, n) = run(py, n_threads, || {
-        affine::column_ranges(&z.data, rows, cols, &box_sizes)
+    let ((m, n), _) = run_on_grid(py, &data, n_threads, |z, rows, cols| {
+        affine::column_ranges(z, rows, cols, &box_sizes)
     })?;
     Ok((array1(py, m), array1(py, n)))
 }
@@ -137,10 +134,7 @@ fn mass_curve_image<'py>(
     z_scale: f64,
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let img = c_order(&image);
-    let (rows, cols) = img.rows_cols();
-    let z = &img.data[..];
-    let n = run(py, n_threads, || {
+    let (n, _) = run_on_grid(py, &image, n_threads, |z, rows, cols| {
         mass_curve(z, rows, cols, &box_sizes, z_scale)
     })?;
     Ok(array1(py, n))
@@ -157,10 +151,7 @@ fn blanket_areas_image<'py>(
     z_scale: f64,
     n_threads: Option<usize>,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, usize)> {
-    let img = c_order(&image);
-    let (rows, cols) = img.rows_cols();
-    let z = &img.data[..];
-    let (a, n) = run(py, n_threads, || {
+    let ((a, n), _) = run_on_grid(py, &image, n_threads, |z, rows, cols| {
         blanket_areas(z, rows, cols, eps_max, z_scale)
     })?;
     Ok((array1(py, a), n))

@@ -2,7 +2,7 @@
 //! and plants on terrain. The documented API is `fractalgeo_rs.lsystem`.
 //! Every kernel runs through `run_in_pool`, so even a bug (a panic) comes
 //! back as RuntimeError, never as a PanicException.
-use super::convert::{array2, c_order, rows_in, run};
+use super::convert::{array2, rows_in, run, run_on_grid};
 use crate::lsystem::derive::LSystem;
 use crate::lsystem::grammar::{parse_module_string, parse_rule_text, ModString};
 use crate::lsystem::mesh::{build_mesh, Mesh};
@@ -362,8 +362,6 @@ fn plants_on_terrain<'py>(
     sides: usize,
     n_threads: Option<usize>,
 ) -> PyResult<(MeshArrays<'py>, Bound<'py, PyArray2<f64>>)> {
-    let z = c_order(&dem);
-    let (r, c) = z.rows_cols();
     let l = lsystem.inner.clone();
     let p = SceneParams {
         n,
@@ -375,7 +373,8 @@ fn plants_on_terrain<'py>(
         scale,
         max_plants,
     };
-    let (m, bases) = run(py, n_threads, || scene_kernel(&l, &z.data, r, c, &p))?;
+    let ((m, bases), _) =
+        run_on_grid(py, &dem, n_threads, |z, r, c| scene_kernel(&l, z, r, c, &p))?;
     Ok((mesh_arrays(py, m), rows(bases).into_pyarray(py)))
 }
 

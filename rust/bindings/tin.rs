@@ -1,5 +1,5 @@
 //! Bindings of `crate::tin`.
-use super::convert::{array1, array2, c_order, rows_in, run};
+use super::convert::{array1, array2, c_order, rows_in, run, run_on_grid};
 use crate::tin::{delaunay, greedy, interpolate};
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -47,10 +47,8 @@ fn tin_greedy<'py>(
     Bound<'py, PyArray2<i64>>,
     f64,
 )> {
-    let z = c_order(&dem);
-    let (rows, cols) = z.rows_cols();
-    let r = run(py, n_threads, || {
-        greedy::greedy_tin(&z.data, rows, cols, max_error, max_triangles, shared_edges)
+    let (r, _) = run_on_grid(py, &dem, n_threads, |z, rows, cols| {
+        greedy::greedy_tin(z, rows, cols, max_error, max_triangles, shared_edges)
     })?;
     let n = r.grid.len();
     let grid: Vec<i64> = r

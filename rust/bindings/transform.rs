@@ -1,5 +1,5 @@
 //! Bindings of `crate::transform`.
-use super::convert::{array2, array3, c_order, run, FloatArray2};
+use super::convert::{array2, array3, run_on_grid, FloatArray2};
 use crate::transform::blanket::{blanket_transform, BlanketMapOptions};
 use crate::transform::dbc::{dbc_transform, DbcMapOptions};
 use crate::transform::driver::MapOut;
@@ -25,10 +25,7 @@ fn map_pair(py: Python<'_>, m: MapOut) -> PyResult<MapPair<'_>> {
 macro_rules! on_float_image {
     ($py:expr, $image:expr, $n_threads:expr, $kernel:path, $($opt:expr),+) => {
         with_float!(FloatArray2::extract($image, "image")?, |a| {
-            let z = c_order(&a);
-            let (rows, cols) = z.rows_cols();
-            let r = run($py, $n_threads, || $kernel(&z.data, rows, cols, $($opt),+))?;
-            (r, (rows, cols))
+            run_on_grid($py, &a, $n_threads, |z, rows, cols| $kernel(z, rows, cols, $($opt),+))?
         })
     };
 }
@@ -167,9 +164,6 @@ fn dbc_transform_map<'py>(
     step: usize,
     n_threads: Option<usize>,
 ) -> PyResult<MapPair<'py>> {
-    let img = c_order(&image);
-    let (rows, cols) = img.rows_cols();
-    let z = &img.data[..];
     let opt = DbcMapOptions {
         window: window_size,
         box_sizes,
@@ -179,7 +173,9 @@ fn dbc_transform_map<'py>(
         step,
         partial_blocks,
     };
-    let m = run(py, n_threads, || dbc_transform(z, rows, cols, &opt))?;
+    let (m, _) = run_on_grid(py, &image, n_threads, |z, rows, cols| {
+        dbc_transform(z, rows, cols, &opt)
+    })?;
     map_pair(py, m)
 }
 
@@ -198,9 +194,6 @@ fn blanket_transform_map<'py>(
     step: usize,
     n_threads: Option<usize>,
 ) -> PyResult<MapPair<'py>> {
-    let img = c_order(&image);
-    let (rows, cols) = img.rows_cols();
-    let z = &img.data[..];
     let opt = BlanketMapOptions {
         window: window_size,
         epsilons,
@@ -208,7 +201,9 @@ fn blanket_transform_map<'py>(
         min_valid,
         step,
     };
-    let m = run(py, n_threads, || blanket_transform(z, rows, cols, &opt))?;
+    let (m, _) = run_on_grid(py, &image, n_threads, |z, rows, cols| {
+        blanket_transform(z, rows, cols, &opt)
+    })?;
     map_pair(py, m)
 }
 
@@ -223,11 +218,8 @@ fn lacunarity_transform_map<'py>(
     min_valid: f64,
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
-    let img = c_order(&image);
-    let (rows, cols) = img.rows_cols();
-    let z = &img.data[..];
     let n = box_sizes.len();
-    let l = run(py, n_threads, || {
+    let (l, (rows, cols)) = run_on_grid(py, &image, n_threads, |z, rows, cols| {
         lacunarity_transform(z, rows, cols, window_size, &box_sizes, min_valid)
     })?;
     array3(py, (n, rows, cols), l)
