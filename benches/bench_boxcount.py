@@ -32,6 +32,7 @@ import time
 import numpy as np
 
 import fractalgeo_rs as fg
+from _timing import best as best_time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SAR = os.path.join(HERE, "..", "..", "shared", "data", "umbra_mount_yasur_x_band.tif")
@@ -68,15 +69,6 @@ def numpy_pyramid_reshape(mask: np.ndarray, levels: int) -> list[int]:
         h, w = a.shape
         a = a.reshape(h // 2, 2, w // 2, 2).any(axis=(1, 3))
     return counts
-
-
-def best_time(fn, repeat: int) -> float:
-    best = float("inf")
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
 
 
 def main() -> None:

@@ -21,20 +21,11 @@ from __future__ import annotations
 
 import os
 import platform
-import time
 
 import numpy as np
 
 import fractalgeo_rs as fg
-
-
-def best(fn, repeat=3):
-    out = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        r = fn()
-        out.append(time.perf_counter() - t0)
-    return min(out), r
+from _timing import best_with_result as best
 
 
 def np_box(mask, levels):

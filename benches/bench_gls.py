@@ -22,6 +22,7 @@ import time
 import numpy as np
 
 import fractalgeo_rs as fg
+from _timing import best
 
 G = importlib.import_module("fractalgeo_rs.dimension.gls")
 
@@ -32,15 +33,6 @@ def mosaic(n: int) -> np.ndarray:
     t = np.concatenate([t, t[:, ::-1]], axis=1)
     reps = -(-n // t.shape[0])
     return np.ascontiguousarray(np.tile(t, (reps, reps))[:n, :n], dtype=np.float32)
-
-
-def best(f, repeat: int) -> float:
-    ts = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        f()
-        ts.append(time.perf_counter() - t0)
-    return min(ts)
 
 
 def main() -> None:

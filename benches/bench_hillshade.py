@@ -24,6 +24,7 @@ import time
 import numpy as np
 
 import fractalgeo_rs as fg
+from _timing import best
 
 
 def child_cpu(cmd, repeats):
@@ -46,15 +47,6 @@ def own_cpu(f, repeats):
         f()
         out.append(time.process_time() - c0)
     return min(out)
-
-
-def best(f, repeats):
-    t = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        f()
-        t.append(time.perf_counter() - t0)
-    return min(t)
 
 
 def main():

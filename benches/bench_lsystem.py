@@ -21,7 +21,6 @@ import argparse
 import math
 import os
 import sys
-import time
 
 import numpy as np
 
@@ -29,6 +28,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tests"))
 import lsystem_compat  # noqa: E402,F401  (temporary shim until the merge)
 
 from fractalgeo_rs.lsystem import LSystem, plant_mesh, turtle_3d  # noqa: E402
+from _timing import best_with_result as best
 
 AXIOM, RULES, ANGLE = "F", {"F": "F[&+F]F[^-F]/F"}, 22.5
 
@@ -119,15 +119,6 @@ def py_mesh(s: str, angle: float, sides: int = 6):
     base = (np.arange(len(st)) * 2 * k)[:, None, None]
     faces = (quad[None] + base).reshape(-1, 3)
     return verts.reshape(-1, 3).astype(np.float32), normals.reshape(-1, 3).astype(np.float32), faces.astype(np.uint32)
-
-
-def best(f, repeat):
-    times, out = [], None
-    for _ in range(repeat):
-        t = time.perf_counter()
-        out = f()
-        times.append(time.perf_counter() - t)
-    return min(times), out
 
 
 def main() -> int:

@@ -40,21 +40,13 @@ import tempfile
 import time
 
 import numpy as np
+from _timing import best
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tests"))
 try:
     import fractalgeo_rs as fg
 except ImportError:  # the lead's modules not merged yet on this branch
     from _synth_support import fg  # noqa: E402
-
-
-def best(fn, repeat):
-    t = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        t.append(time.perf_counter() - t0)
-    return min(t)
 
 
 def numpy_spectral(n, h, rng):

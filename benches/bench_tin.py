@@ -20,20 +20,12 @@ import numpy as np
 
 import fractalgeo_rs as fg
 from fractalgeo_rs.tin import delaunay, grid_from_points, tin_from_dem
+from _timing import best_with_result as best
 
 _REPO = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 # ../shared beside the checkout (or beside the folder of worktrees)
 SHARED = next((p for p in (os.path.join(_REPO, "..", "shared", "data"), os.path.join(_REPO, "..", "..", "shared", "data"))
                if os.path.isdir(p)), "")
-
-
-def best(f, repeat):
-    ts = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = f()
-        ts.append(time.perf_counter() - t0)
-    return min(ts), out
 
 
 def row(case, ours, base_name, base):

@@ -45,6 +45,7 @@ import warnings
 import numpy as np
 
 import fractalgeo_rs as fg
+from _timing import best
 
 
 def mosaic(n: int) -> np.ndarray:
@@ -289,15 +290,6 @@ def whittle_maps(z: np.ndarray) -> None:
               f"step 4 {t4:.2f} s; loop of fg.whittle per window {per * 1e3:.2f} ms -> step 1 {per * n * n:.0f} s "
               f"({per * n * n / t1:.0f} x ours), step 4 {per * n * n / 16:.0f} s ({per * n * n / 16 / t4:.0f} x ours)",
               flush=True)
-
-
-def best(fn, repeat=3):
-    out = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - t0)
-    return min(out)
 
 
 def main() -> None:
