@@ -24,9 +24,6 @@ import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tests"))
-import lsystem_compat  # noqa: E402,F401  (temporary shim until the merge)
-
 from fractalgeo_rs.lsystem import LSystem, plant_mesh, turtle_3d  # noqa: E402
 from _timing import best_with_result as best
 
