@@ -278,3 +278,15 @@ def test_statistics_on_exact_fbm_area(h):
     np.testing.assert_allclose(o.reshape(256, 2, 256, 2).mean((1, 3)), c, rtol=1e-9, atol=1e-12)
     assert abs(hurst_lags(o) - hurst_lags(t)) < 0.03
     assert abs(lag1(o) / lag1(t) - 1) < 0.08
+
+
+def test_analysis_window_size_and_deprecated_window_alias():
+    """``ResampleAnalysis.window_size`` is the window side; the old
+    attribute name still reads the same value, with a DeprecationWarning."""
+    z = fg.fbm_surface(32, 0.5, method="exact", seed=1)
+    a = resample_analysis(z, window_size=9)
+    assert a.window_size == 9
+    with pytest.warns(DeprecationWarning, match="window_size"):
+        assert a.window == 9
+    _, an = fg.fractal_resample(z, 2, seed=1, window_size=7, return_analysis=True)
+    assert an.window_size == 7

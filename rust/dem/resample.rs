@@ -44,7 +44,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 /// Streams of the resampling noise (disjoint from the synthesis streams).
 pub const STREAM_BASE: u64 = 3 << 20;
 /// Halo (input cells) that makes a tile equal the whole for any factor.
-pub const HALO: usize = 8;
+pub const HALO: usize = 12;
 /// Range of `H` in the tables; values outside are clamped.
 pub const H_MIN: f64 = 0.01;
 /// Upper end of the `H` tables.
@@ -740,12 +740,17 @@ impl ParamCache {
 
 /// One area-support level: `(r, c)` -> `(2r, 2c)`, block means kept.
 ///
-/// The four children of a coarse cell are drawn jointly: their kriging means
-/// given the 5 x 5 coarse cells around it (the centre included) plus a
-/// residual with the joint conditional covariance `C` (rank 3: the centre
-/// cell fixes the children's mean), drawn as `L n` for three standard
-/// normals with `L` the Cholesky factor of `C` restricted to children 0-2,
-/// and the fourth residual minus the sum of the others.
+/// Blocks are drawn in four phases by the parity of their global position
+/// (`(even, even)`, `(even, odd)`, `(odd, even)`, `(odd, odd)`). The four
+/// children of a block are drawn jointly given the 5 x 5 coarse cells around
+/// it (the centre included) and the children of its 8 neighbours drawn in an
+/// earlier phase (which replace those neighbours' coarse values): their
+/// kriging means plus a residual with the joint conditional covariance `C`
+/// (rank 3: the centre cell fixes the children's mean), drawn as `L n` for
+/// three standard normals with `L` the Cholesky factor of `C` restricted to
+/// children 0-2, and the fourth residual minus the sum of the others. This
+/// is sequential Gaussian simulation over a moving neighbourhood: residuals
+/// of adjacent blocks are correlated as in the fBm.
 fn level_area(
     coarse: ArrayView2<f64>,
     maps: &Maps,
@@ -757,26 +762,39 @@ fn level_area(
     let cs = coarse
         .as_slice()
         .ok_or_else(|| CoreError::Internal("coarse grid not contiguous".into()))?;
-    let any_nan = cs.iter().any(|x| !x.is_finite());
     let shift = l + 1;
     let gmul = 1u64 << shift;
     let (g0, g1) = (p.origin.0 * gmul, p.origin.1 * gmul);
     let gcols = p.global_cols.max(1) * gmul;
+    // Global parity of the first coarse cell of this level.
+    let (pi0, pj0) = (
+        ((p.origin.0 << l) % 2) as usize,
+        ((p.origin.1 << l) % 2) as usize,
+    );
     let scale = 2f64.powi(-(l as i32));
     let detail = p.detail[l as usize];
     let key = stream(p, l, 0);
     let mi = area_model(p.levels, l);
-    let full = area_full(mi);
-    let inside = |i: usize, j: usize| !any_nan && i >= 2 && j >= 2 && i + 2 < r && j + 2 < c;
-    // Tables of the windows cut by an edge or a hole.
-    let masks: BTreeSet<u32> = (0..r)
+    let any_bad = cs.iter().any(|x| !x.is_finite())
+        || maps.h.iter().any(|x| !x.is_finite())
+        || maps.s.iter().any(|x| !x.is_finite());
+    let ok = |i: usize, j: usize| {
+        let (h, s) = maps.at(i >> l, j >> l);
+        cs[i * c + j].is_finite() && h.is_finite() && s.is_finite()
+    };
+    let phase_of = |i: usize, j: usize| 2 * ((i + pi0) % 2) + (j + pj0) % 2;
+    let inside = |i: usize, j: usize| !any_bad && i >= 2 && j >= 2 && i + 2 < r && j + 2 < c;
+    let win = AreaWindow { cs, r, c, ok: &ok };
+    // Tables of the windows cut by an edge or a hole, per phase.
+    let masks: BTreeSet<(usize, u64)> = (0..r)
         .into_par_iter()
         .fold(BTreeSet::new, |mut set, i| {
             for j in 0..c {
-                if !inside(i, j) && cs[i * c + j].is_finite() {
-                    let m = area_mask(cs, r, c, i, j);
-                    if m != AREA_ALL {
-                        set.insert(m);
+                if !inside(i, j) && ok(i, j) {
+                    let ph = phase_of(i, j);
+                    let m = win.mask(ph, i, j);
+                    if m != area_all(ph) {
+                        set.insert((ph, m));
                     }
                 }
             }
@@ -787,88 +805,126 @@ fn level_area(
             a
         });
     let partial = area_partial(mi, masks);
-    let offs: [isize; NA] = std::array::from_fn(|k| {
-        let (dr, dc) = area_offset(k);
-        dr * c as isize + dc
+    let fulls: [&AreaTable; 4] = std::array::from_fn(|ph| area_full(mi, ph));
+    // Full-window gathers per phase: (slot, source offset, from the fine grid).
+    let gathers: [Vec<(usize, isize, bool)>; 4] = std::array::from_fn(|ph| {
+        let m = area_all(ph);
+        (0..NB)
+            .filter(|&k| m & (1 << k) != 0)
+            .map(|k| {
+                let (dr, dc, q) = slot_geometry(k);
+                match q {
+                    None => (k, dr * c as isize + dc, false),
+                    Some(q) => {
+                        let (a, b) = ((q / 2) as isize, (q % 2) as isize);
+                        (k, (2 * dr + a) * fc as isize + 2 * dc + b, true)
+                    }
+                }
+            })
+            .collect()
     });
     let mut fine = crate::buffers::try_zeroed(fr * fc, "factor")?;
-    fine.par_chunks_mut(2 * fc)
-        .enumerate()
-        .for_each(|(i, rows2)| {
-            let (top, bottom) = rows2.split_at_mut(fc);
+    let len = fine.len();
+    let ptr = Shared(fine.as_mut_ptr());
+    for ph in 0..4usize {
+        let (pi, pj) = (ph / 2, ph % 2);
+        let first_i = (pi + 2 - pi0) % 2;
+        let first_j = (pj + 2 - pj0) % 2;
+        let full = fulls[ph];
+        let gather = &gathers[ph];
+        (first_i..r).into_par_iter().step_by(2).for_each(|i| {
+            let base = ptr.get();
+            // SAFETY: phase `ph` writes only the children of blocks of parity
+            // `(pi, pj)` (rows `2i`, `2i + 1` of block row `i`) and reads only
+            // children of blocks of other parities, written in earlier
+            // phases; every index is below `len` (checked where computed).
+            let read = |k: usize| {
+                assert!(k < len);
+                // SAFETY: k < len and the cell is not written in this phase.
+                unsafe { *base.add(k) }
+            };
             let mut pc = AreaCache::new(detail, scale);
-            for j in 0..c {
+            for j in (first_j..c).step_by(2) {
                 let z = cs[i * c + j];
                 let (h, s) = maps.at(i >> l, j >> l);
-                if !(z.is_finite() && h.is_finite() && s.is_finite()) {
-                    top[2 * j] = f64::NAN;
-                    top[2 * j + 1] = f64::NAN;
-                    bottom[2 * j] = f64::NAN;
-                    bottom[2 * j + 1] = f64::NAN;
-                    continue;
-                }
+                let f0 = 2 * i * fc + 2 * j;
                 let mut v = [0.0; 4];
-                if inside(i, j) {
-                    pc.update(full, h, s);
-                    let c0 = i * c + j;
-                    for (q, vq) in v.iter_mut().enumerate() {
-                        let mut acc = 0.0;
-                        for (w, &o) in pc.e.w[q].iter().zip(&offs) {
-                            // The window is 2 cells from every edge: inside.
-                            acc += w * cs[c0.wrapping_add_signed(o)];
-                        }
-                        *vq = acc;
-                    }
+                if !ok(i, j) {
+                    v = [f64::NAN; 4];
                 } else {
-                    let m = area_mask(cs, r, c, i, j);
-                    let t = if m == AREA_ALL {
-                        full
-                    } else {
-                        match partial.get(&m) {
-                            Some(t) => t.as_ref(),
-                            None => full,
-                        }
-                    };
-                    pc.update_uncached(t, h, s);
-                    for (q, vq) in v.iter_mut().enumerate() {
-                        let mut acc = 0.0;
-                        for k in 0..NA {
-                            if m & (1 << k) != 0 {
-                                let (dr, dc) = area_offset(k);
-                                let (ii, jj) =
-                                    ((i as isize + dr) as usize, (j as isize + dc) as usize);
-                                acc += pc.e.w[q][k] * cs[ii * c + jj];
+                    if inside(i, j) {
+                        pc.update(full, h, s);
+                        let c0 = i * c + j;
+                        for &(k, o, from_fine) in gather {
+                            let x = if from_fine {
+                                read(f0.wrapping_add_signed(o))
+                            } else {
+                                cs[c0.wrapping_add_signed(o)]
+                            };
+                            for (q, vq) in v.iter_mut().enumerate() {
+                                *vq += pc.e.w[q][k] * x;
                             }
                         }
-                        *vq = acc;
+                    } else {
+                        let m = win.mask(ph, i, j);
+                        let t = if m == area_all(ph) {
+                            full
+                        } else {
+                            match partial.get(&(ph, m)) {
+                                Some(t) => t.as_ref(),
+                                None => full,
+                            }
+                        };
+                        pc.update_uncached(t, h, s);
+                        for k in (0..NB).filter(|&k| m & (1 << k) != 0) {
+                            let (dr, dc, q) = slot_geometry(k);
+                            let (ii, jj) = ((i as isize + dr) as usize, (j as isize + dc) as usize);
+                            let x = match q {
+                                None => cs[ii * c + jj],
+                                Some(q) => read((2 * ii + q / 2) * fc + 2 * jj + q % 2),
+                            };
+                            for (q, vq) in v.iter_mut().enumerate() {
+                                *vq += pc.e.w[q][k] * x;
+                            }
+                        }
+                    }
+                    let mut e = [0.0; 4];
+                    if pc.sd != 0.0 {
+                        let (a, b) = (g0 + 2 * i as u64, g1 + 2 * j as u64);
+                        let n0 = key.normal2(a, b, gcols);
+                        let n1 = key.normal2(a, b + 1, gcols);
+                        let n2 = key.normal2(a + 1, b, gcols);
+                        let lf = &pc.e.l;
+                        e[0] = pc.sd * (lf[0] * n0);
+                        e[1] = pc.sd * (lf[1] * n0 + lf[2] * n1);
+                        e[2] = pc.sd * (lf[3] * n0 + lf[4] * n1 + lf[5] * n2);
+                        e[3] = -(e[0] + e[1] + e[2]);
+                    }
+                    let em = 0.25 * (e[0] + e[1] + e[2] + e[3]);
+                    let vm = 0.25 * (v[0] + v[1] + v[2] + v[3]);
+                    for q in 0..4 {
+                        v[q] = v[q] - vm + z + (e[q] - em);
                     }
                 }
-                let mut e = [0.0; 4];
-                if pc.sd != 0.0 {
-                    let (a, b) = (g0 + 2 * i as u64, g1 + 2 * j as u64);
-                    let n0 = key.normal2(a, b, gcols);
-                    let n1 = key.normal2(a, b + 1, gcols);
-                    let n2 = key.normal2(a + 1, b, gcols);
-                    let lf = &pc.e.l;
-                    e[0] = pc.sd * (lf[0] * n0);
-                    e[1] = pc.sd * (lf[1] * n0 + lf[2] * n1);
-                    e[2] = pc.sd * (lf[3] * n0 + lf[4] * n1 + lf[5] * n2);
-                    e[3] = -(e[0] + e[1] + e[2]);
+                for (q, &vq) in v.iter().enumerate() {
+                    let k = f0 + (q / 2) * fc + q % 2;
+                    assert!(k < len);
+                    // SAFETY: k < len; a child of block (i, j), which only
+                    // this task writes, and no task of this phase reads.
+                    unsafe { *base.add(k) = vq };
                 }
-                let em = 0.25 * (e[0] + e[1] + e[2] + e[3]);
-                let vm = 0.25 * (v[0] + v[1] + v[2] + v[3]);
-                top[2 * j] = v[0] - vm + z + (e[0] - em);
-                top[2 * j + 1] = v[1] - vm + z + (e[1] - em);
-                bottom[2 * j] = v[2] - vm + z + (e[2] - em);
-                bottom[2 * j + 1] = v[3] - vm + z + (e[3] - em);
             }
         });
+    }
     Array2::from_shape_vec((fr, fc), fine).map_err(|e| CoreError::Internal(e.to_string()))
 }
 
-/// Cells of the area data window (5 x 5 coarse cells around the parent).
+/// Cells of the area coarse window (5 x 5 coarse cells around the parent).
 const NA: usize = 25;
-const AREA_ALL: u32 = (1 << NA) - 1;
+/// Data slots: the 25 coarse cells, then the 4 children of each of the 8
+/// neighbours (`NA + 4 n + q`, neighbours in row-major order without the
+/// centre, children 0: top left, 1: top right, 2: bottom left, 3: bottom right).
+const NB: usize = NA + 32;
 /// H nodes of the area tables (full window) and of cut windows.
 const N_AREA: usize = 101;
 const N_AREA_PARTIAL: usize = 41;
@@ -880,6 +936,86 @@ fn area_offset(k: usize) -> (isize, isize) {
     ((k / 5) as isize - 2, (k % 5) as isize - 2)
 }
 
+/// Offset of neighbour `n` (0..8, row-major without the centre).
+#[inline]
+fn neighbour_offset(n: usize) -> (isize, isize) {
+    let k = if n < 4 { n } else { n + 1 };
+    ((k / 3) as isize - 1, (k % 3) as isize - 1)
+}
+
+/// Window cell offset of a slot and, for a child slot, the child index.
+#[inline]
+fn slot_geometry(k: usize) -> (isize, isize, Option<usize>) {
+    if k < NA {
+        let (dr, dc) = area_offset(k);
+        (dr, dc, None)
+    } else {
+        let (dr, dc) = neighbour_offset((k - NA) / 4);
+        (dr, dc, Some((k - NA) % 4))
+    }
+}
+
+/// Whether a neighbour at `(dr, dc)` of a block of phase `ph` is drawn in an
+/// earlier phase (phases by parity: `2 (row % 2) + col % 2`).
+#[inline]
+fn drawn_before(ph: usize, dr: isize, dc: isize) -> bool {
+    let pr = ((ph / 2) as isize + dr).rem_euclid(2) as usize;
+    let pc = ((ph % 2) as isize + dc).rem_euclid(2) as usize;
+    2 * pr + pc < ph
+}
+
+/// The slots of phase `ph` with every cell present.
+fn area_all(ph: usize) -> u64 {
+    let mut m = 0u64;
+    for k in 0..NA {
+        let (dr, dc) = area_offset(k);
+        if !(dr.abs() <= 1 && dc.abs() <= 1 && (dr, dc) != (0, 0) && drawn_before(ph, dr, dc)) {
+            m |= 1 << k;
+        }
+    }
+    for n in 0..8 {
+        let (dr, dc) = neighbour_offset(n);
+        if drawn_before(ph, dr, dc) {
+            m |= 0xf << (NA + 4 * n);
+        }
+    }
+    m
+}
+
+/// A coarse grid and its validity (value and parameters finite), for masks.
+struct AreaWindow<'a, F: Fn(usize, usize) -> bool> {
+    cs: &'a [f64],
+    r: usize,
+    c: usize,
+    ok: &'a F,
+}
+
+impl<F: Fn(usize, usize) -> bool> AreaWindow<'_, F> {
+    /// Slots present for the block `(i, j)` of phase `ph`: a neighbour drawn
+    /// earlier with finite children gives its children, else its coarse
+    /// value if finite; other cells their coarse value if inside and finite.
+    fn mask(&self, ph: usize, i: usize, j: usize) -> u64 {
+        let mut m = 0u64;
+        for k in 0..NA {
+            let (dr, dc) = area_offset(k);
+            let (ii, jj) = (i as isize + dr, j as isize + dc);
+            if ii < 0 || jj < 0 || ii as usize >= self.r || jj as usize >= self.c {
+                continue;
+            }
+            let (ii, jj) = (ii as usize, jj as usize);
+            let nb = dr.abs() <= 1 && dc.abs() <= 1 && (dr, dc) != (0, 0);
+            if nb && drawn_before(ph, dr, dc) && (self.ok)(ii, jj) {
+                let kk = (dr + 1) * 3 + dc + 1;
+                let n = if kk < 4 { kk } else { kk - 1 } as usize;
+                m |= 0xf << (NA + 4 * n);
+            } else if self.cs[ii * self.c + jj].is_finite() {
+                m |= 1 << k;
+            }
+        }
+        m
+    }
+}
+
 /// Index of the support model at level `l` of `levels`: the children of
 /// level `l` are means of `2^(levels - 1 - l)` fine points per side (the
 /// last level's children are points), capped at 4 x 4 points.
@@ -887,33 +1023,15 @@ fn area_model(levels: u32, l: u32) -> usize {
     ((levels - 1 - l) as usize).min(N_MODELS - 1)
 }
 
-/// Mask of the window cells inside the grid and finite.
-fn area_mask(cs: &[f64], r: usize, c: usize, i: usize, j: usize) -> u32 {
-    let mut m = 0u32;
-    for k in 0..NA {
-        let (dr, dc) = area_offset(k);
-        let (ii, jj) = (i as isize + dr, j as isize + dc);
-        if ii >= 0
-            && jj >= 0
-            && (ii as usize) < r
-            && (jj as usize) < c
-            && cs[ii as usize * c + jj as usize].is_finite()
-        {
-            m |= 1 << k;
-        }
-    }
-    m
-}
-
-/// Kriging weights of the four children (`w[q][k]`, zero for absent cells)
+/// Kriging weights of the four children (`w[q][k]`, zero for absent slots)
 /// and the Cholesky factor of their conditional covariance restricted to
 /// children 0-2 (`l = [l00, l10, l11, l20, l21, l22]`), unit sigma, coarse
 /// spacing 1.
 #[derive(Debug, Clone, Copy)]
 pub struct AreaEntry {
     /// Weights of child `q` (0: top left, 1: top right, 2: bottom left,
-    /// 3: bottom right) on window cell `k` (row-major, offsets -2..=2).
-    pub w: [[f64; NA]; 4],
+    /// 3: bottom right) on data slot `k` (see [`area_solve`]).
+    pub w: [[f64; NB]; 4],
     /// Lower Cholesky factor, row-major.
     pub l: [f64; 6],
 }
@@ -925,13 +1043,6 @@ pub struct AreaTable {
 }
 
 impl AreaTable {
-    fn build(mi: usize, mask: u32, n: usize) -> AreaTable {
-        let entries = (0..n)
-            .into_par_iter()
-            .map(|k| area_solve(1 << mi, mask, h_node(k, n)).0)
-            .collect();
-        AreaTable { entries }
-    }
     /// Entry interpolated linearly in `H` (clamped to the table's range).
     pub fn at(&self, h: f64) -> AreaEntry {
         let n = self.entries.len();
@@ -941,7 +1052,7 @@ impl AreaTable {
         let (a, b) = (&self.entries[k], &self.entries[k + 1]);
         let mut e = *a;
         for q in 0..4 {
-            for k in 0..NA {
+            for k in 0..NB {
                 e.w[q][k] = a.w[q][k] + f * (b.w[q][k] - a.w[q][k]);
             }
         }
@@ -950,6 +1061,26 @@ impl AreaTable {
         }
         e
     }
+}
+
+/// Tables of several `(phase, mask)` windows on `n` H nodes; the mean
+/// semivariograms are shared between the windows of one H node.
+fn build_tables(mi: usize, windows: &[(usize, u64)], n: usize) -> Vec<AreaTable> {
+    let per_h: Vec<Vec<AreaEntry>> = (0..n)
+        .into_par_iter()
+        .map(|k| {
+            let mut g = Gbar::new(1 << mi, h_node(k, n));
+            windows
+                .iter()
+                .map(|&(_, m)| area_solve_with(&mut g, m).0)
+                .collect()
+        })
+        .collect();
+    (0..windows.len())
+        .map(|w| AreaTable {
+            entries: per_h.iter().map(|v| v[w]).collect(),
+        })
+        .collect()
 }
 
 /// Points (coarse units, relative to the block centre) of a block of side
@@ -967,57 +1098,93 @@ fn block_pattern(side: f64, n: usize) -> Vec<(f64, f64)> {
     v
 }
 
-/// Exact area kriging for children of `m x m` points (parents `2m x 2m`),
-/// window cells in `mask`: the entry and the full conditional covariance of
-/// the four children (for tests).
-pub fn area_solve(m: usize, mask: u32, hurst: f64) -> (AreaEntry, [[f64; 4]; 4]) {
-    let pc = block_pattern(1.0, 2 * m);
-    let pk = block_pattern(0.5, m);
-    // Mean semivariogram between two point patterns with centres `d` apart.
-    let gbar = |p: &[(f64, f64)], q: &[(f64, f64)], d: (f64, f64)| {
+/// Mean semivariograms `d^(2H) / 2` between coarse cells (`2m x 2m` points)
+/// and children (`m x m` points), memoised by kinds and centre offset (in
+/// quarters of a coarse cell).
+struct Gbar {
+    hurst: f64,
+    pats: [Vec<(f64, f64)>; 2],
+    memo: HashMap<(u8, u8, i32, i32), f64>,
+}
+
+impl Gbar {
+    fn new(m: usize, hurst: f64) -> Self {
+        Gbar {
+            hurst,
+            pats: [block_pattern(1.0, 2 * m), block_pattern(0.5, m)],
+            memo: HashMap::new(),
+        }
+    }
+    /// `a`, `b`: (kind 0 coarse / 1 child, centre row, centre col in quarters).
+    fn get(&mut self, a: (u8, i32, i32), b: (u8, i32, i32)) -> f64 {
+        let key = (a.0, b.0, a.1 - b.1, a.2 - b.2);
+        if let Some(&v) = self.memo.get(&key) {
+            return v;
+        }
+        let (p, q) = (&self.pats[a.0 as usize], &self.pats[b.0 as usize]);
+        let d = (key.2 as f64 / 4.0, key.3 as f64 / 4.0);
         let mut acc = 0.0;
-        for a in p {
-            for b in q {
-                let d2 = (a.0 - b.0 - d.0).powi(2) + (a.1 - b.1 - d.1).powi(2);
+        for x in p {
+            for y in q {
+                let d2 = (x.0 - y.0 + d.0).powi(2) + (x.1 - y.1 + d.1).powi(2);
                 if d2 > 0.0 {
-                    acc += 0.5 * d2.powf(hurst);
+                    acc += 0.5 * d2.powf(self.hurst);
                 }
             }
         }
-        acc / (p.len() * q.len()) as f64
-    };
-    let child = |q: usize| (-0.25 + 0.5 * (q / 2) as f64, -0.25 + 0.5 * (q % 2) as f64);
-    let idx: Vec<usize> = (0..NA).filter(|&k| mask & (1 << k) != 0).collect();
+        let v = acc / (p.len() * q.len()) as f64;
+        self.memo.insert(key, v);
+        v
+    }
+}
+
+/// Support of data slot `k`: (kind, centre in quarters of a coarse cell).
+fn slot_support(k: usize) -> (u8, i32, i32) {
+    let (dr, dc, q) = slot_geometry(k);
+    match q {
+        None => (0, 4 * dr as i32, 4 * dc as i32),
+        Some(q) => (
+            1,
+            4 * dr as i32 + 2 * (q / 2) as i32 - 1,
+            4 * dc as i32 + 2 * (q % 2) as i32 - 1,
+        ),
+    }
+}
+
+/// Exact area kriging for children of `m x m` points (parents `2m x 2m`),
+/// with the data slots in `mask` (slots
+/// `0..25`: the 5 x 5 coarse cells, row-major, offsets -2..=2; slots
+/// `25 + 4 n + q`: child `q` of neighbour `n`, the 8 neighbours row-major
+/// without the centre): the entry and the full conditional covariance of
+/// the four children (for tests).
+pub fn area_solve(m: usize, mask: u64, hurst: f64) -> (AreaEntry, [[f64; 4]; 4]) {
+    area_solve_with(&mut Gbar::new(m, hurst), mask)
+}
+
+/// The slots of phase `ph` with every cell present (for tests).
+pub fn area_full_mask(ph: usize) -> u64 {
+    area_all(ph)
+}
+
+fn area_solve_with(g: &mut Gbar, mask: u64) -> (AreaEntry, [[f64; 4]; 4]) {
+    let idx: Vec<usize> = (0..NB).filter(|&k| mask & (1 << k) != 0).collect();
+    let sup: Vec<(u8, i32, i32)> = idx.iter().map(|&k| slot_support(k)).collect();
+    let child = |q: usize| (1u8, 2 * (q / 2) as i32 - 1, 2 * (q % 2) as i32 - 1);
     let n = idx.len();
-    // Coarse-coarse values depend on the offset only: memoised.
-    let mut cc = HashMap::new();
-    let mut g_cc = |a: (isize, isize), b: (isize, isize)| {
-        let d = (a.0 - b.0, a.1 - b.1);
-        *cc.entry(d)
-            .or_insert_with(|| gbar(&pc, &pc, (d.0 as f64, d.1 as f64)))
-    };
     let mm = n + 1;
     let mut a = vec![0.0; mm * mm];
-    for (x, &kx) in idx.iter().enumerate() {
-        for (y, &ky) in idx.iter().enumerate() {
-            a[x * mm + y] = g_cc(area_offset(kx), area_offset(ky));
+    for x in 0..n {
+        for y in 0..n {
+            a[x * mm + y] = g.get(sup[x], sup[y]);
         }
         a[x * mm + n] = 1.0;
         a[n * mm + x] = 1.0;
     }
     let g_kc: Vec<Vec<f64>> = (0..4)
-        .map(|q| {
-            let t = child(q);
-            idx.iter()
-                .map(|&k| {
-                    let (dr, dc) = area_offset(k);
-                    gbar(&pc, &pk, (dr as f64 - t.0, dc as f64 - t.1))
-                })
-                .collect()
-        })
+        .map(|q| sup.iter().map(|&s| g.get(s, child(q))).collect())
         .collect();
     let mut e = AreaEntry {
-        w: [[0.0; NA]; 4],
+        w: [[0.0; NB]; 4],
         l: [0.0; 6],
     };
     let mut wq = vec![vec![0.0; n]; 4];
@@ -1035,8 +1202,7 @@ pub fn area_solve(m: usize, mask: u32, hurst: f64) -> (AreaEntry, [[f64; 4]; 4])
     let mut cov = [[0.0; 4]; 4];
     for q in 0..4 {
         for rr in 0..4 {
-            let (tq, tr) = (child(q), child(rr));
-            let mut v = -gbar(&pk, &pk, (tq.0 - tr.0, tq.1 - tr.1));
+            let mut v = -g.get(child(q), child(rr));
             for x in 0..n {
                 v += wq[q][x] * g_kc[rr][x] + wq[rr][x] * g_kc[q][x];
                 for y in 0..n {
@@ -1059,37 +1225,41 @@ pub fn area_solve(m: usize, mask: u32, hurst: f64) -> (AreaEntry, [[f64; 4]; 4])
     (e, cov)
 }
 
-/// Full-window area tables, one per support model, built on first use.
-pub fn area_full(mi: usize) -> &'static AreaTable {
-    static T: [OnceLock<AreaTable>; N_MODELS] = [OnceLock::new(), OnceLock::new(), OnceLock::new()];
-    T[mi].get_or_init(|| AreaTable::build(mi, AREA_ALL, N_AREA))
+/// Full-window area tables, one per support model and phase, built on
+/// first use (the four phases of a model together).
+pub fn area_full(mi: usize, ph: usize) -> &'static AreaTable {
+    static T: [OnceLock<[AreaTable; 4]>; N_MODELS] =
+        [OnceLock::new(), OnceLock::new(), OnceLock::new()];
+    &T[mi].get_or_init(|| {
+        let w: Vec<(usize, u64)> = (0..4).map(|ph| (ph, area_all(ph))).collect();
+        let v = build_tables(mi, &w, N_AREA);
+        std::array::from_fn(|k| v[k].clone())
+    })[ph]
 }
 
-type AreaCacheMap = Mutex<HashMap<(usize, u32), Arc<AreaTable>>>;
+type AreaCacheMap = Mutex<HashMap<(usize, usize, u64), Arc<AreaTable>>>;
 
-/// Cut-window tables for `masks` (process-wide cache keyed by model and mask).
-fn area_partial(mi: usize, masks: BTreeSet<u32>) -> HashMap<u32, Arc<AreaTable>> {
+/// Cut-window tables for `masks` (process-wide cache keyed by model, phase
+/// and mask).
+fn area_partial(mi: usize, masks: BTreeSet<(usize, u64)>) -> HashMap<(usize, u64), Arc<AreaTable>> {
     static C: OnceLock<AreaCacheMap> = OnceLock::new();
     let cache = C.get_or_init(|| Mutex::new(HashMap::new()));
-    let missing: Vec<u32> = {
+    let missing: Vec<(usize, u64)> = {
         let c = cache.lock().unwrap_or_else(|e| e.into_inner());
         masks
             .iter()
             .copied()
-            .filter(|m| !c.contains_key(&(mi, *m)))
+            .filter(|&(ph, m)| !c.contains_key(&(mi, ph, m)))
             .collect()
     };
-    let built: Vec<(u32, Arc<AreaTable>)> = missing
-        .into_par_iter()
-        .map(|m| (m, Arc::new(AreaTable::build(mi, m, N_AREA_PARTIAL))))
-        .collect();
+    let built = build_tables(mi, &missing, N_AREA_PARTIAL);
     let mut c = cache.lock().unwrap_or_else(|e| e.into_inner());
-    for (m, t) in built {
-        c.entry((mi, m)).or_insert(t);
+    for (&(ph, m), t) in missing.iter().zip(built) {
+        c.entry((mi, ph, m)).or_insert_with(|| Arc::new(t));
     }
     masks
         .into_iter()
-        .filter_map(|m| c.get(&(mi, m)).map(|t| (m, Arc::clone(t))))
+        .filter_map(|(ph, m)| c.get(&(mi, ph, m)).map(|t| ((ph, m), Arc::clone(t))))
         .collect()
 }
 
@@ -1111,7 +1281,7 @@ impl AreaCache {
             h: f64::NAN,
             s: f64::NAN,
             e: AreaEntry {
-                w: [[0.0; NA]; 4],
+                w: [[0.0; NB]; 4],
                 l: [0.0; 6],
             },
             sd: 0.0,
@@ -1266,7 +1436,7 @@ mod tests {
         // each); the joint covariance has rows summing to 0 (the centre cell
         // fixes the mean) and L L^T reproduces its leading 3 x 3 block.
         for h in [0.2, 0.5, 0.8] {
-            let (e, cov) = area_solve(1, AREA_ALL, h);
+            let (e, cov) = area_solve(1, area_full_mask(0), h);
             let data: Vec<Vec<(f64, f64)>> = (0..NA)
                 .map(|k| {
                     let (dr, dc) = area_offset(k);
@@ -1311,9 +1481,56 @@ mod tests {
             }
         }
         // Larger child supports: still rank 3 (rows sum to 0).
-        let (_, cov) = area_solve(2, AREA_ALL, 0.7);
+        let (_, cov) = area_solve(2, area_full_mask(3), 0.7);
         for row in cov {
             assert!(row.iter().sum::<f64>().abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    #[allow(clippy::needless_range_loop)]
+    fn area_later_phases_krige_on_neighbour_children() {
+        // Phase 3 (every neighbour drawn): the weights and the conditional
+        // variance of each child equal point kriging (`krige`) from the
+        // 17 coarse cells left (2 x 2 points each) and the 32 neighbour
+        // children (points); the centre cell still fixes the mean.
+        for ph in 1..4 {
+            let mask = area_full_mask(ph);
+            let n_child = (NA..NB).filter(|&k| mask & (1 << k) != 0).count();
+            assert_eq!(n_child, [0, 8, 24, 32][ph]);
+        }
+        for h in [0.3, 0.8] {
+            let mask = area_full_mask(3);
+            let (e, cov) = area_solve(1, mask, h);
+            let idx: Vec<usize> = (0..NB).filter(|&k| mask & (1 << k) != 0).collect();
+            let data: Vec<Vec<(f64, f64)>> = idx
+                .iter()
+                .map(|&k| {
+                    let (dr, dc, q) = slot_geometry(k);
+                    match q {
+                        None => block_pattern(1.0, 2)
+                            .into_iter()
+                            .map(|(y, x)| (y + dr as f64, x + dc as f64))
+                            .collect(),
+                        Some(q) => vec![(
+                            dr as f64 - 0.25 + 0.5 * (q / 2) as f64,
+                            dc as f64 - 0.25 + 0.5 * (q % 2) as f64,
+                        )],
+                    }
+                })
+                .collect();
+            for q in 0..4 {
+                let t = (-0.25 + 0.5 * (q / 2) as f64, -0.25 + 0.5 * (q % 2) as f64);
+                let (w, v) = krige(&data, t, h);
+                for (x, &k) in idx.iter().enumerate() {
+                    assert!((w[x] - e.w[q][k]).abs() < 1e-8, "{h} {q} {k}");
+                }
+                assert!((v - cov[q][q]).abs() < 1e-8 * v, "{h} {q}");
+                assert!(cov[q].iter().sum::<f64>().abs() < 1e-9 * v);
+            }
+            // Conditioning on the neighbours' children lowers the variance.
+            let (_, cov0) = area_solve(1, area_full_mask(0), h);
+            assert!(cov[0][0] < cov0[0][0]);
         }
     }
 
@@ -1345,7 +1562,7 @@ mod tests {
 
     #[test]
     fn tiles_equal_the_whole() {
-        let (r, c) = (40, 44);
+        let (r, c) = (48, 52);
         let z = field(r, c);
         let h = Array2::from_shape_fn((r, c), |(i, j)| 0.3 + 0.01 * ((i + j) % 40) as f64);
         let s = Array2::from_elem((r, c), 1.5);
@@ -1353,7 +1570,7 @@ mod tests {
             let mut p = params(3, support, true);
             p.global_cols = c as u64;
             let whole = resample(z.view(), h.view(), s.view(), &p).unwrap();
-            let (a0, a1, b0, b1) = (10usize, 30usize, 12usize, 34usize);
+            let (a0, a1, b0, b1) = (14usize, 34usize, 13usize, 38usize);
             let (t0, t1, u0, u1) = (a0 - HALO, a1 + HALO, b0 - HALO, b1 + HALO);
             let mut q = p.clone();
             q.origin = (t0 as u64, u0 as u64);

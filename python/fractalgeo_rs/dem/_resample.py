@@ -37,8 +37,11 @@ class ResampleAnalysis:
     fraction_clipped : float
         Fraction of the valid cells whose raw ``H`` was outside
         ``HURST_RANGE``.
+    window_size : int
+        Side of the square window (cells; 0 when no map was estimated).
     window : int
-        Side of the square window (cells).
+        Deprecated alias of ``window_size`` (renamed in 0.2.0; reading it
+        emits a DeprecationWarning; removed in the next release).
 
     References
     ----------
@@ -51,7 +54,7 @@ class ResampleAnalysis:
     >>> import fractalgeo_rs as fg
     >>> z = fg.fbm_surface(128, 0.6, method="exact", seed=3)
     >>> a = fg.dem.resample_analysis(z, window_size=33)
-    >>> a.hurst.shape, a.window, a.fraction_clipped
+    >>> a.hurst.shape, a.window_size, a.fraction_clipped
     ((128, 128), 33, 0.0)
     >>> round(float(a.hurst[64, 64]), 2), round(float(a.sigma[64, 64]), 2)  # fBm of H = 0.6, sigma = 1
     (0.59, 0.96)
@@ -60,7 +63,15 @@ class ResampleAnalysis:
     hurst: np.ndarray
     sigma: np.ndarray
     fraction_clipped: float
-    window: int
+    window_size: int
+
+    @property
+    def window(self) -> int:
+        """Deprecated alias of :attr:`window_size` (renamed in 0.2.0)."""
+        warnings.warn("ResampleAnalysis: the attribute 'window' is now called 'window_size' "
+                      "(renamed in 0.2.0; the old name will be removed in the next release)",
+                      DeprecationWarning, stacklevel=2)
+        return self.window_size
 
 
 # ---------------------------------------------------------------- analysis --

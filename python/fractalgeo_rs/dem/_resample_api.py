@@ -106,7 +106,7 @@ def fractal_resample(dem, factor=2, *, hurst="local", sigma="local", window_size
     many resamplings at a new point match the exact dense kriging to within
     the tolerances stated in docs/resampling.md. xarray input returns new
     cell-centre coords; Dask input is computed chunk by chunk with a halo of
-    8 input cells (plus the analysis window) and equals the in-memory result
+    12 input cells (plus the analysis window) and equals the in-memory result
     bit for bit.
 
     References
