@@ -25,8 +25,9 @@ def test_resample_geotiff(tmp_path, capsys):
     src, dst = str(tmp_path / "in.tif"), str(tmp_path / "out.tif")
     _write(src, z)
     assert main(["resample", src, dst, "--factor", "4", "--seed", "1", "--chunks", "16",
-                 "--min-scale", "10", "--window", "9"]) == 0
-    assert "blocks" in capsys.readouterr().err
+                 "--min-scale", "10", "--window", "9", "--progress"]) == 0
+    err = capsys.readouterr().err
+    assert "resample" in err and "9/9" in err  # tqdm's bar over the 3 x 3 output blocks
     with rasterio.open(dst) as d:
         out = d.read(1)
         assert out.shape == (157, 157)
@@ -43,7 +44,7 @@ def test_resample_area_edges(tmp_path):
     z = (fg.fbm_surface(32, 0.5, method="exact", seed=1) + 100).astype(np.float32)
     src, dst = str(tmp_path / "in.tif"), str(tmp_path / "out.tif")
     _write(src, z)
-    assert main(["resample", src, dst, "--factor", "2", "--support", "area", "--quiet",
+    assert main(["resample", src, dst, "--factor", "2", "--support", "area", "--no-progress",
                  "--window", "9", "--seed", "2"]) == 0
     with rasterio.open(dst) as d:
         assert d.shape == (64, 64)
@@ -56,3 +57,13 @@ def test_resample_bad_factor_writes_nothing(tmp_path, capsys):
     assert main(["resample", src, dst, "--factor", "3"]) == 1
     assert "factor" in capsys.readouterr().err
     assert not os.path.exists(dst)
+
+
+def test_resample_quiet_is_no_progress(tmp_path, capsys):
+    z = (fg.fbm_surface(32, 0.5, method="exact", seed=1) + 100).astype(np.float32)
+    src = str(tmp_path / "in.tif")
+    _write(src, z)
+    for flag in ("--quiet", "--no-progress"):
+        dst = str(tmp_path / f"out{flag}.tif")
+        assert main(["resample", src, dst, "--window", "9", "--seed", "2", "--chunks", "16", flag]) == 0
+        assert "resample" not in capsys.readouterr().err

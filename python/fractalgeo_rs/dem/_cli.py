@@ -8,7 +8,8 @@ from typing import Any
 
 import numpy as np
 
-from fractalgeo_rs._cli_common import HelpFormatter, add_cell_size, add_n_threads, add_raster_io
+from fractalgeo_rs._cli_common import (HelpFormatter, add_cell_size, add_n_threads, add_progress,
+                                        add_raster_io)
 
 
 def add_parsers(sub) -> None:
@@ -34,7 +35,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--support", default="point", choices=("point", "area"))
     p.add_argument("--chunks", type=int, default=2048, help="block side in input cells")
     add_n_threads(p)
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_progress(p)
+    p.add_argument("--quiet", dest="progress", action="store_false", help=argparse.SUPPRESS)
     p.set_defaults(func=_run_resample)
 
     h = sub.add_parser(
@@ -70,6 +72,7 @@ def _run_resample(args: argparse.Namespace) -> int:
     import rasterio
     from rasterio.windows import Window
 
+    from fractalgeo_rs import _progress
     from fractalgeo_rs._validation import atomic_write_path, check_positive_int
     from fractalgeo_rs.dem import _resample as R
     from fractalgeo_rs.synth._common import resolve_seed
@@ -104,7 +107,8 @@ def _run_resample(args: argparse.Namespace) -> int:
                 blockxsize=256, blockysize=256, compress="deflate")
     nb = out.numblocks
     total = nb[0] * nb[1]
-    with atomic_write_path(args.output) as tmp:
+    show = _progress.resolve(args.progress, cli=True)
+    with atomic_write_path(args.output) as tmp, _progress.bar(total, "resample", show) as pbar:
         with rasterio.open(tmp, "w", **prof) as dst:
             r0 = 0
             for i in range(nb[0]):
@@ -113,14 +117,10 @@ def _run_resample(args: argparse.Namespace) -> int:
                     blk = np.asarray(out.blocks[i, j].compute(), dtype=np.float32)
                     dst.write(blk, 1, window=Window(c0, r0, blk.shape[1], blk.shape[0]))
                     c0 += blk.shape[1]
-                    if not args.quiet:
-                        k = i * nb[1] + j + 1
-                        bar = "#" * (30 * k // total)
-                        print(f"\rresample [{bar:<30}] {k}/{total} blocks", end="",
-                              file=sys.stderr, flush=True)
+                    pbar.update(1)
                 r0 += out.chunks[0][i]
-    if not args.quiet:
-        print(file=sys.stderr)
+    print(f"resample: {z.shape[0]} x {z.shape[1]} -> {out.shape[0]} x {out.shape[1]} (factor {f}, "
+          f"{args.support} support, seed {seed}) -> {args.output}")
     return 0
 
 
