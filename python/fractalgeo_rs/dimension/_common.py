@@ -46,13 +46,21 @@ def reduce_offsets(counts: np.ndarray, offset_reduce: str) -> np.ndarray:
     return counts.mean(axis=1) if offset_reduce == "mean" else counts.min(axis=1)
 
 
-def dyadic_up_to(limit: float, start: int = 1) -> list:
-    """Powers of two from ``start`` up to ``limit`` (inclusive)."""
+def box_size_range(limit: float, *, base: int = 2, start: int = 1) -> list:
+    """Box sizes ``start, start * base, start * base^2, ...`` up to ``limit``
+    (inclusive): the one rule from which every default box-size range is
+    derived (a window's or an extent's limit, e.g. ``w // 2`` or ``E / 4``).
+    Empty when ``start > limit``."""
     out, s = [], start
     while s <= limit:
         out.append(s)
-        s *= 2
+        s *= base
     return out
+
+
+def dyadic_up_to(limit: float, start: int = 1) -> list:
+    """Powers of two from ``start`` up to ``limit`` (inclusive)."""
+    return box_size_range(limit, base=2, start=start)
 
 
 # ---------------------------------------------------------------------------
@@ -127,11 +135,7 @@ def default_lattice_counts(box: np.ndarray) -> Optional[dict]:
     total = int(np.count_nonzero(box))
     best = None
     for b in DEFAULT_BASES:
-        sizes = []
-        s = 1
-        while s <= ext / DEFAULT_TOP:
-            sizes.append(s)
-            s *= b
+        sizes = box_size_range(ext / DEFAULT_TOP, base=b)
         if len(sizes) < 3:
             continue
         levels = [box]

@@ -37,6 +37,8 @@ from fractalgeo_rs._validation import (
 )
 from fractalgeo_rs._zscale import resolve_z_scale
 from fractalgeo_rs.dimension._common import (
+    DEFAULT_TOP,
+    box_size_range,
     check_box_sizes,
     default_lattice_counts,
     dyadic_up_to,
@@ -98,11 +100,7 @@ def _default_box_sizes(b: np.ndarray, bbox: bool) -> Optional[list]:
         return None
 
     def powers(base):
-        out, v = [], 1
-        while v <= ext / 4:
-            out.append(v)
-            v *= base
-        return out
+        return box_size_range(ext / DEFAULT_TOP, base=base)
 
     def misfit(base):
         x = math.log(ext, base)

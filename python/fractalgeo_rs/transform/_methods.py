@@ -80,8 +80,13 @@ def int_list(values, name: str, what: str) -> list:
 
 
 def dbc_default_sizes(w: int) -> list:
-    """Powers of two up to half the window; 2, 3, 4 (or 1, 2, 3) for small windows."""
-    sizes = [2**k for k in range(1, 30) if 2**k <= w // 2]
+    """Powers of two from 2 up to half the window
+    (:func:`~fractalgeo_rs.dimension._common.box_size_range`); windows too
+    small for three of them fall back to 2, 3, 4 (or 1, 2, 3 under 5
+    pixels). This is the only place the small-window rule lives."""
+    from fractalgeo_rs.dimension._common import box_size_range
+
+    sizes = box_size_range(w // 2, base=2, start=2)
     if len(sizes) < 3:
         sizes = [2, 3, 4] if w >= 5 else [1, 2, 3]
     return sizes
