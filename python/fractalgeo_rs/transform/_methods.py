@@ -82,14 +82,16 @@ def int_list(values, name: str, what: str) -> list:
 def dbc_default_sizes(w: int) -> list:
     """Powers of two from 2 up to half the window
     (:func:`~fractalgeo_rs.dimension._common.box_size_range`); windows too
-    small for three of them fall back to 2, 3, 4 (or 1, 2, 3 under 5
-    pixels). This is the only place the small-window rule lives."""
+    small for three of them fall back to 2, 3, 4, and windows under 5
+    pixels are refused (whole-image DBC's rule: no 1-pixel blocks). This is
+    the only place the small-window rule lives."""
     from fractalgeo_rs.dimension._common import box_size_range
 
+    if w < 5:
+        raise ValueError(f"window_size: method 'dbc' needs a window of at least 5 pixels (default block "
+                         f"sides 2, 3, 4; 1-pixel blocks carry no height information), got {w}")
     sizes = box_size_range(w // 2, base=2, start=2)
-    if len(sizes) < 3:
-        sizes = [2, 3, 4] if w >= 5 else [1, 2, 3]
-    return sizes
+    return sizes if len(sizes) >= 3 else [2, 3, 4]
 
 
 # --- option checks ---------------------------------------------------------
@@ -108,9 +110,6 @@ def _configure_mass(w: int, o: MapOptions, opts: Opts) -> int:
 def _configure_dbc(w: int, o: MapOptions, opts: Opts) -> int:
     # One rule with the whole-image differential_box_counting: no 1-pixel
     # blocks (a 1-pixel block spans no height range: it always holds one box).
-    if o.box_sizes is None and w < 5:
-        raise ValueError(f"window_size: method 'dbc' needs a window of at least 5 pixels (default block "
-                         f"sides 2, 3, 4; 1-pixel blocks carry no height information), got {w}")
     sizes = dbc_default_sizes(w) if o.box_sizes is None else int_list(o.box_sizes, "box_sizes", "ints")
     if sizes and sizes[0] < 2:
         raise ValueError(f"box_sizes: DBC needs block sides of at least 2 pixels (a 1-pixel block spans no "
