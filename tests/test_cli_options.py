@@ -47,6 +47,13 @@ def test_shared_options_have_one_help_text():
 
 
 @pytest.mark.parametrize("name", sorted(_subcommands()))
+def test_every_option_has_help(name):
+    p = _subcommands()[name]
+    bare = [a.option_strings for a in p._actions if a.option_strings and a.help is None]
+    assert not bare, (name, bare)
+
+
+@pytest.mark.parametrize("name", sorted(_subcommands()))
 def test_every_subcommand_help_shows_defaults(name, capsys):
     p = _subcommands()[name]
     with pytest.raises(SystemExit) as e:

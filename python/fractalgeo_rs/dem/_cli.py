@@ -31,7 +31,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--sigma", default="local",
                    help="detail scale: 'local' (estimated in each window) or a number >= 0")
     p.add_argument("--window", type=int, default=33, help="analysis window (cells, odd)")
-    p.add_argument("--support", default="point", choices=("point", "area"))
+    p.add_argument("--support", default="point", choices=("point", "area"),
+                   help="point: input samples kept at their positions; area: input cells are block means, kept")
     p.add_argument("--chunks", type=int, default=2048, help="block side in input cells")
     add_n_threads(p)
     add_progress(p)

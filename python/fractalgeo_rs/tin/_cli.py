@@ -20,7 +20,9 @@ def add_parsers(sub) -> None:
     p.add_argument("--max-error", type=float, default=None,
                    help="largest vertical error in DEM units (default: 0.5%% of the 2-98%% relief)")
     p.add_argument("--max-triangles", type=int, default=None, help="triangle budget")
-    p.add_argument("--tile-edges", choices=("shared", "free"), default="shared")
+    p.add_argument("--tile-edges", choices=("shared", "free"), default="shared",
+                   help="shared: outer-edge vertices depend only on the edge samples, so adjacent tiles join "
+                   "without cracks; free: edges refined like the interior")
     add_cell_size(p)
     p.add_argument("--preview", metavar="PNG", default=None, help="also write a shaded-relief PNG of the mesh")
     p.set_defaults(func=_run_tin)
