@@ -293,7 +293,7 @@ def blanket(data, *, epsilons: Optional[Sequence[int]] = None, z_scale: Union[fl
     z_scale : float, "auto" or "range", default "range"
         Value units per blanket step: the blanket grows by ``z_scale`` data
         units per step. ``"range"``: ``(max - min) / max(rows, cols)``;
-        ``"auto"``: 1.4826 x median |lag-1 increment| (both scale with the
+        ``"auto"``: ``1.4826 * median |lag-1 increment|`` (both scale with the
         data, so D does not depend on the height unit).
     nodata : float, optional
         Value marking missing data, in addition to NaN.
