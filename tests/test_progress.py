@@ -74,11 +74,17 @@ def test_run_raster_strips_any_height(rows, boundary, depth, step):
     np.testing.assert_array_equal(run[1][1][:, 0], np.arange(0, rows, step))
 
 
-def test_missing_tqdm_means_no_bar_and_no_error(monkeypatch, capsys):
+def test_missing_tqdm_means_no_bar_no_error_and_one_line(monkeypatch, capsys):
+    from fractalgeo_rs import _progress
+
     monkeypatch.setitem(sys.modules, "tqdm", None)  # import tqdm raises ImportError
     monkeypatch.setitem(sys.modules, "tqdm.auto", None)
+    monkeypatch.setattr(_progress, "_told_no_tqdm", False)
     z = _image()
     np.testing.assert_array_equal(fg.fractal_transform(z, 9, progress=True), fg.fractal_transform(z, 9))
+    err = capsys.readouterr().err
+    assert err == _progress.NO_TQDM + "\n" and '"fractalgeo_rs[progress]"' in err
+    fg.fractal_transform(z, 9, progress=True)  # said once per process
     assert capsys.readouterr().err == ""
 
 

@@ -8,7 +8,8 @@
 * ``True`` / ``False``: on / off.
 
 A bar needs tqdm (``pip install "fractalgeo_rs[progress]"``); without it no
-bar is drawn and nothing fails. Work computed by Dask reports through
+bar is drawn, nothing fails, and the first request for a bar prints one line
+on stderr naming the extra (:data:`NO_TQDM`). Work computed by Dask reports through
 ``dask.diagnostics.ProgressBar`` (:func:`dask_bar`), which needs no tqdm.
 
 One long Rust call reports through a ``_core.ProgressCounter`` that the
@@ -25,6 +26,10 @@ import threading
 from typing import Any, ContextManager, Optional
 
 __all__ = ["resolve", "bar", "dask_bar", "Steps"]
+
+#: The one line printed (once per process) when a bar is asked for without tqdm.
+NO_TQDM = 'progress: no bar without tqdm; pip install "fractalgeo_rs[progress]"'
+_told_no_tqdm = False
 
 #: Seconds between two reads of a running kernel's counter.
 POLL_SECONDS = 0.1
@@ -69,6 +74,10 @@ def bar(total: int, desc: str, enabled: bool, unit: str = "it"):
             from tqdm.auto import tqdm
         except ImportError:
             tqdm = None
+            global _told_no_tqdm
+            if not _told_no_tqdm:
+                _told_no_tqdm = True
+                print(NO_TQDM, file=sys.stderr)
         if tqdm is not None:
             b = tqdm(total=total, desc=desc, file=sys.stderr, leave=False, unit=unit,
                      unit_scale=unit != "it")
