@@ -24,6 +24,8 @@ from typing import Optional, Union
 
 import numpy as np
 
+from fractalgeo_rs._validation import check_positive_float
+
 __all__ = ["Z_SCALE_NAMES", "resolve_z_scale", "range_z_scale"]
 
 Z_SCALE_NAMES = ("auto", "range")
@@ -55,10 +57,7 @@ def check_z_scale(z_scale) -> ZScale:
         return z_scale
     if isinstance(z_scale, bool) or not isinstance(z_scale, numbers.Real):
         raise TypeError(f"z_scale: expected a positive number, 'auto' or 'range', got {z_scale!r}")
-    v = float(z_scale)
-    if not (np.isfinite(v) and v > 0):
-        raise ValueError(f"z_scale: expected a positive finite number, got {z_scale!r}")
-    return v
+    return check_positive_float(z_scale, "z_scale")
 
 
 def resolve_z_scale(z_scale, z, nodata: Optional[float] = None) -> float:

@@ -10,7 +10,7 @@ import numpy as np
 
 from fractalgeo_rs import _core
 from fractalgeo_rs._compat import renamed_parameters
-from fractalgeo_rs._validation import as_array, check_choice, check_memory, check_nodata
+from fractalgeo_rs._validation import as_array, check_choice, check_memory, check_nodata, check_positive_float
 
 __all__ = ["resample_analysis", "ResampleAnalysis", "HURST_RANGE"]
 
@@ -364,12 +364,7 @@ def _cell_size(cell_size, dem):
             if d is not None:
                 return d
         return 1.0
-    if isinstance(cell_size, bool) or not isinstance(cell_size, numbers.Real):
-        raise TypeError(f"cell_size: expected a positive number, got {cell_size!r}")
-    c = float(cell_size)
-    if not (np.isfinite(c) and c > 0):
-        raise ValueError(f"cell_size: expected a positive finite number, got {c}")
-    return c
+    return check_positive_float(cell_size, "cell_size")
 
 
 def _detail(levels, cell, min_scale):
