@@ -17,6 +17,7 @@ __all__ = [
     "blanket_areas_image",
     "blanket_transform_map",
     "box_count_binary",
+    "box_count_point_levels",
     "box_count_points",
     "column_ranges",
     "davies_harte_fbm",
@@ -71,6 +72,14 @@ def box_count_binary(
     anchor_bbox: bool,
     n_threads: Optional[int] = None,
 ) -> Tuple[npt.NDArray[np.uint64], npt.NDArray[np.uint64], int, list[int], list[int]]: ...
+def box_count_point_levels(
+    points: npt.NDArray[np.float64],
+    base: int,
+    k_first: int,
+    min_occupancy: float,
+    max_levels: int,
+    n_threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint64], npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 def box_count_points(
     points: npt.NDArray[np.float64],
     box_sizes: Sequence[float],

@@ -69,6 +69,39 @@ fn box_count_points<'py>(
     Ok((array1(py, r.box_sizes), rows_array(py, &r.counts)?))
 }
 
+/// Default lattice counts of a point set, level by level (see
+/// `points::point_lattice_levels`). Returns (sizes, aligned, shifted,
+/// shifted_inside).
+#[pyfunction]
+#[pyo3(signature = (points, base, k_first, min_occupancy, max_levels, n_threads=None))]
+#[allow(clippy::type_complexity)]
+fn box_count_point_levels<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    base: u64,
+    k_first: u32,
+    min_occupancy: f64,
+    max_levels: usize,
+    n_threads: Option<usize>,
+) -> PyResult<(
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<u64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+)> {
+    let p = c_order(&points);
+    let (n, d) = p.rows_cols();
+    let lv = run(py, n_threads, || {
+        points::point_lattice_levels(&p.data, n, d, base, k_first, min_occupancy, max_levels)
+    })?;
+    Ok((
+        array1(py, lv.iter().map(|l| l.size).collect()),
+        array1(py, lv.iter().map(|l| l.aligned).collect()),
+        array1(py, lv.iter().map(|l| l.shifted).collect()),
+        array1(py, lv.iter().map(|l| l.shifted_inside).collect()),
+    ))
+}
+
 /// Differential box counts of a 2D float32 or float64 image (NaN = nodata).
 /// Returns (box_sizes, counts[n_sizes, n_lattices]).
 #[pyfunction]
@@ -161,6 +194,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(higuchi_lengths, m)?)?;
     m.add_function(wrap_pyfunction!(box_count_binary, m)?)?;
     m.add_function(wrap_pyfunction!(box_count_points, m)?)?;
+    m.add_function(wrap_pyfunction!(box_count_point_levels, m)?)?;
     m.add_function(wrap_pyfunction!(dbc_count, m)?)?;
     m.add_function(wrap_pyfunction!(column_ranges, m)?)?;
     m.add_function(wrap_pyfunction!(mass_curve_image, m)?)?;
