@@ -11,19 +11,33 @@ variogram ``E (z(p) - z(q))^2 = sigma^2 |p - q|^(2H)``,
 
 and for Gaussian fields ``Cov(V_f, V_g) = 2 / (N_f N_g) sum_{x, y}
 C_fg(x - y)^2`` with ``C_fg(l) = -1/2 sum_{a, b} w_a w_b |l + a - b|^(2H)``
-(sums over the anchors of each filter, counted exactly on the grid). By
-the delta method ``y_f = log V_f`` has mean ``a_f(H) = log c_f(H) -
-Var(V_f) / (2 (E V_f)^2) + log sigma^2`` and covariance
-``Sigma_fg = Cov(V_f, V_g) / (E V_f E V_g)``. ``H`` is the generalised least
-squares fit of ``y`` on ``a(H) + log sigma^2`` with weights ``Sigma^-1``:
-starting from ``H = 0.5``, each step is the Gauss-Newton update
+(sums over the anchors of each filter, counted exactly on the grid). With
+``r_f = Var(V_f) / (E V_f)^2``, ``y_f = log V_f`` has mean (delta method)
+``a_f(H) = log c_f(H) - r_f(H) / 2 + log sigma^2`` and covariance
+
+    Sigma_fg = Cov(V_f, V_g) / (E V_f E V_g) + [f = g] (psi'(1 / r_f) - r_f),
+
+the delta method's covariance plus, per filter, an independent term: the
+excess of ``Var log V_f`` under the Welch-Satterthwaite approximation ``V_f
+~ (E V_f / nu_f) chi2(nu_f)``, ``nu_f = 2 / r_f`` (Satterthwaite 1946),
+which is ``psi'(nu_f / 2)`` (trigamma), over the delta method's ``r_f``
+(about ``r_f^2 / 2``). It is negligible for second differences (``r_f``
+below 0.02 at windows of 33 or more) and keeps the first differences of
+smooth fields (``r_f`` 0.1-0.3 at ``H = 0.8``, window 33, where ``log V_f``
+is far from Gaussian) from being weighted through contrasts whose
+delta-method variance is too small, so every filter enters the fit. Scaling
+the whole covariance to the Welch-Satterthwaite variances (correlations
+kept), a cut-off on ``r_f`` or the delta method alone give a larger spread
+of ``H`` at ``H >= 0.7`` on exact fBm. ``H`` is the
+generalised least squares fit of ``y`` on ``a(H) + log sigma^2`` with
+weights ``Sigma^-1``: starting from ``H = 0.5``, each step is the
+Gauss-Newton update
 
     H <- H + g(H) . (y - a(H)),   g = first row of (X' W X)^-1 X' W,
     X = [da/dH, 1],  W = Sigma(H)^-1,
 
-(``g . 1 = 0``: ``sigma`` drops out; filters whose relative variance
-``Var(V_f) / (E V_f)^2`` exceeds 0.05 get no weight, as the delta method
-understates their spread), with ``a`` (and ``da/dH``) and ``g``
+(``g . 1 = 0``: ``sigma`` drops out; ``da/dH`` is the exact derivative of
+``a``, including that of ``r_f``), with ``a`` (and ``da/dH``) and ``g``
 tabulated on a grid of ``H`` (0.02 to 0.98 by 0.02; ``a`` interpolated by
 cubic Hermite, ``g`` linearly) per grid shape. Its standard error is
 ``sqrt((X' W X)^-1)_HH`` at the estimate. ``D = 2 - H`` (profiles) or
@@ -43,6 +57,9 @@ local Hölder index of a Gaussian process. *Ann. Inst. H. Poincaré Probab.
 Statist.* 33(4), 407-436. https://doi.org/10.1016/S0246-0203(97)80099-4
 Chan, G., Wood, A. T. A. (2000). Increment-based estimators of fractal
 dimension for two-dimensional surface data. *Statistica Sinica* 10, 343-376.
+Satterthwaite, F. E. (1946). An approximate distribution of estimates of
+variance components. *Biometrics Bulletin* 2(6), 110-114.
+https://doi.org/10.2307/3002019
 """
 from __future__ import annotations
 
@@ -61,11 +78,6 @@ __all__ = ["gls_dimension", "anisotropy_from_variations"]
 H_GRID = np.round(np.arange(0.02, 0.985, 0.02), 10)
 #: Gauss-Newton steps from H = 0.5.
 N_STEPS = 4
-#: Largest relative variance ``Var(V_f) / (E V_f)^2`` of a filter that
-#: enters the fit at a given H: beyond it the delta method understates the
-#: spread of ``log V_f`` (first differences of rough-to-smooth fields, H >=
-#: 0.7 at window 33) and weighting them raises the spread of H.
-MAX_REL_VAR = 0.05
 #: Largest grid side whose covariance is computed exactly (larger grids
 #: take the weights of this size; their standard error is scaled by the
 #: number of samples).
@@ -97,19 +109,80 @@ def _overlap(n1: int, n2: int, lags: np.ndarray) -> np.ndarray:
 @lru_cache(maxsize=32)
 def tables(shape: Tuple[int, ...], dilations: int) -> dict:
     """GLS tables for grids of ``shape`` on :data:`H_GRID`: ``a``, ``da``,
-    ``g`` (each (nH, K)), ``se`` (nH,), ``counts`` (K,) full-grid anchors.
+    ``g``, ``rel_var`` (each (nH, K)), ``sigma`` (nH, K, K), ``se`` (nH,),
+    ``counts`` (K,) full-grid anchors.
 
-    A grid too small for its filters (their covariance singular: e.g. a
-    window of 11 or fewer pixels) is a ``ValueError`` naming ``window_size``."""
+    A grid too small for its filters (fewer than two anchors, or a singular
+    covariance) is a ``ValueError`` naming ``window_size``."""
     try:
         return _tables(tuple(shape), dilations)
     except np.linalg.LinAlgError:
         raise ValueError(f"window_size: the GLS filters with dilations={dilations} are degenerate on a "
                          f"{' x '.join(map(str, shape))} grid (singular covariance); use a larger window "
-                         f"(13 or more pixels) or fewer dilations") from None
+                         f"or fewer dilations") from None
 
 
-def _tables(shape: Tuple[int, ...], dilations: int) -> dict:
+def _moments(fl: list, shape: Tuple[int, ...], counts: np.ndarray, H: float, geo: dict):
+    """Exact fBm moments of the quadratic variations at ``H`` (unit
+    ``sigma``): ``c`` (E V_f), ``dc`` (its H-derivative), ``cov`` (Cov(V_f,
+    V_g)) and ``dvar`` (the H-derivative of Var V_f)."""
+    ndim, pad, lag_axes, dist2, logd, ovs = (geo[k] for k in ("ndim", "pad", "lag_axes", "dist2", "logd", "ovs"))
+    K = len(fl)
+    G = np.exp(2 * H * logd) * (dist2 > 0)  # |d|^(2H), 0 at d = 0
+    dG = 2 * logd * G  # its H-derivative
+    c = np.empty(K)
+    dc = np.empty(K)
+    for k, (offs, w, _, _) in enumerate(fl):
+        dd = offs[:, None, :] - offs[None, :, :]
+        r = np.sqrt((dd.astype(np.float64) ** 2).sum(-1))
+        ww = w[:, None] * w[None, :]
+        lr = np.log(np.where(r > 0, r, 1.0))
+        c[k] = -0.5 * np.sum(ww * r ** (2 * H))
+        dc[k] = -0.5 * np.sum(ww * 2 * lr * r ** (2 * H) * (r > 0))
+    cov = np.empty((K, K))
+    dvar = np.empty(K)
+    for i, (oi, wi, _, _) in enumerate(fl):
+        for j in range(i, K):
+            oj, wj = fl[j][0], fl[j][1]
+            C: Any = 0.0
+            dC: Any = 0.0
+            for ta, wa in zip(oi, wi):
+                for tb, wb in zip(oj, wj):
+                    sl = tuple(slice(pad + int(x), pad + int(x) + len(lg)) for x, lg in zip(ta - tb, lag_axes))
+                    C = C + (-0.5 * wa * wb) * G[sl]
+                    if i == j:
+                        dC = dC + (-0.5 * wa * wb) * dG[sl]
+            ov = ovs[i, j]
+
+            def pairsum(M):
+                return ov[0] @ M if ndim == 1 else ov[0] @ M @ ov[1]
+
+            cov[i, j] = cov[j, i] = 2.0 * pairsum(C * C) / (counts[i] * counts[j])
+            if i == j:
+                dvar[i] = 4.0 * pairsum(C * dC) / (counts[i] * counts[i])
+    return c, dc, cov, dvar
+
+
+def log_moments(c: np.ndarray, dc: np.ndarray, cov: np.ndarray, dvar: np.ndarray):
+    """Model of ``y_f = log V_f`` (unit ``sigma``) from the moments of
+    :func:`_moments`: ``(a, da, Sigma, r)`` with ``r_f = Var V_f / (E
+    V_f)^2``, ``a_f = log c_f - r_f / 2``, ``da`` its exact H-derivative and
+    ``Sigma`` the delta method's covariance plus the independent
+    Welch-Satterthwaite excess ``psi'(1 / r_f) - r_f`` per filter (module
+    docstring)."""
+    from scipy.special import polygamma
+
+    var = np.diag(cov)
+    r = var / c**2
+    dr = dvar / c**2 - 2.0 * r * dc / c
+    a = np.log(c) - r / 2
+    da = dc / c - dr / 2
+    sig = cov / np.outer(c, c) + np.diag(polygamma(1, 1.0 / r) - r)
+    return a, da, sig, r
+
+
+def _tables(shape: Tuple[int, ...], dilations: int, h_grid: Optional[np.ndarray] = None) -> dict:
+    h_grid = H_GRID if h_grid is None else np.asarray(h_grid, dtype=np.float64)
     ndim = len(shape)
     fl = filters(ndim, dilations)
     K = len(fl)
@@ -127,53 +200,24 @@ def _tables(shape: Tuple[int, ...], dilations: int) -> dict:
         for j in range(i, K):
             sj = fl[j][2]
             ovs[i, j] = [_overlap(n - a, n - b, lg) for n, a, b, lg in zip(shape, si, sj, lag_axes)]
-    nH = len(H_GRID)
+    geo = dict(ndim=ndim, pad=pad, lag_axes=lag_axes, dist2=dist2, logd=logd, ovs=ovs)
+    nH = len(h_grid)
     a = np.empty((nH, K))
     da = np.empty((nH, K))
     g = np.empty((nH, K))
     se = np.empty(nH)
     sigs = np.empty((nH, K, K))
-    for hi, H in enumerate(H_GRID):
-        G = np.exp(2 * H * logd) * (dist2 > 0)  # |d|^(2H), 0 at d = 0
-        c = np.empty(K)
-        dc = np.empty(K)
-        for k, (offs, w, _, _) in enumerate(fl):
-            dd = offs[:, None, :] - offs[None, :, :]
-            r = np.sqrt((dd.astype(np.float64) ** 2).sum(-1))
-            ww = w[:, None] * w[None, :]
-            lr = np.log(np.where(r > 0, r, 1.0))
-            c[k] = -0.5 * np.sum(ww * r ** (2 * H))
-            dc[k] = -0.5 * np.sum(ww * 2 * lr * r ** (2 * H) * (r > 0))
-        cov = np.empty((K, K))
-        for i, (oi, wi, _, _) in enumerate(fl):
-            for j in range(i, K):
-                oj, wj = fl[j][0], fl[j][1]
-                C = 0.0
-                for ta, wa in zip(oi, wi):
-                    for tb, wb in zip(oj, wj):
-                        sl = tuple(slice(pad + int(x), pad + int(x) + len(lg)) for x, lg in zip(ta - tb, lag_axes))
-                        C = C + (-0.5 * wa * wb) * G[sl]
-                C2 = C * C
-                ov = ovs[i, j]
-                s = ov[0] @ C2 if ndim == 1 else ov[0] @ C2 @ ov[1]
-                cov[i, j] = cov[j, i] = 2.0 * s / (counts[i] * counts[j])
-        sig = cov / np.outer(c, c)
+    rel = np.empty((nH, K))
+    for hi, H in enumerate(h_grid):
+        c, dc, cov, dvar = _moments(fl, shape, counts, float(H), geo)
+        a[hi], da[hi], sig, rel[hi] = log_moments(c, dc, cov, dvar)
         sigs[hi] = sig
-        a[hi] = np.log(c) - 0.5 * np.diag(sig)
-        da[hi] = dc / c
-        # filters whose log variation is far from Gaussian (relative variance
-        # above MAX_REL_VAR: first differences at large H) get no weight
-        sel = np.flatnonzero(np.diag(sig) <= MAX_REL_VAR)
-        if len(sel) < 2:
-            sel = np.sort(np.argsort(np.diag(sig))[:2])
-        X = np.column_stack([da[hi][sel], np.ones(len(sel))])
-        ss = sig[np.ix_(sel, sel)]
-        Wx = np.linalg.solve(ss + 1e-12 * np.trace(ss) / len(sel) * np.eye(len(sel)), X)
+        X = np.column_stack([da[hi], np.ones(K)])
+        Wx = np.linalg.solve(sig + 1e-12 * np.trace(sig) / K * np.eye(K), X)
         Minv = np.linalg.inv(X.T @ Wx)
-        g[hi] = 0.0
-        g[hi, sel] = (Minv @ Wx.T)[0]
+        g[hi] = (Minv @ Wx.T)[0]
         se[hi] = np.sqrt(Minv[0, 0])
-    return {"a": a, "da": da, "g": g, "se": se, "sigma": sigs, "counts": counts, "filters": fl, "shape": tuple(shape),
+    return {"a": a, "da": da, "g": g, "se": se, "sigma": sigs, "rel_var": rel, "counts": counts, "filters": fl, "shape": tuple(shape),
             "dilations": dilations}
 
 
@@ -259,8 +303,9 @@ def gls_dimension(
     diagonals) are fitted by ``log c_f(H) + log sigma^2``, where
     ``c_f(H)`` is the exact expected quadratic variation of filter ``f``
     under fBm with Hurst exponent ``H``, weighted by the inverse of their
-    exact covariance under fBm on the grid (delta method), iterated at the
-    current ``H`` (see the module docstring for the formulas). ``D = 2 - H``
+    exact covariance under fBm on the grid (delta method, with the
+    Welch-Satterthwaite excess variance of each log as an independent term),
+    iterated at the current ``H`` (see the module docstring for the formulas). ``D = 2 - H``
     (profiles) or ``3 - H`` (surfaces). Scale free (no height unit).
 
     On exact fBm the estimate is unbiased to 0.005 and its spread is close to
