@@ -109,7 +109,8 @@ impl GlsTables {
     fn locate(&self, h: f64) -> (usize, f64) {
         let x = (h - self.h0) / self.dh;
         // floor of x clamped to [0, n_h - 2] (a cast truncates: floor for x >= 0)
-        let i = (x.max(0.0) as usize).min(self.n_h - 2);
+        // (through i64: one conversion instruction, same value, saturating)
+        let i = (x.max(0.0) as i64 as usize).min(self.n_h - 2);
         (i, x - i as f64)
     }
 
@@ -171,6 +172,59 @@ impl GlsTables {
         }
         let (i, s) = self.locate(h);
         (h, (1.0 - s) * self.se[i] + s * self.se[i + 1])
+    }
+
+    /// [`GlsTables::solve_with`] on `n = hs.len()` windows at once (`ys`
+    /// row-major `n x K`), the steps of the windows interleaved so that their
+    /// dependency chains (division, dot products, quartic) overlap; each
+    /// window's arithmetic is that of `solve_with`, so the results are equal
+    /// bit for bit. Writes `(H, se of H)` to `hs`, `ses`.
+    pub fn solve_batch(
+        &self,
+        polys: &[[f64; 5]],
+        ys: &[f64],
+        steps: usize,
+        hs: &mut [f64],
+        ses: &mut [f64],
+    ) {
+        const B: usize = 8;
+        let n = hs.len();
+        let Some(k) = ys.len().checked_div(n) else {
+            return;
+        };
+        let hi = self.h0 + self.dh * (self.n_h - 1) as f64;
+        for b0 in (0..n).step_by(B) {
+            let m = B.min(n - b0);
+            let mut h = [0.5f64; B];
+            let mut last = [usize::MAX; B];
+            let (mut y0, mut y1) = ([0.0f64; B], [0.0f64; B]);
+            for _ in 0..steps {
+                for l in 0..m {
+                    let (i, s) = self.locate(h[l]);
+                    if i != last[l] {
+                        let y = &ys[(b0 + l) * k..(b0 + l + 1) * k];
+                        let (g0, g1) = (
+                            &self.g[i * k..(i + 1) * k],
+                            &self.g[(i + 1) * k..(i + 2) * k],
+                        );
+                        let (mut a0, mut a1) = (0.0, 0.0);
+                        for f in 0..k {
+                            a0 += g0[f] * y[f];
+                            a1 += g1[f] * y[f];
+                        }
+                        (y0[l], y1[l], last[l]) = (a0, a1, i);
+                    }
+                    let c = &polys[i];
+                    let ga = c[0] + s * (c[1] + s * (c[2] + s * (c[3] + s * c[4])));
+                    h[l] = (h[l] + (1.0 - s) * y0[l] + s * y1[l] - ga).clamp(self.h0, hi);
+                }
+            }
+            for l in 0..m {
+                let (i, s) = self.locate(h[l]);
+                hs[b0 + l] = h[l];
+                ses[b0 + l] = (1.0 - s) * self.se[i] + s * self.se[i + 1];
+            }
+        }
     }
 
     /// Gauss-Newton steps from `H = 0.5`; returns `(H, se of H)`.
@@ -250,30 +304,34 @@ pub struct GlsOptions {
     pub anisotropy: bool,
 }
 
-/// `ln` of positive finite values in place: a polynomial (atanh series to
-/// `s^13`, relative error below 1e-10) the compiler vectorises, with the
-/// library `ln` for the rare subnormal values.
-fn ln_in_place(v: &mut [f64]) {
+/// `ln` of a positive normal finite value: a polynomial (atanh series to
+/// `s^13`, relative error below 1e-10) the compiler vectorises.
+#[inline(always)]
+fn ln_normal(x: f64) -> f64 {
     const SQRT2: f64 = std::f64::consts::SQRT_2;
     const LN2: f64 = std::f64::consts::LN_2;
+    let bits = x.to_bits();
+    let e = ((bits >> 52) & 0x7ff) as i64 - 1023;
+    let m = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | 0x3ff0_0000_0000_0000);
+    let big = m > SQRT2;
+    let (m, e) = if big { (m * 0.5, e + 1) } else { (m, e) };
+    let s = (m - 1.0) / (m + 1.0);
+    let s2 = s * s;
+    let p = 1.0
+        + s2 * (1.0 / 3.0
+            + s2 * (1.0 / 5.0
+                + s2 * (1.0 / 7.0 + s2 * (1.0 / 9.0 + s2 * (1.0 / 11.0 + s2 * (1.0 / 13.0))))));
+    e as f64 * LN2 + 2.0 * s * p
+}
+
+/// `ln` of positive finite values in place: [`ln_normal`], or the library
+/// `ln` for all of them when one is subnormal.
+fn ln_in_place(v: &mut [f64]) {
     if v.iter().any(|&x| x < f64::MIN_POSITIVE) {
         v.iter_mut().for_each(|x| *x = x.ln());
         return;
     }
-    for x in v.iter_mut() {
-        let bits = x.to_bits();
-        let e = ((bits >> 52) & 0x7ff) as i64 - 1023;
-        let m = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | 0x3ff0_0000_0000_0000);
-        let big = m > SQRT2;
-        let (m, e) = if big { (m * 0.5, e + 1) } else { (m, e) };
-        let s = (m - 1.0) / (m + 1.0);
-        let s2 = s * s;
-        let p = 1.0
-            + s2 * (1.0 / 3.0
-                + s2 * (1.0 / 5.0
-                    + s2 * (1.0 / 7.0 + s2 * (1.0 / 9.0 + s2 * (1.0 / 11.0 + s2 * (1.0 / 13.0))))));
-        *x = e as f64 * LN2 + 2.0 * s * p;
-    }
+    v.iter_mut().for_each(|x| *x = ln_normal(*x));
 }
 
 #[test]
@@ -354,6 +412,64 @@ fn slide_row<T: Sample, const N: usize>(
     }
 }
 
+/// Prefix sums along the row of the per-filter column sums `hi + lo`
+/// (`nf x cols`), compensated (two [`add2`] per value, `hi` then `lo`):
+/// `phi + plo` at `c * nf + f` is the sum over columns `0 .. c` of filter
+/// `f`. Filters in pairs with SSE2 on x86_64 (the same operations, so the
+/// same bits as the scalar loop).
+fn prefix_sums(hi: &[f64], lo: &[f64], cols: usize, nf: usize, phi: &mut [f64], plo: &mut [f64]) {
+    assert!(hi.len() >= nf * cols && lo.len() >= nf * cols);
+    assert!(phi.len() >= (cols + 1) * nf && plo.len() >= (cols + 1) * nf);
+    phi[..nf].fill(0.0);
+    plo[..nf].fill(0.0);
+    #[cfg(not(target_arch = "x86_64"))]
+    let f0 = 0;
+    #[cfg(target_arch = "x86_64")]
+    let f0 = {
+        use std::arch::x86_64::*;
+        // SAFETY: SSE2 is part of x86_64; every index is below the lengths
+        // asserted above (f + 1 < nf, c < cols).
+        unsafe {
+            #[inline(always)]
+            unsafe fn add2v(h: &mut __m128d, l: &mut __m128d, x: __m128d) {
+                let s = _mm_add_pd(*h, x);
+                let bp = _mm_sub_pd(s, *h);
+                let t = _mm_add_pd(_mm_sub_pd(*h, _mm_sub_pd(s, bp)), _mm_sub_pd(x, bp));
+                *l = _mm_add_pd(*l, t);
+                *h = s;
+            }
+            let (hp, lp) = (hi.as_ptr(), lo.as_ptr());
+            let (pp, qp) = (phi.as_mut_ptr(), plo.as_mut_ptr());
+            let pairs = nf / 2;
+            for c in 0..cols {
+                for j in 0..pairs {
+                    let f = 2 * j;
+                    let (p, q) = (c * nf + f, (c + 1) * nf + f);
+                    let mut ph = _mm_loadu_pd(pp.add(p));
+                    let mut pl = _mm_loadu_pd(qp.add(p));
+                    let xh = _mm_set_pd(*hp.add((f + 1) * cols + c), *hp.add(f * cols + c));
+                    let xl = _mm_set_pd(*lp.add((f + 1) * cols + c), *lp.add(f * cols + c));
+                    add2v(&mut ph, &mut pl, xh);
+                    add2v(&mut ph, &mut pl, xl);
+                    _mm_storeu_pd(pp.add(q), ph);
+                    _mm_storeu_pd(qp.add(q), pl);
+                }
+            }
+            2 * pairs
+        }
+    };
+    for c in 0..cols {
+        let (p, q) = (c * nf, (c + 1) * nf);
+        for fi in f0..nf {
+            let (mut ph, mut pl) = (phi[p + fi], plo[p + fi]);
+            add2(&mut ph, &mut pl, hi[fi * cols + c]);
+            add2(&mut ph, &mut pl, lo[fi * cols + c]);
+            phi[q + fi] = ph;
+            plo[q + fi] = pl;
+        }
+    }
+}
+
 /// Per-thread buffers of [`gls_transform`], reused from band to band.
 #[derive(Default)]
 struct GlsScratch {
@@ -371,7 +487,16 @@ struct GlsScratch {
     pcnt: Vec<f64>,
     /// Anchor rows `lo .. hi` summed now, per filter (and for `vcol`).
     span: Vec<(usize, usize)>,
+    /// `V_f` (then `ln V_f`) of the row's windows to fit, packed, with
+    /// their output columns and valid counts, and their `(H, se)`.
     vrow: Vec<f64>,
+    todo: Vec<(usize, f64)>,
+    /// Per filter, the increment counts of the window and those of the
+    /// row's interior windows (bands without holes).
+    nbuf: Vec<f64>,
+    nrow: Vec<f64>,
+    hbuf: Vec<f64>,
+    sebuf: Vec<f64>,
 }
 
 /// Moving-window GLS Hurst exponent (see the module docs); NaN where the
@@ -411,6 +536,8 @@ pub fn gls_transform<T: Sample>(
     let (ocols, min_pixels) = (grid.ocols, grid.min_pixels);
     let full = (w * w) as f64;
     let polys = tab.step_polys(nf);
+    // per filter, its column span times nf (offset of its window sums' end)
+    let sx: Vec<usize> = fl.iter().map(|f| f.span.1 * nf).collect();
     let an = opt.anisotropy;
     let mut maps = grid.drive(&[true, true, an, an], |sc: &mut GlsScratch, band, outs| {
         let i0 = band.i0;
@@ -429,6 +556,10 @@ pub fn gls_transform<T: Sample>(
         sc.span.clear();
         sc.span.resize(nf + 1, (0, 0));
         sc.vrow.resize(ocols * nf, 0.0);
+        sc.hbuf.resize(ocols, 0.0);
+        sc.nbuf.resize(nf, 0.0);
+        sc.nrow.resize(nf, 0.0);
+        sc.sebuf.resize(ocols, 0.0);
         let GlsScratch {
             hi,
             lo,
@@ -439,6 +570,11 @@ pub fn gls_transform<T: Sample>(
             pcnt,
             span,
             vrow,
+            todo,
+            nbuf,
+            nrow,
+            hbuf,
+            sebuf,
         } = sc;
         for g in band.g0..band.g1 {
             let (r0, r1) = grid.win_rows(band, g);
@@ -491,18 +627,7 @@ pub fn gls_transform<T: Sample>(
                 span[nf] = (r0, r1);
             }
             // prefix sums along the row, filter-interleaved
-            phi[..nf].fill(0.0);
-            plo[..nf].fill(0.0);
-            for c in 0..cols {
-                let (p, q) = (c * nf, (c + 1) * nf);
-                for fi in 0..nf {
-                    let (mut ph, mut pl) = (phi[p + fi], plo[p + fi]);
-                    add2(&mut ph, &mut pl, hi[fi * cols + c]);
-                    add2(&mut ph, &mut pl, lo[fi * cols + c]);
-                    phi[q + fi] = ph;
-                    plo[q + fi] = pl;
-                }
-            }
+            prefix_sums(hi, lo, cols, nf, phi, plo);
             if !complete {
                 pcnt[..nc].fill(0.0);
                 for c in 0..cols {
@@ -513,6 +638,13 @@ pub fn gls_transform<T: Sample>(
                     pcnt[q + nf] = pcnt[p + nf] + vcol[c];
                 }
             }
+            // the windows of the row that pass the gates: their V_f packed
+            // in `vrow` (`todo` their columns and valid counts), then ln and
+            // the Gauss-Newton steps over all of them at once
+            todo.clear();
+            for (fi, f) in fl.iter().enumerate() {
+                nrow[fi] = ((r1 - r0).saturating_sub(f.span.0) * (w - f.span.1)) as f64;
+            }
             for q in 0..ocols {
                 let (c0, c1) = grid.win_cols(q);
                 let valid = if complete {
@@ -520,39 +652,74 @@ pub fn gls_transform<T: Sample>(
                 } else {
                     pcnt[c1 * nc + nf] - pcnt[c0 * nc + nf]
                 };
-                let ys = &mut vrow[q * nf..(q + 1) * nf];
                 if valid < min_pixels {
                     continue;
                 }
-                for (fi, f) in fl.iter().enumerate() {
-                    let cc1 = c1.saturating_sub(f.span.1).max(c0);
-                    let (x, y) = (cc1 * nf + fi, c0 * nf + fi);
-                    let sp = (phi[x] - phi[y]) + (plo[x] - plo[y]);
-                    let rr1 = r1.saturating_sub(f.span.0).max(r0);
-                    let n = if complete {
-                        ((rr1 - r0) * (cc1 - c0)) as f64
-                    } else {
-                        pcnt[cc1 * nc + fi] - pcnt[c0 * nc + fi]
-                    };
-                    // no valid increment, a zero variation, or one that
-                    // overflowed: not fitted
-                    let v = sp / n;
-                    ys[fi] = if n >= 0.5 && v > 0.0 && v.is_finite() {
-                        v
-                    } else {
-                        0.0
-                    };
+                let j = todo.len();
+                let ys = &mut vrow[j * nf..(j + 1) * nf];
+                let ns = &mut nbuf[..nf];
+                let jc = q * grid.step;
+                if complete && jc >= grid.h && jc + grid.h < cols {
+                    // an interior window of a band without holes: the
+                    // increment counts are the row's, the taps of every
+                    // anchor column fit (w > span), cc1 = c1 - span
+                    let (x0, y0) = (c1 * nf, c0 * nf);
+                    for fi in 0..nf {
+                        let (x, y) = (x0 + fi - sx[fi], y0 + fi);
+                        ys[fi] = (phi[x] - phi[y]) + (plo[x] - plo[y]);
+                    }
+                    ns.copy_from_slice(&nrow[..nf]);
+                } else {
+                    for (fi, f) in fl.iter().enumerate() {
+                        let cc1 = c1.saturating_sub(f.span.1).max(c0);
+                        let (x, y) = (cc1 * nf + fi, c0 * nf + fi);
+                        ys[fi] = (phi[x] - phi[y]) + (plo[x] - plo[y]);
+                        let rr1 = r1.saturating_sub(f.span.0).max(r0);
+                        ns[fi] = if complete {
+                            ((rr1 - r0) * (cc1 - c0)) as f64
+                        } else {
+                            pcnt[cc1 * nc + fi] - pcnt[c0 * nc + fi]
+                        };
+                    }
                 }
-                if ys.contains(&0.0) {
+                // no valid increment, a zero variation, or one that
+                // overflowed: not fitted
+                let (mut fit, mut tiny) = (true, false);
+                for (v, &n) in ys.iter_mut().zip(ns.iter()) {
+                    *v /= n;
+                    fit &= (n >= 0.5) & (*v > 0.0) & (*v < f64::INFINITY);
+                    tiny |= *v < f64::MIN_POSITIVE;
+                }
+                if !fit {
                     continue;
                 }
+                if tiny {
+                    // a subnormal variation: the library ln, solved alone
+                    ln_in_place(ys);
+                    let (hh, se) = tab.solve_with(&polys, ys, opt.steps);
+                    let kk = (g - band.g0) * ocols + q;
+                    outs[0][kk] = hh as f32;
+                    outs[1][kk] = (se * (full / valid).sqrt()) as f32;
+                    if an {
+                        let (ang, rat) = anisotropy(&ys[..4 * k], k, hh);
+                        outs[2][kk] = ang as f32;
+                        outs[3][kk] = rat as f32;
+                    }
+                    continue;
+                }
+                todo.push((q, valid));
+            }
+            let nt = todo.len();
+            let ys = &mut vrow[..nt * nf];
+            ys.iter_mut().for_each(|x| *x = ln_normal(*x));
+            tab.solve_batch(&polys, ys, opt.steps, &mut hbuf[..nt], &mut sebuf[..nt]);
+            for (j, &(q, valid)) in todo.iter().enumerate() {
+                let (hh, se) = (hbuf[j], sebuf[j]);
                 let kk = (g - band.g0) * ocols + q;
-                ln_in_place(ys);
-                let (hh, se) = tab.solve_with(&polys, ys, opt.steps);
                 outs[0][kk] = hh as f32;
                 outs[1][kk] = (se * (full / valid).sqrt()) as f32;
                 if an {
-                    let (ang, rat) = anisotropy(&ys[..4 * k], k, hh);
+                    let (ang, rat) = anisotropy(&ys[j * nf..j * nf + 4 * k], k, hh);
                     outs[2][kk] = ang as f32;
                     outs[3][kk] = rat as f32;
                 }
@@ -791,6 +958,70 @@ mod tests {
                 }
             }
             assert!(checked > 100);
+        }
+    }
+
+    #[test]
+    fn batched_steps_equal_single_steps_bit_for_bit() {
+        let tab = toy_tables(2);
+        let polys = tab.step_polys(16);
+        // 21 windows (two full batches and a partial one), spread over H
+        let n = 21;
+        // y = 2 H ln|step| (the toy law) for H from 0.1 to 0.9, perturbed
+        let x: Vec<f64> = filters(2)
+            .iter()
+            .map(|f| {
+                let (r, c) = (
+                    f.taps[1].0 as f64 - f.taps[0].0 as f64,
+                    f.taps[1].1 as f64 - f.taps[0].1 as f64,
+                );
+                (r * r + c * c).sqrt().ln()
+            })
+            .collect();
+        let ys: Vec<f64> = (0..n * 16)
+            .map(|v| {
+                let h = 0.1 + 0.04 * (v / 16) as f64;
+                2.0 * h * x[v % 16] + ((v * 7) % 5) as f64 * 0.01
+            })
+            .collect();
+        let (mut hs, mut ses) = (vec![0.0; n], vec![0.0; n]);
+        tab.solve_batch(&polys, &ys, 4, &mut hs, &mut ses);
+        let mut distinct = std::collections::BTreeSet::new();
+        for j in 0..n {
+            let (h, se) = tab.solve_with(&polys, &ys[j * 16..(j + 1) * 16], 4);
+            assert_eq!(
+                (h.to_bits(), se.to_bits()),
+                (hs[j].to_bits(), ses[j].to_bits())
+            );
+            distinct.insert(h.to_bits());
+        }
+        assert!(distinct.len() > 5);
+    }
+
+    #[test]
+    fn prefix_sums_equal_the_scalar_compensated_sums() {
+        let cols = 37;
+        for nf in [16usize, 5] {
+            let hi = crate::testdata::uniform(nf * cols, 3);
+            let lo: Vec<f64> = crate::testdata::uniform(nf * cols, 4)
+                .iter()
+                .map(|v| v * 1e-17)
+                .collect();
+            let (mut phi, mut plo) = (vec![1.0; (cols + 1) * nf], vec![1.0; (cols + 1) * nf]);
+            prefix_sums(&hi, &lo, cols, nf, &mut phi, &mut plo);
+            for fi in 0..nf {
+                let (mut ph, mut pl) = (0.0, 0.0);
+                for c in 0..cols {
+                    add2(&mut ph, &mut pl, hi[fi * cols + c]);
+                    add2(&mut ph, &mut pl, lo[fi * cols + c]);
+                    let q = (c + 1) * nf + fi;
+                    assert_eq!(
+                        (phi[q].to_bits(), plo[q].to_bits()),
+                        (ph.to_bits(), pl.to_bits())
+                    );
+                }
+                assert_eq!((phi[fi], plo[fi]), (0.0, 0.0));
+            }
         }
     }
 }
