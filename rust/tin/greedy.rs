@@ -18,6 +18,10 @@
 //! sample is refined first (any valid sample inside it is inserted) and is
 //! left out of the result when it has no valid sample left to insert, so
 //! nodata regions become holes.
+//!
+//! A raster larger than one [`TILE`] is meshed as a fixed grid of tiles in
+//! parallel, each with its seams simplified in 1D like shared edges, and the
+//! tiles' meshes are merged (see [`greedy_tin`]).
 use crate::error::{CoreError, CoreResult};
 use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
 use spade::{DelaunayTriangulation, HasPosition, Point2, Triangulation};
