@@ -189,6 +189,100 @@ def test_identical_for_any_n_threads(rough):
         np.testing.assert_array_equal(t.triangles, ref.triangles)
 
 
+@pytest.fixture(scope="module")
+def big():
+    """700 x 900 fBm, relief 100: several tiles of the kernel's tiling."""
+    s = np.asarray(fg.fbm_surface((700, 900), hurst=0.8, seed=5), dtype=np.float64)
+    return (s - s.min()) / (s.max() - s.min()) * 100.0
+
+
+def edge_counts(t: TIN):
+    """Undirected edges (sorted vertex pairs), how many triangles use each, and
+    whether any directed edge is used twice (overlapping or folded triangles)."""
+    d = np.vstack([t.triangles[:, [0, 1]], t.triangles[:, [1, 2]], t.triangles[:, [2, 0]]])
+    folded = len(np.unique(d, axis=0)) < len(d)
+    e, n = np.unique(np.sort(d, axis=1), axis=0, return_counts=True)
+    return e, n, folded
+
+
+def t_junctions(t: TIN):
+    """Axis-parallel triangle edges with a mesh vertex strictly inside them."""
+    verts = set(map(tuple, t.grid.tolist()))
+    e, _, _ = edge_counts(t)
+    p, q = t.grid[e[:, 0]], t.grid[e[:, 1]]
+    bad = []
+    for (c0, r0), (c1, r1) in zip(p[(p[:, 0] == q[:, 0]) | (p[:, 1] == q[:, 1])].tolist(),
+                                  q[(p[:, 0] == q[:, 0]) | (p[:, 1] == q[:, 1])].tolist()):
+        if c0 == c1:
+            inside = [(c0, r) for r in range(min(r0, r1) + 1, max(r0, r1))]
+        else:
+            inside = [(c, r0) for c in range(min(c0, c1) + 1, max(c0, c1))]
+        if any(v in verts for v in inside):
+            bad.append((c0, r0, c1, r1))
+    return bad
+
+
+@pytest.mark.parametrize("tile_edges", ["shared", "free"])
+def test_tiled_dem_bound_watertight_and_thread_independent(big, tile_edges):
+    err = 1.0
+    t = tin_from_dem(big, max_error=err, tile_edges=tile_edges, n_threads=1)
+    t2 = tin_from_dem(big, max_error=err, tile_edges=tile_edges, n_threads=2)
+    np.testing.assert_array_equal(t.vertices, t2.vertices)
+    np.testing.assert_array_equal(t.triangles, t2.triangles)
+    assert t.max_error == t2.max_error
+    assert np.all(signed_area2(t.vertices, t.triangles) > 0)
+    assert len(np.unique(t.grid, axis=0)) == len(t.grid)  # seam vertices merged
+    g = rasterize(t)
+    assert not np.isnan(g).any()
+    measured = np.abs(g - big).max()
+    assert measured <= err + 1e-9
+    assert t.max_error == pytest.approx(measured, abs=1e-9)
+    # watertight: every edge in two triangles except on the raster's outer boundary
+    e, n, folded = edge_counts(t)
+    assert not folded and n.max() == 2
+    p, q = t.grid[e[n == 1, 0]], t.grid[e[n == 1, 1]]
+    rows, cols = big.shape
+    outer = (((p[:, 0] == q[:, 0]) & np.isin(p[:, 0], [0, cols - 1]))
+             | ((p[:, 1] == q[:, 1]) & np.isin(p[:, 1], [0, rows - 1])))
+    assert outer.all()
+    # and the outer boundary is the raster's: its length is the perimeter
+    length = np.abs(p - q).sum()
+    assert length == 2 * (rows - 1) + 2 * (cols - 1)
+
+
+def test_tiled_dem_holes_across_seams(big):
+    z = big.copy()
+    z[200:400, 400:500] = np.nan  # across the row and column seams
+    z[:260, :230] = np.nan  # a corner region covering a whole tile or more
+    z[450:452, :] = np.nan  # a nodata strip across the whole raster
+    t = tin_from_dem(z, max_error=1.0)
+    t2 = tin_from_dem(z, max_error=1.0, n_threads=2)
+    np.testing.assert_array_equal(t.triangles, t2.triangles)
+    np.testing.assert_array_equal(t.vertices, t2.vertices)
+    g = rasterize(t)
+    hole = np.isnan(z)
+    assert np.isnan(g[hole]).all()
+    valid = ~hole & ~np.isnan(g)
+    assert valid.sum() >= 0.99 * (~hole).sum()
+    assert np.abs(g[valid] - z[valid]).max() <= 1.0 + 1e-9
+    _, n, folded = edge_counts(t)
+    assert not folded and n.max() == 2
+    assert t_junctions(t) == []
+
+
+@pytest.mark.slow
+def test_tiled_vertex_count_against_pydelatin():
+    Delatin = pytest.importorskip("pydelatin").Delatin
+    s = np.asarray(fg.fbm_surface((1024, 1024), hurst=0.5, seed=1, cell_size=10.0), dtype=np.float64)
+    z = (s - s.min()) / (s.max() - s.min()) * 1000.0
+    for err in (10.0, 30.0):
+        ref = Delatin(z.astype(np.float32), width=1024, height=1024, max_error=err)
+        for edges in ("free", "shared"):
+            t = tin_from_dem(z, max_error=err, tile_edges=edges)
+            assert len(t.vertices) <= 1.05 * len(ref.vertices), (err, edges, len(t.vertices), len(ref.vertices))
+            assert t.max_error <= err + 1e-9
+
+
 def test_default_max_error(crop):
     t = tin_from_dem(crop)
     lo, hi = np.percentile(crop, [2, 98])

@@ -18,6 +18,10 @@
 //! sample is refined first (any valid sample inside it is inserted) and is
 //! left out of the result when it has no valid sample left to insert, so
 //! nodata regions become holes.
+//!
+//! A raster larger than one [`TILE`] is meshed as a fixed grid of tiles in
+//! parallel, each with its seams simplified in 1D like shared edges, and the
+//! tiles' meshes are merged (see [`greedy_tin`]).
 use crate::error::{CoreError, CoreResult};
 use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
 use spade::{DelaunayTriangulation, HasPosition, Point2, Triangulation};
@@ -249,7 +253,7 @@ struct Refiner<'a> {
     g: Grid<'a>,
     tri: Tri,
     /// The heights, with the samples that are never candidates (vertices,
-    /// and the raster's edge samples with shared tile edges) set to the NaN
+    /// and the valid samples of shared edges) set to the NaN
     /// [`SKIP`]: one load per sample tells valid, nodata and skipped apart.
     zq: Vec<f64>,
     faces: Vec<FaceInfo>,
@@ -401,6 +405,23 @@ fn prefetch_box(zq: &[f64], cols: usize, p: [(usize, usize); 3]) {
     let _ = (zq, cols, p);
 }
 
+/// Side length, in sample spacings, above which a raster is meshed in tiles:
+/// a raster of more than `TILE + 1` samples along an axis is cut into
+/// `ceil((n - 1) / TILE)` tiles of nearly equal size along it (cuts at
+/// samples `i (n - 1) / k`, `i = 0..=k`), neighbouring tiles sharing their
+/// seam row or column. The tiling depends on the shape alone, never on the
+/// thread count. 256 was the faster of 256 and 512 on a 1024² fBm
+/// (`benches/bench_tin.py`): a tile's heights (0.5 MB) stay in the L2 cache.
+pub const TILE: usize = 256;
+
+/// The sample indices `0 = c_0 < c_1 < ... < c_k = n - 1` of the tile
+/// boundaries along an axis of `n` samples (see [`TILE`]).
+fn tile_cuts(n: usize) -> Vec<usize> {
+    let spans = n.saturating_sub(1);
+    let k = spans.div_ceil(TILE).max(1);
+    (0..=k).map(|i| i * spans / k).collect()
+}
+
 /// Greedy error-bounded TIN of the `rows x cols` raster `z` (row-major,
 /// NaN = nodata).
 ///
@@ -408,11 +429,19 @@ fn prefetch_box(zq: &[f64], cols: usize, p: [(usize, usize); 3]) {
 ///   distance of the mesh (same unit as `z`; >= 0), allowing for the
 ///   rounding of the interpolation (`16 eps max|z|`).
 /// * `max_triangles`: stop when the mesh has this many triangles (the
-///   initial mesh may already have more).
+///   initial mesh may already have more). The budget is spent worst-first
+///   over the whole raster, so the raster is meshed as one tile.
 /// * `shared_edges`: the vertices on the four raster edges are chosen by a
 ///   1D simplification of the edge samples alone (within `max_error`) and no
 ///   other edge sample is inserted, so tiles of one raster meshed separately
 ///   have identical vertices on their common edges.
+///
+/// Without `max_triangles`, a raster larger than one [`TILE`] is cut into
+/// tiles that are meshed independently (in parallel) with their seams
+/// simplified in 1D as shared edges are, whatever `shared_edges` says
+/// (which then applies to the raster's outer edges only); the tiles' meshes
+/// are merged in tile order, vertices deduplicated by grid position. The
+/// result does not depend on the thread count.
 pub fn greedy_tin(
     z: &[f64],
     rows: usize,
@@ -446,35 +475,142 @@ pub fn greedy_tin(
         .iter()
         .filter(|v| !v.is_nan())
         .fold(0.0f64, |m, v| m.max(v.abs()));
+    let slack = 16.0 * f64::EPSILON * zmax;
+    let no_triangle = || {
+        CoreError::invalid(
+            "dem",
+            "the valid samples are fewer than 3 or all on one line: there is no triangle",
+        )
+    };
+    let (rcuts, ccuts) = (tile_cuts(rows), tile_cuts(cols));
+    if max_triangles.is_some() || (rcuts.len() == 2 && ccuts.len() == 2) {
+        return greedy_tile(
+            z,
+            rows,
+            cols,
+            max_error,
+            max_triangles,
+            [shared_edges; 4],
+            slack,
+        )?
+        .ok_or_else(no_triangle);
+    }
+    let whole = Grid {
+        z,
+        rows,
+        cols,
+        slack,
+    };
+    if valid_hull(&whole).len() < 3 {
+        return Err(no_triangle());
+    }
+    // Tiles in row-major order: (first row, last row, first col, last col).
+    let mut tiles = Vec::new();
+    for rw in rcuts.windows(2) {
+        for cw in ccuts.windows(2) {
+            tiles.push((rw[0], rw[1], cw[0], cw[1]));
+        }
+    }
+    use rayon::prelude::*;
+    let meshes: Vec<Option<GreedyTin>> = tiles
+        .par_iter()
+        .map(|&(r0, r1, c0, c1)| {
+            let (tr, tc) = (r1 - r0 + 1, c1 - c0 + 1);
+            let mut sub = Vec::new();
+            sub.try_reserve_exact(tr * tc).map_err(|_| {
+                CoreError::invalid("dem", format!("cannot allocate a tile of {tr} x {tc}"))
+            })?;
+            for r in r0..=r1 {
+                sub.extend_from_slice(&z[r * cols + c0..=r * cols + c1]);
+            }
+            // Seams are always shared; the raster's own edges as asked.
+            let sides = [
+                r0 > 0 || shared_edges,
+                r1 < rows - 1 || shared_edges,
+                c0 > 0 || shared_edges,
+                c1 < cols - 1 || shared_edges,
+            ];
+            greedy_tile(&sub, tr, tc, max_error, None, sides, slack)
+        })
+        .collect::<CoreResult<_>>()?;
+    // Merge in tile order: a seam vertex gets the index of its first tile.
+    let mut index = vec![u32::MAX; n];
+    let mut out = GreedyTin {
+        grid: Vec::new(),
+        z: Vec::new(),
+        triangles: Vec::new(),
+        max_error: 0.0,
+    };
+    for (&(r0, _, c0, _), mesh) in tiles.iter().zip(&meshes) {
+        let Some(m) = mesh else { continue };
+        out.max_error = out.max_error.max(m.max_error);
+        let global: Vec<u32> = m
+            .grid
+            .iter()
+            .map(|&[c, r]| {
+                let (gc, gr) = (c0 + c as usize, r0 + r as usize);
+                let s = gr * cols + gc;
+                if index[s] == u32::MAX {
+                    index[s] = out.grid.len() as u32;
+                    out.grid.push([gc as u32, gr as u32]);
+                    out.z.push(z[s]);
+                }
+                index[s]
+            })
+            .collect();
+        out.triangles.extend(
+            m.triangles
+                .iter()
+                .map(|t| t.map(|i| global[i as usize] as i64)),
+        );
+    }
+    Ok(out)
+}
+
+/// [`greedy_tin`] of one tile, with the slack of the whole raster and the
+/// sides (top, bottom, left, right) simplified in 1D flagged in `sides`;
+/// `None` when the tile's valid samples are fewer than 3 or collinear.
+fn greedy_tile(
+    z: &[f64],
+    rows: usize,
+    cols: usize,
+    max_error: f64,
+    max_triangles: Option<usize>,
+    sides: [bool; 4],
+    slack: f64,
+) -> CoreResult<Option<GreedyTin>> {
+    let n = rows * cols;
     let g = Grid {
         z,
         rows,
         cols,
-        slack: 16.0 * f64::EPSILON * zmax,
+        slack,
     };
     let mut initial: Vec<usize> = valid_hull(&g)
         .into_iter()
         .map(|(c, r)| r as usize * cols + c as usize)
         .collect();
     if initial.len() < 3 {
-        return Err(CoreError::invalid(
-            "dem",
-            "the valid samples are fewer than 3 or all on one line: there is no triangle",
-        ));
+        return Ok(None);
     }
     let mut zq = Vec::new();
     zq.try_reserve_exact(n)
         .map_err(|_| CoreError::invalid("dem", format!("cannot allocate a copy of {n} samples")))?;
     zq.extend(z.iter().map(|&v| if v.is_nan() { f64::NAN } else { v }));
     let mut edge_error = 0.0f64;
-    if shared_edges {
-        let top: Vec<usize> = (0..cols).collect();
-        let bottom: Vec<usize> = (0..cols).map(|c| (rows - 1) * cols + c).collect();
-        let left: Vec<usize> = (0..rows).map(|r| r * cols).collect();
-        let right: Vec<usize> = (0..rows).map(|r| r * cols + cols - 1).collect();
-        for side in [&top, &bottom, &left, &right] {
-            edge_error = edge_error.max(simplify_edge(&g, side, max_error, &mut initial));
-            for &s in side {
+    let top: Vec<usize> = (0..cols).collect();
+    let bottom: Vec<usize> = (0..cols).map(|c| (rows - 1) * cols + c).collect();
+    let left: Vec<usize> = (0..rows).map(|r| r * cols).collect();
+    let right: Vec<usize> = (0..rows).map(|r| r * cols + cols - 1).collect();
+    for (side, shared) in [&top, &bottom, &left, &right].into_iter().zip(sides) {
+        if !shared {
+            continue;
+        }
+        edge_error = edge_error.max(simplify_edge(&g, side, max_error, &mut initial));
+        // Valid edge samples are never candidates; nodata ones stay NaN, so
+        // a triangle across a gap of the edge counts as covering nodata.
+        for &s in side {
+            if !z[s].is_nan() {
                 zq[s] = f64::from_bits(SKIP);
             }
         }
@@ -554,12 +690,12 @@ pub fn greedy_tin(
         }
         triangles.push(t);
     }
-    Ok(GreedyTin {
+    Ok(Some(GreedyTin {
         grid,
         z: zs,
         triangles,
         max_error: achieved,
-    })
+    }))
 }
 
 /// Rasterise the triangle mesh (`xy` in grid coordinates `(col, row)`,
@@ -642,6 +778,176 @@ mod tests {
         assert_eq!(t.grid.len(), 4);
         assert_eq!(t.triangles.len(), 2);
         assert!(t.max_error < 1e-9);
+    }
+
+    /// A smooth-plus-random field: sums of sines and uniform noise.
+    fn field(rows: usize, cols: usize, seed: u64) -> Vec<f64> {
+        let noise = crate::testdata::uniform(rows * cols, seed);
+        (0..rows * cols)
+            .map(|s| {
+                let (r, c) = ((s / cols) as f64, (s % cols) as f64);
+                20.0 * (r / 37.0).sin() * (c / 23.0).cos() + 5.0 * noise[s]
+            })
+            .collect()
+    }
+
+    /// Every valid sample within `bound` of the mesh and no nodata sample
+    /// covered (the kernel's own rasteriser, which `tests/test_tin_dem.py`
+    /// checks against an independent one); returns the coverage.
+    fn check_bound(t: &GreedyTin, z: &[f64], rows: usize, cols: usize, bound: f64) -> Vec<f64> {
+        let xy: Vec<[f64; 2]> = t.grid.iter().map(|g| [g[0] as f64, g[1] as f64]).collect();
+        let g = rasterize(&xy, &t.z, &t.triangles, rows, cols).unwrap();
+        for s in 0..rows * cols {
+            if z[s].is_nan() {
+                assert!(g[s].is_nan(), "nodata sample {s} covered");
+            } else if !g[s].is_nan() {
+                assert!((g[s] - z[s]).abs() <= bound + 1e-9, "sample {s}");
+            }
+        }
+        g
+    }
+
+    /// Undirected edges used by more than two triangles or directed edges
+    /// used twice (a fold or overlap), and edges used once that are not on
+    /// the raster's outer boundary.
+    fn open_edges(t: &GreedyTin, rows: usize, cols: usize) -> Vec<[u32; 4]> {
+        use std::collections::HashMap;
+        let mut count: HashMap<(i64, i64), (u32, u32)> = HashMap::new();
+        for tr in &t.triangles {
+            for k in 0..3 {
+                let (a, b) = (tr[k], tr[(k + 1) % 3]);
+                let e = count.entry((a.min(b), a.max(b))).or_default();
+                if a < b {
+                    e.0 += 1;
+                } else {
+                    e.1 += 1;
+                }
+            }
+        }
+        let mut bad = Vec::new();
+        for (&(a, b), &(f, r)) in &count {
+            let (p, q) = (t.grid[a as usize], t.grid[b as usize]);
+            let on_outer = (p[0] == q[0] && (p[0] == 0 || p[0] as usize == cols - 1))
+                || (p[1] == q[1] && (p[1] == 0 || p[1] as usize == rows - 1));
+            if f > 1 || r > 1 || (f + r == 1 && !on_outer) {
+                bad.push([p[0], p[1], q[0], q[1]]);
+            }
+        }
+        bad
+    }
+
+    /// Triangle edges along a seam (or any grid line) with a mesh vertex
+    /// strictly inside them: T-junctions.
+    fn t_junctions(t: &GreedyTin) -> Vec<[u32; 4]> {
+        use std::collections::HashSet;
+        let verts: HashSet<[u32; 2]> = t.grid.iter().copied().collect();
+        let mut bad = Vec::new();
+        for tr in &t.triangles {
+            for k in 0..3 {
+                let (p, q) = (t.grid[tr[k] as usize], t.grid[tr[(k + 1) % 3] as usize]);
+                let inside: Vec<[u32; 2]> = if p[0] == q[0] {
+                    (p[1].min(q[1]) + 1..p[1].max(q[1]))
+                        .map(|r| [p[0], r])
+                        .collect()
+                } else if p[1] == q[1] {
+                    (p[0].min(q[0]) + 1..p[0].max(q[0]))
+                        .map(|c| [c, p[1]])
+                        .collect()
+                } else {
+                    Vec::new()
+                };
+                if inside.iter().any(|v| verts.contains(v)) {
+                    bad.push([p[0], p[1], q[0], q[1]]);
+                }
+            }
+        }
+        bad
+    }
+
+    #[test]
+    fn tile_cuts_are_balanced_and_fixed() {
+        assert_eq!(tile_cuts(1), vec![0, 0]);
+        assert_eq!(tile_cuts(TILE + 1), vec![0, TILE]);
+        assert_eq!(tile_cuts(TILE + 2).len(), 3);
+        let c = tile_cuts(1024);
+        assert_eq!(*c.first().unwrap(), 0);
+        assert_eq!(*c.last().unwrap(), 1023);
+        assert!(c
+            .windows(2)
+            .all(|w| w[1] - w[0] <= TILE && w[1] - w[0] >= TILE / 2));
+    }
+
+    #[test]
+    fn tiles_join_without_cracks_and_keep_the_bound() {
+        let (rows, cols) = (2 * TILE + 40, TILE + 90);
+        let z = field(rows, cols, 7);
+        for shared in [false, true] {
+            let t = greedy_tin(&z, rows, cols, 2.0, None, shared).unwrap();
+            let g = check_bound(&t, &z, rows, cols, 2.0);
+            assert!(g.iter().all(|v| !v.is_nan()), "the raster is covered");
+            assert!(t.max_error <= 2.0 + 1e-9);
+            assert_eq!(open_edges(&t, rows, cols), Vec::<[u32; 4]>::new());
+            assert_eq!(t_junctions(&t), Vec::<[u32; 4]>::new());
+            // no vertex twice
+            let mut pos = t.grid.clone();
+            pos.sort_unstable();
+            pos.dedup();
+            assert_eq!(pos.len(), t.grid.len());
+            // the tiled mesh is not far from the single-tile one
+            let one = greedy_tin(&z, rows, cols, 2.0, Some(usize::MAX), shared).unwrap();
+            assert!(t.grid.len() as f64 <= 1.05 * one.grid.len() as f64);
+        }
+    }
+
+    #[test]
+    fn identical_for_any_thread_count() {
+        let (rows, cols) = (TILE + 60, 2 * TILE + 10);
+        let z = field(rows, cols, 9);
+        let run = |n| {
+            crate::parallel::run_in_pool(Some(n), || greedy_tin(&z, rows, cols, 1.0, None, true))
+        };
+        let a = run(1).unwrap();
+        assert_eq!(a, run(2).unwrap());
+        assert_eq!(a, run(3).unwrap());
+    }
+
+    #[test]
+    fn nodata_tiles_and_holes_across_seams() {
+        let (rows, cols) = (2 * TILE + 1, 2 * TILE + 1);
+        let mut z = field(rows, cols, 11);
+        // the first tile entirely nodata, a hole across the vertical seam,
+        // a one-sample-wide nodata line along part of the horizontal seam
+        for r in 0..=TILE {
+            for c in 0..=TILE {
+                z[r * cols + c] = f64::NAN;
+            }
+        }
+        for r in TILE + 40..TILE + 90 {
+            for c in TILE - 30..TILE + 25 {
+                z[r * cols + c] = f64::NAN;
+            }
+        }
+        for c in TILE + 50..TILE + 70 {
+            z[TILE * cols + c] = f64::NAN;
+        }
+        let t = greedy_tin(&z, rows, cols, 1.5, None, true).unwrap();
+        let g = check_bound(&t, &z, rows, cols, 1.5);
+        let covered = (0..rows * cols).filter(|&s| !g[s].is_nan()).count();
+        let valid = z.iter().filter(|v| !v.is_nan()).count();
+        assert!(covered as f64 >= 0.99 * valid as f64);
+        assert_eq!(t_junctions(&t), Vec::<[u32; 4]>::new());
+        // a whole raster of nodata but three samples in three tiles
+        let mut sparse = vec![f64::NAN; rows * cols];
+        sparse[0] = 1.0;
+        sparse[rows * cols - 1] = 2.0;
+        sparse[cols - 1] = 3.0;
+        let t = greedy_tin(&sparse, rows, cols, 0.0, None, true).unwrap();
+        assert!(t.triangles.is_empty());
+        let mut line = vec![f64::NAN; rows * cols];
+        for c in 0..cols {
+            line[TILE * cols + c] = c as f64;
+        }
+        assert!(greedy_tin(&line, rows, cols, 0.0, None, true).is_err());
     }
 
     #[test]

@@ -286,6 +286,16 @@ def tin_from_dem(dem, *, max_error=None, max_triangles=None, transform=None, cel
     within ``max_error`` of the mesh or the mesh has ``max_triangles``
     triangles. Only the triangles around each new vertex are re-examined.
 
+    A DEM of more than 257 samples along a side is meshed in tiles of at most
+    257 x 257 samples (a fixed tiling by the shape alone: ``ceil((n - 1) /
+    256)`` tiles of nearly equal size along an axis of ``n`` samples,
+    neighbours sharing a seam row or column), in parallel. Every seam gets
+    its vertices from the 1D simplification of its samples described under
+    ``tile_edges="shared"``, so both sides have the same vertices there and
+    the merged mesh is watertight; vertices are merged by grid position and
+    the triangles concatenated in tile order, so the result is the same for
+    any ``n_threads``.
+
     Parameters
     ----------
     dem : array_like, shape (rows, cols)
@@ -299,7 +309,9 @@ def tin_from_dem(dem, *, max_error=None, max_triangles=None, transform=None, cel
         neighbours.
     max_triangles : int, optional
         Triangle budget: refinement stops when it is reached (the achieved
-        ``max_error`` is then larger than asked).
+        ``max_error`` is then larger than asked). The budget is spent
+        worst-first over the whole DEM, so with ``max_triangles`` the DEM is
+        meshed as one tile, sequentially.
     transform : Affine or GDAL 6-tuple, optional
         Georeferencing of the DEM (pixel corners); vertices sit at sample
         centres. Default: ``cell_size`` spacing, north up, origin at the lower
@@ -314,9 +326,12 @@ def tin_from_dem(dem, *, max_error=None, max_triangles=None, transform=None, cel
         run of valid edge samples) and no other edge sample is inserted, so
         adjacent tiles of one DEM meshed separately have identical vertices
         on their common edge and join without cracks. ``"free"``: edge
-        samples are refined like any other (fewer vertices).
+        samples are refined like any other (fewer vertices). The option
+        applies to the DEM's outer edges; the seams between the internal
+        tiles are always simplified as shared edges.
     n_threads : int, optional
-        Accepted for a uniform interface; the refinement is sequential.
+        Tiles are meshed in parallel on this many threads (default: all
+        cores); the result does not depend on it.
 
     Returns
     -------
