@@ -57,14 +57,7 @@ pub fn point_box_count(
             format!("need at least 3 distinct box sizes, got {}", sizes.len()),
         ));
     }
-    let mut mins = vec![f64::INFINITY; d];
-    let mut maxs = vec![f64::NEG_INFINITY; d];
-    for p in coords.chunks_exact(d) {
-        for a in 0..d {
-            mins[a] = mins[a].min(p[a]);
-            maxs[a] = maxs[a].max(p[a]);
-        }
-    }
+    let (mins, _) = bounds(coords, d);
     let s_max = *sizes.last().unwrap();
     // shifts: j / n_offsets of the largest box, all combinations over axes
     let mut shifts: Vec<Vec<f64>> = vec![vec![]];
@@ -155,14 +148,7 @@ pub fn point_lattice_levels(
             "coordinates must be finite (no NaN or inf)",
         ));
     }
-    let mut lo = vec![f64::INFINITY; d];
-    let mut hi = vec![f64::NEG_INFINITY; d];
-    for p in coords.chunks_exact(d) {
-        for a in 0..d {
-            lo[a] = lo[a].min(p[a]);
-            hi[a] = hi[a].max(p[a]);
-        }
-    }
+    let (lo, hi) = bounds(coords, d);
     let ext: Vec<f64> = lo.iter().zip(&hi).map(|(l, h)| h - l).collect();
     let e = ext.iter().cloned().fold(0.0f64, f64::max);
     if e <= 0.0 {
@@ -256,6 +242,19 @@ fn distinct(v: &mut [u128]) -> u64 {
     }
     v.sort_unstable();
     1 + v.windows(2).filter(|w| w[0] != w[1]).count() as u64
+}
+
+/// Per-axis minimum and maximum of an `n x d` row-major coordinate array.
+fn bounds(coords: &[f64], d: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut lo = vec![f64::INFINITY; d];
+    let mut hi = vec![f64::NEG_INFINITY; d];
+    for p in coords.chunks_exact(d) {
+        for a in 0..d {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    (lo, hi)
 }
 
 /// Largest extent of the set over its axes (for default box sizes).
