@@ -69,6 +69,7 @@ def _file_bytes(write, a, suffix):
 # name: (the array argument, the call on it)
 CASES = {
     "box_count_binary": (MASK, lambda a: _core.box_count_binary(a, [1, 2, 4], 1, True)),
+    "box_count_point_levels": (rng.random((2000, 2)), lambda a: _core.box_count_point_levels(a, 2, 2, 5.0, 8, 1)),
     "box_count_points": (rng.random((200, 2)), lambda a: _core.box_count_points(a, [0.1, 0.2, 0.4], 1)),
     "dbc_count": (IMG, lambda a: _core.dbc_count(a, [2, 4, 8], 1, 0.0, 1.0)),
     "higuchi_lengths": (PROFILE, lambda a: _core.higuchi_lengths(a, 8)),
