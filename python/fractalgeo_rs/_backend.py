@@ -72,11 +72,18 @@ def _call(kernel, block, origin, locate):
     return kernel(block, origin) if locate else kernel(block)
 
 
+def _stacked(out):
+    """The kernel's maps as one ``(n_out, ...)`` array (a kernel may return a
+    sequence of equally shaped maps, which is not copied where no caller
+    needs them stacked)."""
+    return np.stack(out) if isinstance(out, (list, tuple)) else out
+
+
 def _run_numpy(kernel, arr, *, n_out, depth, step, dtype, locate=False, progress=False, desc="", **_):
     rows = arr.shape[0]
     if not progress:
         out = _call(kernel, arr, (0, 0), locate)
-        assert out.shape[0] == n_out
+        assert len(out) == n_out
         return out
     from fractalgeo_rs._progress import bar
 
@@ -90,7 +97,7 @@ def _run_numpy(kernel, arr, *, n_out, depth, step, dtype, locate=False, progress
         for r0 in starts:
             r1 = min(rows, r0 + height)
             a0, a1 = max(0, r0 - halo), min(rows, r1 + halo)
-            res = _call(kernel, arr[a0:a1], (a0, 0), locate)
+            res = _stacked(_call(kernel, arr[a0:a1], (a0, 0), locate))
             k0 = (r0 - a0) // step
             parts.append(res[:, k0:k0 + -(-(r1 - r0) // step)])
             b.update(1)
@@ -206,7 +213,8 @@ def run_raster(
     ----------
     kernel : callable
         ``kernel(block) -> ndarray (n_out, ceil(r / step), ceil(c / step))``
-        on a 2D block of the image (numpy, NaN = missing).
+        (or a list of ``n_out`` such 2D maps) on a 2D block of the image
+        (numpy, NaN = missing).
     image : ndarray, dask.array.Array or xarray.DataArray, 2D
         Already validated (real dtype, 2D).
     depth : int
@@ -251,9 +259,12 @@ def run_raster(
     if boundary not in ("nan", "none"):
         raise ValueError(f"boundary: expected 'nan' or 'none', got {boundary!r}")
     def run(b, *origin):  # origin: the block's (row, col) when locate is set
-        return kernel(prep(b), *origin)
+        out = kernel(prep(b), *origin)
+        return out if inner == "numpy" else _stacked(out)
     stacked = _RUNNERS[inner](run, data, depth=depth, step=step, n_out=n_out, dtype=dtype,
                               boundary=boundary, locate=locate, progress=progress, desc=desc)
+    if stack_dim is not None:
+        stacked = _stacked(stacked)
     if xr_obj is None:
         return stacked if stack_dim is not None else [stacked[k] for k in range(n_out)]
     dims = xr_obj.dims

@@ -478,5 +478,5 @@ def gls_grid(z: np.ndarray, w: int, dilations: int, min_valid: float, step: int,
     dh = float(H_GRID[1] - H_GRID[0])
     maps = _core.gls_transform_map(z, w, k, float(H_GRID[0]), dh, t["a"], t["da"], t["g"], t["se"].tolist(),
                                    N_STEPS, min_valid, step, anisotropy, n_threads)
-    maps[0] = (3.0 - maps[0]).astype(np.float32)
+    np.subtract(np.float32(3.0), maps[0], out=maps[0])  # H -> D in place (float32, as returned)
     return maps

@@ -304,9 +304,9 @@ def fractal_transform(
         return z
 
     def kernel(z):
-        """Stacked (dimension, quality[, ...]) on the ``step`` grid from the block's origin."""
+        """The maps (dimension, quality[, ...]) on the ``step`` grid from the block's origin."""
         z = np.ascontiguousarray(z, dtype=_float_dtype(z.dtype) if spec.reads_float32 else np.float64)
-        return np.stack(spec.grid(z, w, opts, min_valid, step, n_threads))
+        return list(spec.grid(z, w, opts, min_valid, step, n_threads))
 
     image = _prepared(image, arr, prepare)
     names: Tuple[str, ...] = ("fractal_dimension", spec.quality) + spec.extra_names(opts)
