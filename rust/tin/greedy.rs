@@ -410,9 +410,10 @@ fn prefetch_box(zq: &[f64], cols: usize, p: [(usize, usize); 3]) {
 /// `ceil((n - 1) / TILE)` tiles of nearly equal size along it (cuts at
 /// samples `i (n - 1) / k`, `i = 0..=k`), neighbouring tiles sharing their
 /// seam row or column. The tiling depends on the shape alone, never on the
-/// thread count. 256 was the faster of 256 and 512 on a 1024² fBm
-/// (`benches/bench_tin.py`): a tile's heights (0.5 MB) stay in the L2 cache.
-pub const TILE: usize = 256;
+/// thread count. 128 was the fastest of 128, 256 and 512 on a 1024² fBm and
+/// on Big Tujunga (`benches/bench_tin.py`): a tile's heights (129² float64,
+/// 130 kB) and its triangulation stay in the L2 cache.
+pub const TILE: usize = 128;
 
 /// The sample indices `0 = c_0 < c_1 < ... < c_k = n - 1` of the tile
 /// boundaries along an axis of `n` samples (see [`TILE`]).

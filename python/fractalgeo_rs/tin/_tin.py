@@ -286,9 +286,9 @@ def tin_from_dem(dem, *, max_error=None, max_triangles=None, transform=None, cel
     within ``max_error`` of the mesh or the mesh has ``max_triangles``
     triangles. Only the triangles around each new vertex are re-examined.
 
-    A DEM of more than 257 samples along a side is meshed in tiles of at most
-    257 x 257 samples (a fixed tiling by the shape alone: ``ceil((n - 1) /
-    256)`` tiles of nearly equal size along an axis of ``n`` samples,
+    A DEM of more than 129 samples along a side is meshed in tiles of at most
+    129 x 129 samples (a fixed tiling by the shape alone: ``ceil((n - 1) /
+    128)`` tiles of nearly equal size along an axis of ``n`` samples,
     neighbours sharing a seam row or column), in parallel. Every seam gets
     its vertices from the 1D simplification of its samples described under
     ``tile_edges="shared"``, so both sides have the same vertices there and
