@@ -10,8 +10,15 @@ side, offset by (37, 11) pixels inside an array of its side, and padded by
 100 pixels; the triadic Koch curve (D = log3 4) rasterised at widths 500,
 1000 and 2000 (finite sampling sets the smallest scale).
 
-Run: ``python benches/accuracy_boxcount_defaults.py`` (seconds); prints
-Markdown.
+Point sets (second table): ``fractalgeo_rs.box_counting_points(points)``
+with no options on chaos-game samples (``IFS.preset(name).chaos_game(n,
+seed)``, 10^5 points for seeds 1-3 and 10^6 for seed 1) of the Sierpinski
+triangle, carpet, triadic Koch curve and Vicsek set, against what a user of
+Moisy's ``boxcount`` would do: rasterise the points on a 1024 x 1024 grid
+over the square around their bounding box and count that image.
+
+Run: ``python benches/accuracy_boxcount_defaults.py [--no-points]`` (about
+half a minute with the point sets); prints Markdown.
 """
 from __future__ import annotations
 
@@ -23,6 +30,7 @@ import warnings
 import numpy as np
 
 import fractalgeo_rs as fg
+import fractalgeo_rs.lsystem  # noqa: F401  (rasterize_points)
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"))
 from fractals import sierpinski_carpet, sierpinski_triangle, triadic_koch_curve  # noqa: E402
@@ -69,6 +77,40 @@ def cases():
     return out
 
 
+POINT_SETS = ("sierpinski_triangle", "sierpinski_carpet", "koch_curve", "vicsek")
+
+
+def moisy_points(points: np.ndarray, side: int = 1024) -> float:
+    """Moisy's algorithm on the points rasterised on ``side x side`` cells
+    over the square around their bounding box."""
+    lo = points.min(axis=0)
+    e = float((points.max(axis=0) - lo).max())
+    mask = fg.lsystem.rasterize_points(points, side, bounds=(lo[0], lo[0] + e, lo[1], lo[1] + e))
+    return moisy_boxcount(mask.astype(bool))
+
+
+def point_table() -> None:
+    print("\n| set | points | seed | true D | box_counting_points() | error | base, lattice | sizes "
+          "| Moisy on 1024² raster | error |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    errs, merrs = [], []
+    for name in POINT_SETS:
+        ifs = fg.IFS.preset(name)
+        d = ifs.dimension
+        for n, seed in ((10**5, 1), (10**5, 2), (10**5, 3), (10**6, 1)):
+            pts = ifs.chaos_game(n, seed=seed)
+            f = fg.box_counting_points(pts)
+            m = moisy_points(pts)
+            errs.append(abs(f.dimension - d))
+            merrs.append(abs(m - d))
+            lat = f"{f.extra.get('base', '-')} {f.extra.get('lattice', '-')}"
+            print(f"| {name} | {n:.0e} | {seed} | {d:.4f} | {f.dimension:.4f} | {f.dimension - d:+.4f} | {lat} "
+                  f"| {int(np.count_nonzero(f.used))} | {m:.4f} | {m - d:+.4f} |", flush=True)
+    print(f"\nmax |error|: box_counting_points {max(errs):.4f}, Moisy on the raster {max(merrs):.4f}; "
+          f"within 0.02: {sum(e <= 0.02 for e in errs)} of {len(errs)} and {sum(e <= 0.02 for e in merrs)} "
+          f"of {len(merrs)}")
+
+
 def main() -> None:
     warnings.simplefilter("ignore")
     print("| set | true D | box_counting() | error | sizes (fitted) | lattice | Moisy boxcount | error |")
@@ -85,6 +127,8 @@ def main() -> None:
               f"| {lat} | {m:.4f} | {m - d:+.4f} |")
     print(f"\nmax |error|: box_counting {max(errs):.4f}, Moisy {max(merrs):.4f}; "
           f"within 0.02: {sum(e <= 0.02 for e in errs)} of {len(errs)} and {sum(e <= 0.02 for e in merrs)} of {len(merrs)}")
+    if "--no-points" not in sys.argv[1:]:
+        point_table()
 
 
 if __name__ == "__main__":
