@@ -613,19 +613,15 @@ fn gls_band<T: Sample>(
                 }
                 (a, b) = (r0, r0);
             }
-            let mut slide = |r: usize, sign: f64| {
+            // (a loop, not a closure: a closure would not be compiled with
+            // the AVX2 features of `gls_band_avx2`)
+            for (r, sign) in (b..rr1).map(|r| (r, 1.0)).chain((a..r0).map(|r| (r, -1.0))) {
                 let c = ct.as_deref_mut();
                 if f.n_taps == 2 {
                     slide_row::<T, 2>(zb, cols, r, f, sign, h, l, c);
                 } else {
                     slide_row::<T, 3>(zb, cols, r, f, sign, h, l, c);
                 }
-            };
-            for r in b..rr1 {
-                slide(r, 1.0);
-            }
-            for r in a..r0 {
-                slide(r, -1.0);
             }
             span[fi] = (r0, rr1.max(b));
         }
