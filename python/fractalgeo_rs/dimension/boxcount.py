@@ -318,7 +318,7 @@ def box_counting_points(
         Box sides in coordinate units. Default (see Notes): ``E / b^k`` for
         ``b`` = 2 and 3, from ``E / 4`` (``E`` the largest extent of the
         set) down to the last size whose boxes hold at least
-        :data:`POINT_MIN_OCCUPANCY` (20) points on average, counted on
+        ``POINT_MIN_OCCUPANCY`` (20) points on average, counted on
         shifted lattices; the base and lattice with the straightest
         log-log line are fitted.
     offsets, offset_reduce, scale_range, n_threads
