@@ -158,15 +158,6 @@ impl Padded<'_> {
         }
         buf
     }
-
-    /// Whether the sample at padded `(i, j)` is finite.
-    fn finite(&self, i: usize, j: usize) -> bool {
-        let b = self.border;
-        if i < b || j < b || i >= self.rows + b || j >= self.cols + b {
-            return false;
-        }
-        self.z[(i - b) * self.cols + (j - b)].is_finite()
-    }
 }
 
 /// Row buffers of [`increments`] (one set per task).
@@ -286,62 +277,148 @@ fn check(z: &ArrayView2<f64>, p: &AnalysisParams) -> CoreResult<usize> {
 }
 
 /// `numpy.interp(x, xp, fp, left, right)` for a finite `x` and an increasing
-/// `xp` (the same arithmetic: the slope of the bracketing interval times the
-/// offset from its lower end).
-pub fn interp(x: f64, xp: &[f64], fp: &[f64], left: f64, right: f64) -> f64 {
-    let n = xp.len();
-    if x < xp[0] {
-        return left;
-    }
-    if x > xp[n - 1] {
-        return right;
-    }
-    let j = xp.partition_point(|&v| v <= x) - 1;
-    if j == n - 1 || xp[j] == x {
-        return fp[j];
-    }
-    let slope = (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j]);
-    let y = slope * (x - xp[j]) + fp[j];
-    if y.is_nan() {
-        let y2 = slope * (x - xp[j + 1]) + fp[j + 1];
-        if y2.is_nan() && fp[j] == fp[j + 1] {
-            return fp[j];
-        }
-        return y2;
-    }
-    y
+/// `xp`, with the same arithmetic (the slope of the bracketing interval
+/// times the offset from its lower end). The interval is found from a
+/// uniform grid of buckets over `xp` and a short scan, which gives the same
+/// interval as a binary search.
+pub struct Interp<'a> {
+    xp: &'a [f64],
+    fp: &'a [f64],
+    left: f64,
+    right: f64,
+    /// `numpy.interp`'s slopes, computed once.
+    slope: Vec<f64>,
+    per_bucket: f64,
+    /// The interval holding the lower edge of each bucket.
+    start: Vec<usize>,
 }
 
-/// Raw `H` and lag-1 variance of the interpolated sums (NaN when none).
+impl<'a> Interp<'a> {
+    /// The interpolant of `(xp, fp)`, `xp` increasing with at least 2 values.
+    pub fn new(xp: &'a [f64], fp: &'a [f64], left: f64, right: f64) -> Self {
+        let n = xp.len();
+        let m = 4 * n;
+        let per_bucket = m as f64 / (xp[n - 1] - xp[0]);
+        let start = (0..m)
+            .map(|b| {
+                let e = xp[0] + b as f64 / per_bucket;
+                xp.partition_point(|&v| v <= e).saturating_sub(1)
+            })
+            .collect();
+        let slope = (0..n - 1)
+            .map(|j| (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j]))
+            .collect();
+        Interp {
+            xp,
+            fp,
+            left,
+            right,
+            slope,
+            per_bucket,
+            start,
+        }
+    }
+
+    /// The interpolated value at `x`.
+    pub fn at(&self, x: f64) -> f64 {
+        let (xp, fp, n) = (self.xp, self.fp, self.xp.len());
+        if x < xp[0] {
+            return self.left;
+        }
+        if x > xp[n - 1] {
+            return self.right;
+        }
+        // the j with xp[j] <= x < xp[j + 1] (or j = n - 1 at the last point)
+        let b = (((x - xp[0]) * self.per_bucket) as usize).min(self.start.len() - 1);
+        let mut j = self.start[b];
+        while j > 0 && xp[j] > x {
+            j -= 1;
+        }
+        while j + 1 < n && xp[j + 1] <= x {
+            j += 1;
+        }
+        if j == n - 1 || xp[j] == x {
+            return fp[j];
+        }
+        let slope = self.slope[j];
+        let y = slope * (x - xp[j]) + fp[j];
+        if y.is_nan() {
+            let y2 = slope * (x - xp[j + 1]) + fp[j + 1];
+            if y2.is_nan() && fp[j] == fp[j + 1] {
+                return fp[j];
+            }
+            return y2;
+        }
+        y
+    }
+}
+
+/// The two interpolants of area support: `H` from the ratio, `gamma_B(1)`
+/// from `H`.
+struct AreaFit<'a> {
+    hurst_of_ratio: Interp<'a>,
+    gamma1_of_hurst: Interp<'a>,
+}
+
+impl<'a> AreaFit<'a> {
+    fn new(t: &AreaTable<'a>) -> Self {
+        let n = t.gamma1.len();
+        AreaFit {
+            hurst_of_ratio: Interp::new(t.ratio, t.hurst, -1.0, 9.0),
+            gamma1_of_hurst: Interp::new(t.hurst, t.gamma1, t.gamma1[0], t.gamma1[n - 1]),
+        }
+    }
+}
+
+/// Raw `H` and lag-1 variance from `g1` and `g2 / g1` (NaN when none).
 #[inline]
-fn fit(v: &Quadf, p: &AnalysisParams) -> (f64, f64) {
-    let g1 = v.s1 / v.c1;
-    let g2 = v.s2 / v.c2;
-    let ratio = g2 / g1;
+fn fit(g1: f64, ratio: f64, area: Option<&AreaFit>, (lo, hi): (f64, f64)) -> (f64, f64) {
     if !(ratio.is_finite() && g1 > 0.0) {
         return (f64::NAN, f64::NAN);
     }
-    match &p.area {
+    match area {
         None => (0.5 * ratio.log2(), g1),
-        Some(t) => {
-            let h = interp(ratio, t.ratio, t.hurst, -1.0, 9.0);
-            let h = if h == -1.0 {
-                0.0
-            } else if h == 9.0 {
-                2.0
-            } else {
-                h
+        Some(a) => {
+            let h = match a.hurst_of_ratio.at(ratio) {
+                -1.0 => 0.0,
+                9.0 => 2.0,
+                h => h,
             };
-            let (lo, hi) = p.hurst_range;
             let hc = h.max(lo).min(hi);
-            let g = interp(
-                hc,
-                t.hurst,
-                t.gamma1,
-                t.gamma1[0],
-                t.gamma1[t.gamma1.len() - 1],
-            );
-            (h, g1 / g)
+            (h, g1 / a.gamma1_of_hurst.at(hc))
+        }
+    }
+}
+
+/// The four interpolated sums along a row (one vector each).
+#[derive(Default)]
+struct Sums {
+    s1: Vec<f64>,
+    c1: Vec<f64>,
+    s2: Vec<f64>,
+    c2: Vec<f64>,
+}
+
+impl Sums {
+    /// The first `n` values of `s1, c1, s2, c2`.
+    fn slices(&self, n: usize) -> (&[f64], &[f64], &[f64], &[f64]) {
+        (&self.s1[..n], &self.c1[..n], &self.s2[..n], &self.c2[..n])
+    }
+
+    /// Node row `nrow` (nodes `la ..`) interpolated to the columns
+    /// `t .. t + oc`.
+    fn along_columns(&mut self, nrow: &[Quad], la: usize, t: usize, oc: usize, step: usize) {
+        for v in [&mut self.s1, &mut self.c1, &mut self.s2, &mut self.c2] {
+            v.clear();
+        }
+        for px in t..t + oc {
+            let l = px / step - la;
+            let (a, b) = (Quadf::from(&nrow[l]), Quadf::from(&nrow[l + 1]));
+            let v = Quadf::lerp(&a, &b, (px % step) as f64 / step as f64);
+            self.s1.push(v.s1);
+            self.c1.push(v.c1);
+            self.s2.push(v.s2);
+            self.c2.push(v.c2);
         }
     }
 }
@@ -439,55 +516,71 @@ pub fn local_maps(z: ArrayView2<f64>, p: &AnalysisParams) -> CoreResult<LocalMap
             }
         },
     );
-    // Interpolation to the pixels and the fit, in groups of `step` rows
-    // between two node rows.
+    // Interpolation to the pixels (node rows along the columns, then
+    // between node rows) and the fit, in groups of `step` rows between two
+    // node rows.
     let (lo, hi) = p.hurst_range;
-    let u_of = |r: usize| (r % step) as f64 / step as f64;
+    let area = p.area.as_ref().map(AreaFit::new);
     let mut hurst = hurst;
     let mut sigma = sigma;
     let (n_clipped, n_valid) = hurst
         .par_chunks_mut(step * oc)
         .zip(sigma.par_chunks_mut(step * oc))
         .enumerate()
-        .map(|(g, (hrows, srows))| {
-            let col_interp = |k: usize| -> Vec<Quadf> {
-                let nrow = &nodes[(k - ka) * nl..(k - ka + 1) * nl];
-                (0..oc)
-                    .map(|x| {
-                        let px = t + x;
-                        let l = px / step - la;
-                        Quadf::lerp(&(&nrow[l]).into(), &(&nrow[l + 1]).into(), u_of(px))
-                    })
-                    .collect()
-            };
-            let k = t / step + g;
-            let (v0, v1) = (col_interp(k), col_interp(k + 1));
-            let (mut nc, mut nv) = (0u64, 0u64);
-            for (r, (hrow, srow)) in hrows.chunks_mut(oc).zip(srows.chunks_mut(oc)).enumerate() {
-                let py = t + g * step + r;
-                let u = u_of(py);
-                for x in 0..oc {
-                    let v = Quadf::lerp(&v0[x], &v1[x], u);
-                    let (h, var1) = if pad.finite(py, t + x) {
-                        fit(&v, p)
-                    } else {
-                        (f64::NAN, f64::NAN)
-                    };
-                    if h.is_finite() {
-                        nv += 1;
-                        if h < lo || h > hi {
-                            nc += 1;
+        .map_init(
+            || {
+                (
+                    Sums::default(),
+                    Sums::default(),
+                    vec![0.0; oc],
+                    vec![0.0; oc],
+                    Vec::new(),
+                )
+            },
+            |(v0, v1, g1, ratio, zbuf), (g, (hrows, srows))| {
+                let k = t / step + g;
+                let node_row = |k: usize| &nodes[(k - ka) * nl..(k - ka + 1) * nl];
+                v0.along_columns(node_row(k), la, t, oc, step);
+                v1.along_columns(node_row(k + 1), la, t, oc, step);
+                let (mut nc, mut nv) = (0u64, 0u64);
+                let rows = hrows.chunks_mut(oc).zip(srows.chunks_mut(oc));
+                for (r, (hrow, srow)) in rows.enumerate() {
+                    let py = t + g * step + r;
+                    let u = (py % step) as f64 / step as f64;
+                    let w = 1.0 - u;
+                    let (g1, ratio) = (&mut g1[..oc], &mut ratio[..oc]);
+                    let (a, b) = (v0.slices(oc), v1.slices(oc));
+                    for x in 0..oc {
+                        let s1 = a.0[x] * w + b.0[x] * u;
+                        let c1 = a.1[x] * w + b.1[x] * u;
+                        let s2 = a.2[x] * w + b.2[x] * u;
+                        let c2 = a.3[x] * w + b.3[x] * u;
+                        // g2 / g1 with one division: NaN when either count
+                        // or s1 is 0, as (s2 / c2) / (s1 / c1) is
+                        g1[x] = s1 / c1;
+                        ratio[x] = (s2 * c1) / (c2 * s1);
+                    }
+                    let zrow = &pad.row(py, zbuf)[t..t + oc];
+                    for x in 0..oc {
+                        let (h, var1) = if zrow[x].is_finite() {
+                            fit(g1[x], ratio[x], area.as_ref(), p.hurst_range)
+                        } else {
+                            (f64::NAN, f64::NAN)
+                        };
+                        if h.is_finite() {
+                            nv += 1;
+                            nc += u64::from(h < lo || h > hi);
+                            hrow[x] = h.max(lo).min(hi);
+                            srow[x] = if var1.is_finite() { var1.sqrt() } else { 0.0 };
+                        } else {
+                            hrow[x] = 0.5;
+                            srow[x] = 0.0;
                         }
-                        hrow[x] = h.max(lo).min(hi);
-                        srow[x] = if var1.is_finite() { var1.sqrt() } else { 0.0 };
-                    } else {
-                        hrow[x] = 0.5;
-                        srow[x] = 0.0;
                     }
                 }
-            }
-            (nc, nv)
-        })
+                (nc, nv)
+            },
+        )
         .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
     Ok(LocalMaps {
         hurst: Array2::from_shape_vec((or, oc), hurst).map_err(internal)?,
@@ -710,12 +803,36 @@ mod tests {
     fn interp_is_numpys() {
         let xp = [0.0, 1.0, 3.0];
         let fp = [10.0, 20.0, 0.0];
-        assert_eq!(interp(-0.5, &xp, &fp, -1.0, 9.0), -1.0);
-        assert_eq!(interp(3.5, &xp, &fp, -1.0, 9.0), 9.0);
-        assert_eq!(interp(3.0, &xp, &fp, -1.0, 9.0), 0.0);
-        assert_eq!(interp(1.0, &xp, &fp, -1.0, 9.0), 20.0);
-        assert_eq!(interp(0.5, &xp, &fp, -1.0, 9.0), 15.0);
-        assert_eq!(interp(2.0, &xp, &fp, -1.0, 9.0), 10.0);
+        let f = Interp::new(&xp, &fp, -1.0, 9.0);
+        for (x, y) in [
+            (-0.5, -1.0),
+            (3.5, 9.0),
+            (3.0, 0.0),
+            (1.0, 20.0),
+            (0.5, 15.0),
+            (2.0, 10.0),
+        ] {
+            assert_eq!(f.at(x), y, "{x}");
+        }
+        // the buckets give the interval of a binary search
+        let xp: Vec<f64> = (0..50).map(|k| (k as f64 * 0.3).exp()).collect();
+        let fp: Vec<f64> = xp.iter().map(|x| x.sqrt()).collect();
+        let f = Interp::new(&xp, &fp, -1.0, 9.0);
+        for x in (0..4000).map(|k| k as f64 * 0.7).chain(xp.iter().copied()) {
+            let y = if x < xp[0] {
+                -1.0
+            } else if x > xp[49] {
+                9.0
+            } else {
+                let j = xp.partition_point(|&v| v <= x) - 1;
+                if j == 49 || xp[j] == x {
+                    fp[j]
+                } else {
+                    (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j]) * (x - xp[j]) + fp[j]
+                }
+            };
+            assert_eq!(f.at(x), y, "{x}");
+        }
     }
 
     #[test]
