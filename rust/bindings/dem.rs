@@ -116,7 +116,7 @@ fn fractal_resample<'py>(
 /// `table = (hurst, ratio, gamma1)` selects area support.
 #[pyfunction]
 #[pyo3(signature = (dem, half, step, border, hurst_range, table=None, n_threads=None))]
-#[allow(clippy::type_complexity)]
+#[allow(clippy::type_complexity, clippy::too_many_arguments)]
 fn resample_local_maps<'py>(
     py: Python<'py>,
     dem: PyReadonlyArray2<'py, f64>,

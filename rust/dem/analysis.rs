@@ -320,6 +320,7 @@ impl<'a> Interp<'a> {
     }
 
     /// The interpolated value at `x`.
+    #[inline]
     pub fn at(&self, x: f64) -> f64 {
         let (xp, fp, n) = (self.xp, self.fp, self.xp.len());
         if x < xp[0] {
@@ -330,7 +331,10 @@ impl<'a> Interp<'a> {
         }
         // the j with xp[j] <= x < xp[j + 1] (or j = n - 1 at the last point)
         let b = (((x - xp[0]) * self.per_bucket) as usize).min(self.start.len() - 1);
+        // buckets are narrower than the intervals of the tables used here:
+        // one step at most (without a branch); the loops cover any other xp
         let mut j = self.start[b];
+        j += usize::from(j + 1 < n && xp[j + 1] <= x);
         while j > 0 && xp[j] > x {
             j -= 1;
         }
