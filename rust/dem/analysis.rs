@@ -144,62 +144,71 @@ impl Padded<'_> {
         self.cols + 2 * self.border
     }
 
-    /// Row `i` (padded index) with its border, in `buf` when it has one.
-    fn row<'s>(&'s self, i: usize, buf: &'s mut Vec<f64>) -> &'s [f64] {
+    /// Row `i` (padded index) with its border and 2 more NaN at the end
+    /// into `buf` (rows past the last are NaN).
+    fn row_into(&self, i: usize, buf: &mut Vec<f64>) {
         let b = self.border;
-        if b == 0 {
-            return &self.z[i * self.cols..(i + 1) * self.cols];
-        }
         buf.clear();
-        buf.resize(self.n_cols(), f64::NAN);
+        buf.resize(self.n_cols() + 2, f64::NAN);
         if i >= b && i < self.rows + b {
             let r = i - b;
             buf[b..b + self.cols].copy_from_slice(&self.z[r * self.cols..(r + 1) * self.cols]);
         }
-        buf
     }
 }
 
-/// Row buffers of [`increments`] (one set per task).
+/// Rows `first, first + 1, first + 2` of the input, as [`increments`] reads
+/// them (one set per task; moving down one row copies one row).
 #[derive(Default)]
 struct RowBufs {
     r: [Vec<f64>; 3],
+    first: Option<usize>,
+}
+
+impl RowBufs {
+    fn load(&mut self, p: &Padded, i: usize) {
+        match self.first {
+            Some(f) if f == i => {}
+            Some(f) if f + 1 == i => {
+                self.r.rotate_left(1);
+                p.row_into(i + 2, &mut self.r[2]);
+            }
+            _ => {
+                for (k, buf) in self.r.iter_mut().enumerate() {
+                    p.row_into(i + k, buf);
+                }
+            }
+        }
+        self.first = Some(i);
+    }
 }
 
 /// The squared increments (each assigned to its first sample) of padded row
-/// `i`, rows then columns, into `out`.
+/// `i`, rows then columns, into `out` (the sums are `0 + row + column`,
+/// absent pairs adding 0, as the numpy reference forms them).
 fn increments(p: &Padded, i: usize, bufs: &mut RowBufs, out: &mut [Quad]) {
-    let n = p.n_rows();
-    let [b0, b1, b2] = &mut bufs.r;
-    let r0 = p.row(i, b0);
-    let r1 = (i + 1 < n).then(|| p.row(i + 1, b1));
-    let r2 = (i + 2 < n).then(|| p.row(i + 2, b2));
-    let m = r0.len();
+    bufs.load(p, i);
+    let m = out.len();
+    let [r0, r1, r2] = &bufs.r;
+    let (r0, r1, r2) = (&r0[..m + 2], &r1[..m], &r2[..m]);
     for (j, q) in out.iter_mut().enumerate() {
         let a = r0[j];
-        *q = Quad::default();
-        if !a.is_finite() {
-            continue;
-        }
-        let pair = |b: f64, s: &mut f64, c: &mut u32| {
-            if b.is_finite() {
-                let d = b - a;
-                *s += d * d;
-                *c += 1;
+        let sq = |b: f64| {
+            let d = b - a;
+            if a.is_finite() && b.is_finite() {
+                (d * d, 1)
+            } else {
+                (0.0, 0)
             }
         };
-        if let Some(r1) = r1 {
-            pair(r1[j], &mut q.s1, &mut q.c1);
-        }
-        if let Some(r2) = r2 {
-            pair(r2[j], &mut q.s2, &mut q.c2);
-        }
-        if j + 1 < m {
-            pair(r0[j + 1], &mut q.s1, &mut q.c1);
-        }
-        if j + 2 < m {
-            pair(r0[j + 2], &mut q.s2, &mut q.c2);
-        }
+        let ((v1, n1), (h1, m1)) = (sq(r1[j]), sq(r0[j + 1]));
+        let ((v2, n2), (h2, m2)) = (sq(r2[j]), sq(r0[j + 2]));
+        *q = Quad {
+            s1: v1 + h1,
+            s2: v2 + h2,
+            c1: n1 + m1,
+            c2: n2 + m2,
+        };
     }
 }
 
@@ -564,7 +573,8 @@ pub fn local_maps(z: ArrayView2<f64>, p: &AnalysisParams) -> CoreResult<LocalMap
                         g1[x] = s1 / c1;
                         ratio[x] = (s2 * c1) / (c2 * s1);
                     }
-                    let zrow = &pad.row(py, zbuf)[t..t + oc];
+                    pad.row_into(py, zbuf);
+                    let zrow = &zbuf[t..t + oc];
                     for x in 0..oc {
                         let (h, var1) = if zrow[x].is_finite() {
                             fit(g1[x], ratio[x], area.as_ref(), p.hurst_range)
