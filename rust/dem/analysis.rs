@@ -228,6 +228,9 @@ fn add_into(acc: &mut [Quad], v: &[Quad]) {
     }
 }
 
+/// Largest window half side, node step or border accepted (cells).
+const MAX_CELLS: usize = 1 << 30;
+
 fn check(z: &ArrayView2<f64>, p: &AnalysisParams) -> CoreResult<usize> {
     if p.half == 0 {
         return Err(CoreError::invalid(
@@ -240,6 +243,15 @@ fn check(z: &ArrayView2<f64>, p: &AnalysisParams) -> CoreResult<usize> {
             "step",
             "expected a positive integer, got 0",
         ));
+    }
+    // the halo and the block sizes below stay far from overflowing
+    for (name, v) in [("half", p.half), ("step", p.step), ("border", p.border)] {
+        if v > MAX_CELLS {
+            return Err(CoreError::invalid(
+                name,
+                format!("expected at most {MAX_CELLS} cells, got {v}"),
+            ));
+        }
     }
     let (lo, hi) = p.hurst_range;
     if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
@@ -880,7 +892,11 @@ mod tests {
             .to_string();
         assert!(e.starts_with("dem: "), "{e}");
         let z = Array2::<f64>::zeros((60, 60));
-        for (half, step, name) in [(0, 8, "half: "), (2, 0, "step: ")] {
+        for (half, step, name) in [
+            (0, 8, "half: "),
+            (2, 0, "step: "),
+            (usize::MAX - 1, 8, "half: "),
+        ] {
             let e = local_maps(z.view(), &params(half, step, None))
                 .unwrap_err()
                 .to_string();
