@@ -57,6 +57,7 @@ __all__ = [
     "write_mesh",
     "write_png",
     "resample_stencil",
+    "resample_local_maps",
     "RESAMPLE_HALO",
     "tin_delaunay",
     "tin_greedy",
@@ -389,6 +390,17 @@ def fractal_resample(
 def resample_stencil(
     which: int, hurst: float
 ) -> Tuple[list[float], float, list[Tuple[int, int]]]: ...
+def resample_local_maps(
+    dem: npt.NDArray[np.float64],
+    half: int,
+    step: int,
+    border: int,
+    hurst_range: Tuple[float, float],
+    table: Optional[
+        Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]
+    ] = None,
+    n_threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], int, int]: ...
 def tin_delaunay(
     points: npt.NDArray[np.float64],
     constraints: Optional[npt.NDArray[np.int64]] = None,

@@ -1,9 +1,10 @@
-//! Bindings of `crate::dem`: shaded relief and fractal resampling.
+//! Bindings of `crate::dem`: shaded relief, fractal resampling and its local analysis.
 use super::convert::{array2, c_order, run};
+use crate::dem::analysis::{self, AnalysisParams, AreaTable};
 use crate::dem::hillshade::{self, ShadeParams};
 use crate::dem::resample::{self, ResampleParams, Support};
 use crate::error::CoreError;
-use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 /// Hillshade in [0, 1] (NaN = nodata); `dx` per row, `dy` scalar.
@@ -109,6 +110,56 @@ fn fractal_resample<'py>(
     Ok(out.into_pyarray(py))
 }
 
+/// Local `H` and `sigma` maps of a DEM block with a NaN halo of
+/// `pad_width(half, step)` cells (`border` of them virtual), on the block
+/// without its halo, and the counts of clipped and of valid pixels.
+/// `table = (hurst, ratio, gamma1)` selects area support.
+#[pyfunction]
+#[pyo3(signature = (dem, half, step, border, hurst_range, table=None, n_threads=None))]
+#[allow(clippy::type_complexity, clippy::too_many_arguments)]
+fn resample_local_maps<'py>(
+    py: Python<'py>,
+    dem: PyReadonlyArray2<'py, f64>,
+    half: usize,
+    step: usize,
+    border: usize,
+    hurst_range: (f64, f64),
+    table: Option<(
+        PyReadonlyArray1<'py, f64>,
+        PyReadonlyArray1<'py, f64>,
+        PyReadonlyArray1<'py, f64>,
+    )>,
+    n_threads: Option<usize>,
+) -> PyResult<(
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    u64,
+    u64,
+)> {
+    let z = dem.as_array();
+    let t = table
+        .as_ref()
+        .map(|(h, r, g)| (c_order(h), c_order(r), c_order(g)));
+    let p = AnalysisParams {
+        half,
+        step,
+        border,
+        hurst_range,
+        area: t.as_ref().map(|(h, r, g)| AreaTable {
+            hurst: &h.data,
+            ratio: &r.data,
+            gamma1: &g.data,
+        }),
+    };
+    let m = run(py, n_threads, || analysis::local_maps(z, &p))?;
+    Ok((
+        m.hurst.into_pyarray(py),
+        m.sigma.into_pyarray(py),
+        m.n_clipped,
+        m.n_valid,
+    ))
+}
+
 /// Full-stencil kriging weights (16) and residual standard deviation (unit
 /// sigma, coarse spacing 1) of stencil `which` (0 diamond, 1 square) at
 /// `hurst`, and the stencil's source offsets.
@@ -136,6 +187,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(hillshade_gdal_byte, m)?)?;
     m.add_function(wrap_pyfunction!(fractal_resample, m)?)?;
     m.add_function(wrap_pyfunction!(resample_stencil, m)?)?;
+    m.add_function(wrap_pyfunction!(resample_local_maps, m)?)?;
     m.add("RESAMPLE_HALO", resample::HALO)?;
     Ok(())
 }

@@ -95,7 +95,7 @@ def _run_resample(args: argparse.Namespace) -> int:
     detail = R._detail(levels, cell, args.min_scale)
     seed = resolve_seed(args.seed)
     an = R._maps(z, hurst, sigma, R._check_window(args.window), args.support,
-                 hurst == "local", sigma == "local", min(1 << levels, 8))
+                 hurst == "local", sigma == "local", min(1 << levels, 8), args.n_threads)
     from fractalgeo_rs.dem._resample_dask import run_dask
 
     out = run_dask(da.from_array(z, chunks=chunks), levels, an.hurst, an.sigma, args.window,

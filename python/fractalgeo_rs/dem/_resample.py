@@ -10,7 +10,8 @@ import numpy as np
 
 from fractalgeo_rs import _core
 from fractalgeo_rs._compat import renamed_parameters
-from fractalgeo_rs._validation import as_array, check_choice, check_memory, check_nodata, check_positive_float
+from fractalgeo_rs._validation import (as_array, check_choice, check_memory, check_n_threads, check_nodata,
+                                      check_positive_float)
 
 __all__ = ["resample_analysis", "ResampleAnalysis", "HURST_RANGE"]
 
@@ -87,6 +88,147 @@ def _pad_width(half, step=STEP):
     return -(-(half + 2 + step) // step) * step
 
 
+def _block_variogram(hurst, lag, n=2):
+    """``Var(Zbar(x + lag) - Zbar(x)) / sigma^2`` for fBm block means, each
+    block the mean of ``n x n`` points at spacing ``1/n`` (the kernel's area
+    model uses ``n = 2``); ``n = 1`` is the point variogram ``lag^(2H)``."""
+    off = (np.arange(n) - (n - 1) / 2) / n
+    yy, xx = np.meshgrid(off, off, indexing="ij")
+    p = np.stack([yy.ravel(), xx.ravel()], 1)
+
+    def gbar(d):
+        dd = p[:, None, :] - (p[None, :, :] + np.array(d))
+        r2 = (dd**2).sum(-1)
+        with np.errstate(divide="ignore"):
+            g = np.where(r2 > 0, 0.5 * r2 ** hurst[..., None, None], 0.0)
+        return g.mean((-1, -2))
+
+    return 2.0 * (gbar((0.0, lag)) - gbar((0.0, 0.0)))
+
+
+_H_TABLE = np.linspace(0.001, 1.5, 1500)
+
+
+@functools.lru_cache(maxsize=8)
+def _ratio_table(n):
+    """``(H, gamma_B(2) / gamma_B(1), gamma_B(1))`` on ``_H_TABLE``."""
+    h = _H_TABLE
+    g1 = _block_variogram(h, 1.0, n)
+    return h, _block_variogram(h, 2.0, n) / g1, g1
+
+
+def _analyse_padded(z, half, support, block=2, step=STEP, border=0, n_threads=None):
+    """Local maps ``(hurst, sigma, n_clipped, n_valid)`` of a NaN-padded
+    block whose origin is a multiple of ``step``, trimmed by
+    ``_pad_width(half, step)`` (``border`` cells of that halo are virtual:
+    not in ``z``). ``hurst`` is clipped to ``HURST_RANGE`` (0.5 where there
+    is none), ``sigma`` is 0 where there is none; ``n_clipped`` of the
+    ``n_valid`` finite raw values were outside the range. The Rust kernel
+    (``rust/dem/analysis.rs``): window sums at the nodes of a ``step`` grid,
+    each formed in a fixed order from its window only, interpolated
+    bilinearly, so any such block of a larger array gives the same bits."""
+    table = None if support == "point" else _ratio_table(block)
+    return _core.resample_local_maps(z, half, step, border, HURST_RANGE, table, n_threads)
+
+
+def _check_window(window, shape=None):
+    if isinstance(window, bool) or not isinstance(window, numbers.Integral):
+        raise TypeError(f"window_size: expected an odd int >= 5, got {window!r}")
+    if window < 5 or window % 2 == 0:
+        raise ValueError(f"window_size: expected an odd int >= 5, got {window}")
+    if shape is not None and window > 2 * max(shape) + 1:
+        raise ValueError(f"window_size: {window} is more than twice the DEM's side {max(shape)}; "
+                         f"a window of at most {2 * max(shape) + 1} already covers it")
+    return int(window)
+
+
+@renamed_parameters({"window": "window_size"}, since="0.2.0")
+def resample_analysis(dem, *, window_size=33, support="point", block=2, nodata=None, n_threads=None):
+    r"""Local Hurst exponent and increment scale of a DEM.
+
+    Over each ``window_size x window_size`` window, the mean squared increments at lags
+    1 and 2 cells (rows and columns pooled, NaN-free pairs only) give
+    :math:`H = \tfrac12 \log_2(\gamma_2 / \gamma_1)` and
+    :math:`\sigma^2 = \gamma_1`: the variogram map of
+    :func:`fractalgeo_rs.fractal_transform` with ``method="variogram"`` and
+    ``lags=(1, 2)`` (``D = 3 - H``). With ``support="area"`` the cells are
+    taken as block means: ``H`` inverts the ratio of the block-mean
+    variogram (blocks of 2 x 2 points at spacing 1/2, the model of the
+    resampling kernel) and :math:`\sigma^2 = \gamma_1 / \bar\gamma_B(1; H)`.
+    ``H`` is clipped to ``HURST_RANGE`` (0.05, 0.95) with a warning giving
+    the fraction clipped.
+
+    Parameters
+    ----------
+    dem : array_like, shape (rows, cols)
+        Heights; NaN and ``nodata`` are missing. Not modified.
+    window_size : int, default 33
+        Odd window side in cells (>= 5). (Called ``window`` before 0.2.0;
+        the old keyword still works, with a DeprecationWarning.)
+    support : {"point", "area"}, default "point"
+        ``"point"``: the heights are point samples; ``"area"``: each cell is
+        the mean height over its area (block-mean variogram model).
+    block : int, default 2
+        ``support="area"``: the block mean is modelled by ``block x block``
+        points at spacing ``1 / block`` of a cell.
+    nodata : float, optional
+        Height value meaning "no data" (NaN is always missing).
+    n_threads : int, optional
+        Threads (default all cores); the maps do not depend on it.
+
+    Returns
+    -------
+    ResampleAnalysis
+
+    References
+    ----------
+    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
+    dimension: assessing the roughness of time series and spatial data,
+    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+
+    Examples
+    --------
+    >>> import numpy as np, fractalgeo_rs as fg
+    >>> z = fg.fbm_surface(128, 0.6, method="exact", seed=3)
+    >>> a = fg.dem.resample_analysis(z, window_size=33)
+    >>> round(float(a.hurst[64, 64]), 3), round(float(np.median(a.hurst)), 3)  # fBm of H = 0.6
+    (0.593, 0.584)
+    """
+    check_choice(support, "support", ("point", "area"))
+    n_threads = check_n_threads(n_threads)
+    z = _as_float(dem, nodata)
+    window = _check_window(window_size, z.shape)
+    half = window // 2
+    hurst, sigma, n_clip, n_ok = _analyse_padded(z, half, support, block, border=_pad_width(half),
+                                                 n_threads=n_threads)
+    frac = n_clip / n_ok if n_ok else 0.0
+    _warn_clipped(frac)
+    return ResampleAnalysis(hurst, sigma, frac, window)
+
+
+def _warn_clipped(frac):
+    if frac > 0:
+        warnings.warn(f"hurst: {100 * frac:.2g} % of the local H values were outside "
+                      f"{HURST_RANGE} and were clipped", RuntimeWarning, stacklevel=3)
+
+
+def _as_float(dem, nodata):
+    z = as_array(dem, "dem")
+    if z.ndim != 2:
+        raise ValueError(f"dem: expected a 2D array, got shape {z.shape}")
+    if not (np.issubdtype(z.dtype, np.number) and not np.issubdtype(z.dtype, np.complexfloating)):
+        raise TypeError(f"dem: expected a real numeric array, got dtype {z.dtype}")
+    # No copy unless needed: nothing downstream writes into ``z``.
+    z = np.ascontiguousarray(z, dtype=np.float64)
+    nodata = check_nodata(nodata)
+    if nodata is not None and not np.isnan(nodata):
+        z = np.where(z == nodata, np.nan, z)
+    return z
+
+
+# ------------------------------------------------------- numpy reference --
+# The analysis in numpy, for the tests and the benchmark only.
+
 def _node_sums(a, half, step):
     """Sums along axis 0 over rows ``[p - half, p + half]`` at the nodes
     ``p = k step`` whose window fits in ``a``; returns ``(sums, k_first)``.
@@ -141,39 +283,10 @@ def _box_sum(a, half, t, step=STEP):
     return _interp_nodes(np.ascontiguousarray(v), k0, t, a.shape[0] - t, step)
 
 
-def _block_variogram(hurst, lag, n=2):
-    """``Var(Zbar(x + lag) - Zbar(x)) / sigma^2`` for fBm block means, each
-    block the mean of ``n x n`` points at spacing ``1/n`` (the kernel's area
-    model uses ``n = 2``); ``n = 1`` is the point variogram ``lag^(2H)``."""
-    off = (np.arange(n) - (n - 1) / 2) / n
-    yy, xx = np.meshgrid(off, off, indexing="ij")
-    p = np.stack([yy.ravel(), xx.ravel()], 1)
-
-    def gbar(d):
-        dd = p[:, None, :] - (p[None, :, :] + np.array(d))
-        r2 = (dd**2).sum(-1)
-        with np.errstate(divide="ignore"):
-            g = np.where(r2 > 0, 0.5 * r2 ** hurst[..., None, None], 0.0)
-        return g.mean((-1, -2))
-
-    return 2.0 * (gbar((0.0, lag)) - gbar((0.0, 0.0)))
-
-
-_H_TABLE = np.linspace(0.001, 1.5, 1500)
-
-
-@functools.lru_cache(maxsize=8)
-def _ratio_table(n):
-    """``(H, gamma_B(2) / gamma_B(1), gamma_B(1))`` on ``_H_TABLE``."""
-    h = _H_TABLE
-    g1 = _block_variogram(h, 1.0, n)
-    return h, _block_variogram(h, 2.0, n) / g1, g1
-
-
-def _analyse_padded(z, half, support, block=2, step=STEP):
-    """Local maps on a NaN-padded block whose origin is a multiple of
-    ``step``; returns raw H and the lag-1 point variance, both trimmed by
-    ``_pad_width(half, step)``."""
+def _analyse_padded_reference(z, half, support, block=2, step=STEP):
+    """numpy twin of :func:`_analyse_padded` (the same window sums, interpolation
+    and fit in the same order), kept as the reference the kernel is tested
+    and benchmarked against; returns the same four values."""
     t = _pad_width(half, step)
     m = np.isfinite(z)
     zz = np.where(m, z, 0.0)
@@ -215,110 +328,19 @@ def _analyse_padded(z, half, support, block=2, step=STEP):
         var1 = np.where(ok, g1 / np.interp(hc, hh, g1tab), np.nan)
     # An interior pixel of the core is only valid if it was a valid sample.
     hraw = np.where(m[core], hraw, np.nan)
-    return hraw, var1
+    return _finish(hraw, var1)
 
 
-def _finish(hraw, var1, valid):
+def _finish(hraw, var1):
+    """Clipped H (0.5 where none), sigma (0 where none) and the counts."""
     ok = np.isfinite(hraw)
     lo, hi = HURST_RANGE
     n_clip = int(np.count_nonzero(ok & ((hraw < lo) | (hraw > hi))))
-    n_ok = int(np.count_nonzero(ok & valid))
+    n_ok = int(np.count_nonzero(ok))
     hurst = np.where(ok, np.clip(np.where(ok, hraw, 0.5), lo, hi), 0.5)
     sigma = np.where(np.isfinite(var1) & ok, np.sqrt(np.where(np.isfinite(var1), var1, 0.0)), 0.0)
-    return hurst, sigma, (n_clip / n_ok if n_ok else 0.0)
+    return hurst, sigma, n_clip, n_ok
 
-
-def _check_window(window, shape=None):
-    if isinstance(window, bool) or not isinstance(window, numbers.Integral):
-        raise TypeError(f"window_size: expected an odd int >= 5, got {window!r}")
-    if window < 5 or window % 2 == 0:
-        raise ValueError(f"window_size: expected an odd int >= 5, got {window}")
-    if shape is not None and window > 2 * max(shape) + 1:
-        raise ValueError(f"window_size: {window} is more than twice the DEM's side {max(shape)}; "
-                         f"a window of at most {2 * max(shape) + 1} already covers it")
-    return int(window)
-
-
-@renamed_parameters({"window": "window_size"}, since="0.2.0")
-def resample_analysis(dem, *, window_size=33, support="point", block=2, nodata=None):
-    r"""Local Hurst exponent and increment scale of a DEM.
-
-    Over each ``window_size x window_size`` window, the mean squared increments at lags
-    1 and 2 cells (rows and columns pooled, NaN-free pairs only) give
-    :math:`H = \tfrac12 \log_2(\gamma_2 / \gamma_1)` and
-    :math:`\sigma^2 = \gamma_1`: the variogram map of
-    :func:`fractalgeo_rs.fractal_transform` with ``method="variogram"`` and
-    ``lags=(1, 2)`` (``D = 3 - H``). With ``support="area"`` the cells are
-    taken as block means: ``H`` inverts the ratio of the block-mean
-    variogram (blocks of 2 x 2 points at spacing 1/2, the model of the
-    resampling kernel) and :math:`\sigma^2 = \gamma_1 / \bar\gamma_B(1; H)`.
-    ``H`` is clipped to ``HURST_RANGE`` (0.05, 0.95) with a warning giving
-    the fraction clipped.
-
-    Parameters
-    ----------
-    dem : array_like, shape (rows, cols)
-        Heights; NaN and ``nodata`` are missing. Not modified.
-    window_size : int, default 33
-        Odd window side in cells (>= 5). (Called ``window`` before 0.2.0;
-        the old keyword still works, with a DeprecationWarning.)
-    support : {"point", "area"}, default "point"
-        ``"point"``: the heights are point samples; ``"area"``: each cell is
-        the mean height over its area (block-mean variogram model).
-    block : int, default 2
-        ``support="area"``: the block mean is modelled by ``block x block``
-        points at spacing ``1 / block`` of a cell.
-    nodata : float, optional
-        Height value meaning "no data" (NaN is always missing).
-
-    Returns
-    -------
-    ResampleAnalysis
-
-    References
-    ----------
-    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
-    dimension: assessing the roughness of time series and spatial data,
-    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
-
-    Examples
-    --------
-    >>> import numpy as np, fractalgeo_rs as fg
-    >>> z = fg.fbm_surface(128, 0.6, method="exact", seed=3)
-    >>> a = fg.dem.resample_analysis(z, window_size=33)
-    >>> round(float(a.hurst[64, 64]), 3), round(float(np.median(a.hurst)), 3)  # fBm of H = 0.6
-    (0.593, 0.584)
-    """
-    check_choice(support, "support", ("point", "area"))
-    z = _as_float(dem, nodata)
-    window = _check_window(window_size, z.shape)
-    half = window // 2
-    t = _pad_width(half)
-    zp = np.pad(z, t, constant_values=np.nan)
-    hraw, var1 = _analyse_padded(zp, half, support, block)
-    hurst, sigma, frac = _finish(hraw, var1, np.isfinite(z))
-    _warn_clipped(frac)
-    return ResampleAnalysis(hurst, sigma, frac, window)
-
-
-def _warn_clipped(frac):
-    if frac > 0:
-        warnings.warn(f"hurst: {100 * frac:.2g} % of the local H values were outside "
-                      f"{HURST_RANGE} and were clipped", RuntimeWarning, stacklevel=3)
-
-
-def _as_float(dem, nodata):
-    z = as_array(dem, "dem")
-    if z.ndim != 2:
-        raise ValueError(f"dem: expected a 2D array, got shape {z.shape}")
-    if not (np.issubdtype(z.dtype, np.number) and not np.issubdtype(z.dtype, np.complexfloating)):
-        raise TypeError(f"dem: expected a real numeric array, got dtype {z.dtype}")
-    # No copy unless needed: nothing downstream writes into ``z``.
-    z = np.ascontiguousarray(z, dtype=np.float64)
-    nodata = check_nodata(nodata)
-    if nodata is not None and not np.isnan(nodata):
-        z = np.where(z == nodata, np.nan, z)
-    return z
 
 
 # ------------------------------------------------------------------- main --
@@ -414,7 +436,7 @@ def run_numpy(dem, levels, hurst, sigma, window, detail, support, nodata, seed, 
     _check_memory(z.shape, 1 << levels)
     local_h = isinstance(hurst, str) and hurst == "local"
     local_s = isinstance(sigma, str) and sigma == "local"
-    an = _maps(z, hurst, sigma, window, support, local_h, local_s, min(1 << levels, 8))
+    an = _maps(z, hurst, sigma, window, support, local_h, local_s, min(1 << levels, 8), n_threads)
     h, s = an.hurst, an.sigma
     if h.strides == (0, 0) and s.strides == (0, 0):
         # Constant maps: the kernel takes them as 1 x 1.
@@ -429,10 +451,10 @@ def _check_shape(shape):
         raise ValueError(f"dem: the kriging stencil needs at least 4 x 4 samples, got {shape}")
 
 
-def _maps(z, hurst, sigma, window, support, local_h, local_s, block=2):
+def _maps(z, hurst, sigma, window, support, local_h, local_s, block=2, n_threads=None):
     frac = 0.0
     if local_h or local_s:
-        a = resample_analysis(z, window_size=window, support=support, block=block)
+        a = resample_analysis(z, window_size=window, support=support, block=block, n_threads=n_threads)
         h_map, s_map, frac = a.hurst, a.sigma, a.fraction_clipped
     h = h_map if local_h else _param_map(hurst, "hurst", z.shape, 0.0, 1.0, True, True)
     s = s_map if local_s else _param_map(sigma, "sigma", z.shape, 0.0, np.inf, False, False)

@@ -16,7 +16,7 @@ def _out_bounds(a, b, n, f, point):
     return f * a, f * b
 
 
-def _analysis_maps(dem, hurst, sigma, window, support, nodata, block=2):
+def _analysis_maps(dem, hurst, sigma, window, support, nodata, block=2, n_threads=None):
     """Hurst and sigma maps as dask arrays chunked like ``dem``."""
     import dask.array as da
 
@@ -27,9 +27,7 @@ def _analysis_maps(dem, hurst, sigma, window, support, nodata, block=2):
         t = R._pad_width(half)
 
         def block_fn(b):
-            hraw, var1 = R._analyse_padded(b, half, support, block)
-            core = b[t:-t, t:-t] if t else b
-            h, s, _ = R._finish(hraw, var1, np.isfinite(core))
+            h, s, _, _ = R._analyse_padded(b, half, support, block, n_threads=n_threads)
             return np.stack([h, s])
 
         z = dem.map_blocks(R._as_float, nodata, dtype=np.float64)
@@ -57,7 +55,7 @@ def run_dask(dem, levels, hurst, sigma, window, detail, support, nodata, seed, n
     R._check_shape(dem.shape)
     f = 1 << levels
     point = support == "point"
-    h_map, s_map = _analysis_maps(dem, hurst, sigma, window, support, nodata, min(f, 8))
+    h_map, s_map = _analysis_maps(dem, hurst, sigma, window, support, nodata, min(f, 8), n_threads)
     n0, n1 = dem.shape
     halo = R._HALO
     row_edges = np.concatenate([[0], np.cumsum(dem.chunks[0])])
