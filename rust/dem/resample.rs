@@ -744,13 +744,15 @@ fn level_point(
                 } else if row_inside && j >= 3 && j + 3 < fc {
                     pc.update(full, h, s);
                     let c0 = i * fc + j;
+                    // Every stencil offset has |dr|, |dc| <= 3.
+                    assert!(c0 >= 3 * fc + 3 && c0 + 3 * fc + 3 < len);
                     let mut acc = 0.0;
                     for (w, &o) in pc.w.iter().zip(&offs) {
                         let k = c0.wrapping_add_signed(o);
-                        assert!(k < len);
-                        // SAFETY: k < len (asserted: the target is 3 cells
-                        // away from every edge and |dr|, |dc| <= 3), and the
-                        // cell is not written in this phase.
+                        debug_assert!(k < len);
+                        // SAFETY: k lies within 3 rows and 3 columns of c0,
+                        // inside the buffer (asserted above), and the cell is
+                        // not written in this phase.
                         acc += w * unsafe { *base.add(k) };
                     }
                     acc + pc.noise(&key, g0, g1, gcols, i, j)
