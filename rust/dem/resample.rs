@@ -565,18 +565,25 @@ where
     (0..rows)
         .into_par_iter()
         .fold(BTreeSet::new, |mut set, i| {
-            let row_inside = i >= reach && i + reach < g.rows;
-            for j in targets(i) {
-                if !any_nan && row_inside {
-                    if j >= reach && j + reach < g.cols {
-                        continue;
-                    }
-                } else if !any_nan && g.interior(i, j, reach) {
-                    continue;
-                }
+            let mut add = |j: usize| {
                 let (m, hole) = g.mask(st, i, j);
                 if !hole && m != st.all() {
                     set.insert(m);
+                }
+            };
+            if !any_nan && i >= reach && i + reach < g.rows {
+                // Only the targets near the left and right edges are cut.
+                let cols = g.cols;
+                targets(i).take_while(|&j| j < reach).for_each(&mut add);
+                targets(i)
+                    .rev()
+                    .take_while(|&j| j >= reach && j + reach >= cols)
+                    .for_each(&mut add);
+            } else {
+                for j in targets(i) {
+                    if any_nan || !g.interior(i, j, reach) {
+                        add(j);
+                    }
                 }
             }
             set
