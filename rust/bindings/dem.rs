@@ -161,8 +161,9 @@ fn resample_local_maps<'py>(
 }
 
 /// Full-stencil kriging weights (16) and residual standard deviation (unit
-/// sigma, coarse spacing 1) of stencil `which` (0 diamond, 1 square) at
-/// `hurst`, and the stencil's source offsets.
+/// sigma, coarse spacing 1) of stencil `which` (0 diamond, 1 square) in its
+/// first phase (no same-step neighbours) at `hurst`, and the stencil's
+/// source offsets.
 #[pyfunction]
 #[allow(clippy::type_complexity)]
 fn resample_stencil(

@@ -34,14 +34,18 @@ def fractal_resample(dem, factor=2, *, hurst="local", sigma="local", window_size
     ``sigma`` (:func:`~fractalgeo_rs.dem.resample_analysis`), then refined in x2 levels. Each
     new sample is the conditional (intrinsic kriging) mean of fBm with the
     variogram :math:`\gamma(d) = \sigma^2 d^{2H} / 2` (``d`` in input cells)
-    given the 16 nearest samples of the current level, plus an independent
-    Gaussian residual with the kriging variance; at level ``l`` (coarse
-    spacing :math:`2^{-l}` cells) that variance scales by :math:`2^{-2Hl}`.
+    given the 16 nearest samples of the current level, plus a Gaussian
+    residual with the kriging variance; at level ``l`` (coarse spacing
+    :math:`2^{-l}` cells) that variance scales by :math:`2^{-2Hl}`.
     Point support uses the diamond step (cell centres from the 4 x 4 coarse
     samples around them) then the square step (edge midpoints from the 16
-    nearest samples of the 45-degree lattice); the weights and variances are
-    tabulated once on 201 values of ``H`` in [0.01, 0.99] and interpolated.
-    The 16-sample stencil leaves no dyadic creases (crease ratio of
+    nearest samples of the 45-degree lattice), each in four phases by the
+    parity of the new samples' positions: a sample is also conditioned on
+    its (up to 8) neighbours of the same step drawn in an earlier phase, so
+    neighbouring residuals get their conditional correlation (sequential
+    Gaussian simulation). The weights and variances are tabulated once on
+    201 values of ``H`` in [0.01, 0.99] and interpolated.
+    The stencils leave no dyadic creases (crease ratio of
     :func:`fractalgeo_rs.validate_surface` about 1.0; see
     docs/resampling.md). Pointwise the result is one sample of the
     conditional distribution, so its RMSE against the truth is about
@@ -106,7 +110,7 @@ def fractal_resample(dem, factor=2, *, hurst="local", sigma="local", window_size
     many resamplings at a new point match the exact dense kriging to within
     the tolerances stated in docs/resampling.md. xarray input returns new
     cell-centre coords; Dask input is computed chunk by chunk with a halo of
-    12 input cells (plus the analysis window) and equals the in-memory result
+    16 input cells (plus the analysis window) and equals the in-memory result
     bit for bit.
 
     References
