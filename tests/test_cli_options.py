@@ -40,7 +40,7 @@ def test_shared_options_have_one_help_text():
             first = next(a for a in p._actions if not a.option_strings)
             assert first.help == cc.INPUT_HELP, (name, first.help)
     # the options are offered where they belong
-    assert {"hillshade", "transform", "dimension"} <= set(seen["--band"])
+    assert {"hillshade", "transform", "dimension", "resample", "tin"} <= set(seen["--band"])
     assert {"hillshade", "tin"} <= set(seen["--cell-size"])
     assert len(seen["--n-threads"]) >= 5
     assert {"synth", "transform"} <= set(seen["--progress"])

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from fractalgeo_rs._cli_common import (HelpFormatter, add_cell_size, add_n_threads, add_progress,
+from fractalgeo_rs._cli_common import (HelpFormatter, add_band, add_cell_size, add_n_threads, add_progress,
                                         add_raster_io)
 
 
@@ -18,13 +18,18 @@ def add_parsers(sub) -> None:
         description="Fractal resampling (fractalgeo_rs.fractal_resample): the DEM is analysed for "
         "its local Hurst exponent and roughness and refined by --factor (a power of 2) with "
         "conditional fBm detail. The output GeoTIFF keeps the CRS; the pixel size is divided by "
-        "the factor. Computed in blocks of --chunks input cells and written block by block.",
+        "the factor. With dask installed (pip install \"fractalgeo_rs[dask]\", needed for outputs above "
+        "the memory limit) it is computed in blocks of --chunks input cells and written block by block; "
+        "without dask a result that fits in memory is computed in one piece (the same values).",
     )
     p.add_argument("input", help="input DEM (GeoTIFF or any format rasterio reads)")
-    p.add_argument("output", help="output GeoTIFF (float32, nodata NaN)")
+    p.add_argument("output", help="output GeoTIFF (.tif or .tiff; float32, nodata NaN)")
+    add_band(p)
     p.add_argument("--factor", type=int, default=2, help="refinement factor, a power of 2")
     p.add_argument("--min-scale", type=float, default=None,
-                   help="no random detail in cells smaller than this (ground units)")
+                   help="no random detail in cells smaller than this, in ground units (metres on a "
+                   "geographic grid such as EPSG:4326: the cell size in metres is the larger of its x and "
+                   "y spacings at the centre latitude)")
     p.add_argument("--seed", type=int, default=None, help="seed in [0, 2**64); None draws one")
     p.add_argument("--hurst", default="local",
                    help="Hurst exponent: 'local' (estimated in each window) or a number in (0, 1)")
@@ -66,61 +71,98 @@ def _number_or_local(v, name):
         raise ValueError(f"{name}: expected 'local' or a number, got {v!r}") from None
 
 
+def _ground_cell(tr, crs, rows):
+    """Cell size for ``min_scale`` and its unit: the transform's x spacing in
+    map units on a projected grid; on a geographic one the larger of the x
+    and y spacings in metres at the centre latitude (WGS84,
+    :func:`~fractalgeo_rs.dem.metres_per_degree`)."""
+    if crs is None or not getattr(crs, "is_geographic", False):
+        return abs(tr.a), ""
+    from fractalgeo_rs.dem import metres_per_degree
+
+    lat = tr.f + tr.e * rows / 2.0
+    if tr.b != 0 or tr.d != 0 or not -90.0 <= lat <= 90.0:
+        raise ValueError("input: a geographic grid that is rotated or has its centre outside latitude "
+                         "[-90, 90]: --min-scale needs its cell size in metres; give a projected DEM")
+    m_lat, m_lon = metres_per_degree(lat)
+    return max(abs(tr.a) * float(m_lon), abs(tr.e) * float(m_lat)), " m"
+
+
 def _run_resample(args: argparse.Namespace) -> int:
-    import dask.array as da
     import numpy as np
     import rasterio
     from rasterio.windows import Window
 
     from fractalgeo_rs import _progress
-    from fractalgeo_rs._validation import atomic_write_path, check_positive_int
+    from fractalgeo_rs._validation import MemoryLimitError, atomic_write_path, check_positive_int
     from fractalgeo_rs.dem import _resample as R
     from fractalgeo_rs.synth._common import resolve_seed
     from fractalgeo_rs.io import read_raster
 
+    if not str(args.output).lower().endswith((".tif", ".tiff")):
+        raise ValueError(f"output: expected a GeoTIFF (.tif or .tiff), got {args.output!r}")
     hurst = _number_or_local(args.hurst, "hurst")
     sigma = _number_or_local(args.sigma, "sigma")
     chunks = check_positive_int(args.chunks, "chunks")
     levels = R._levels(args.factor)
     f = 1 << levels
-    z, profile = read_raster(args.input)
+    z, profile = read_raster(args.input, band=args.band)
     if profile is None or profile.get("transform") is None:
         raise ValueError("input: expected a georeferenced raster (GeoTIFF)")
     tr = profile["transform"]
-    cell = abs(tr.a)
+    cell, unit = _ground_cell(tr, profile.get("crs"), z.shape[0])
     z = R._as_float(z, profile.get("nodata"))
     R._check_shape(z.shape)
     if not np.isfinite(z).any():
         raise ValueError("dem: every sample is NaN or nodata")
     detail = R._detail(levels, cell, args.min_scale)
     seed = resolve_seed(args.seed)
-    an = R._maps(z, hurst, sigma, R._check_window(args.window), args.support,
-                 hurst == "local", sigma == "local", min(1 << levels, 8), args.n_threads)
-    from fractalgeo_rs.dem._resample_dask import run_dask
-
-    out = run_dask(da.from_array(z, chunks=chunks), levels, an.hurst, an.sigma, args.window,
-                   detail, args.support, None, seed, args.n_threads, False)
+    window = R._check_window(args.window)
+    try:
+        import dask.array as da
+    except ImportError as exc:
+        # Without dask: in memory when the result fits under the memory limit.
+        try:
+            R._check_memory(z.shape, f)
+        except MemoryLimitError:
+            raise ModuleNotFoundError(f"{exc}", name="dask") from None
+        da = None
     prof = dict(profile)
-    prof.update(driver="GTiff", height=out.shape[0], width=out.shape[1], count=1,
-                dtype="float32", nodata=float("nan"),
+    prof.update(driver="GTiff", count=1, dtype="float32", nodata=float("nan"),
                 transform=R.fine_transform(tr, f, args.support), tiled=True,
                 blockxsize=256, blockysize=256, compress="deflate")
-    nb = out.numblocks
-    total = nb[0] * nb[1]
     show = _progress.resolve(args.progress, cli=True)
-    with atomic_write_path(args.output) as tmp, _progress.bar(total, "resample", show) as pbar:
-        with rasterio.open(tmp, "w", **prof) as dst:
-            r0 = 0
-            for i in range(nb[0]):
-                c0 = 0
-                for j in range(nb[1]):
-                    blk = np.asarray(out.blocks[i, j].compute(), dtype=np.float32)
-                    dst.write(blk, 1, window=Window(c0, r0, blk.shape[1], blk.shape[0]))
-                    c0 += blk.shape[1]
-                    pbar.update(1)
-                r0 += out.chunks[0][i]
+    if da is None:
+        out, _ = R.run_numpy(z, levels, hurst, sigma, window, detail, args.support, None, seed,
+                             args.n_threads)
+        prof.update(height=out.shape[0], width=out.shape[1])
+        with atomic_write_path(args.output) as tmp, _progress.bar(1, "resample", show) as pbar:
+            with rasterio.open(tmp, "w", **prof) as dst:
+                dst.write(out.astype(np.float32), 1)
+            pbar.update(1)
+    else:
+        from fractalgeo_rs.dem._resample_dask import run_dask
+
+        an = R._maps(z, hurst, sigma, window, args.support, hurst == "local", sigma == "local",
+                     min(1 << levels, 8), args.n_threads)
+        out = run_dask(da.from_array(z, chunks=chunks), levels, an.hurst, an.sigma, window,
+                       detail, args.support, None, seed, args.n_threads, False)
+        prof.update(height=out.shape[0], width=out.shape[1])
+        nb = out.numblocks
+        total = nb[0] * nb[1]
+        with atomic_write_path(args.output) as tmp, _progress.bar(total, "resample", show) as pbar:
+            with rasterio.open(tmp, "w", **prof) as dst:
+                r0 = 0
+                for i in range(nb[0]):
+                    c0 = 0
+                    for j in range(nb[1]):
+                        blk = np.asarray(out.blocks[i, j].compute(), dtype=np.float32)
+                        dst.write(blk, 1, window=Window(c0, r0, blk.shape[1], blk.shape[0]))
+                        c0 += blk.shape[1]
+                        pbar.update(1)
+                    r0 += out.chunks[0][i]
     print(f"resample: {z.shape[0]} x {z.shape[1]} -> {out.shape[0]} x {out.shape[1]} (factor {f}, "
-          f"{args.support} support, seed {seed}) -> {args.output}")
+          f"{args.support} support, cell {cell:g}{unit}, seed {seed}) -> {args.output}")
     return 0
 
 

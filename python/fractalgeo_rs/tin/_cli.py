@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 
 from fractalgeo_rs._cli_common import HelpFormatter, add_cell_size, add_raster_io
@@ -14,9 +15,10 @@ def add_parsers(sub) -> None:
         description="Greedy error-bounded TIN of a DEM (Garland-Heckbert): every valid sample is within "
         "--max-error of the mesh (unless --max-triangles stops it first). Georeferencing and nodata come "
         "from the file when it has them; nodata areas become holes. Prints vertex and triangle counts and "
-        "the achieved maximum error.",
+        "the achieved maximum error. A DEM in a geographic CRS (e.g. SRTM .hgt, EPSG:4326) gives x, y in "
+        "degrees and z in metres (a warning says so): reproject it for a metric mesh.",
     )
-    add_raster_io(p, input="dem", output_help="output mesh (.ply or .obj)", band=False)
+    add_raster_io(p, input="dem", output_help="output mesh (.ply or .obj)")
     p.add_argument("--max-error", type=float, default=None,
                    help="largest vertical error in DEM units (default: 0.5%% of the 2-98%% relief)")
     p.add_argument("--max-triangles", type=int, default=None, help="triangle budget")
@@ -35,11 +37,15 @@ def _run_tin(args: argparse.Namespace) -> int:
     ext = str(args.output).lower().rsplit(".", 1)[-1]
     if ext not in ("ply", "obj"):
         raise ValueError(f"output: expected a .ply or .obj file, got {args.output!r}")
-    z, prof = read_raster(args.dem)
+    z, prof = read_raster(args.dem, band=args.band)
     transform = nodata = None
     if prof:
         transform = prof.get("transform")
         nodata = prof.get("nodata")
+        crs = prof.get("crs")
+        if crs is not None and getattr(crs, "is_geographic", False) and args.cell_size is None:
+            print("fractalgeo tin: warning: the DEM's CRS is geographic, so the mesh has x, y in degrees and "
+                  "z in metres; a projected DEM (e.g. UTM) gives a metric mesh", file=sys.stderr)
     cell = args.cell_size if transform is None else None
     if transform is not None and args.cell_size is not None:
         # the given cell size with the file's origin (north up)
