@@ -28,6 +28,7 @@ import numpy as np
 
 from fractalgeo_rs import _core
 from fractalgeo_rs._compat import renamed_parameters
+from fractalgeo_rs._warn import user_stacklevel
 from fractalgeo_rs._validation import (
     as_array,
     check_choice,
@@ -447,7 +448,7 @@ def _default_points_fit(pts: np.ndarray, scale_range: ScaleRange, n_threads) -> 
         msg = (f"points: {n} points are too few for 3 box sizes holding {POINT_MIN_OCCUPANCY:g} points each "
                f"on average; the fit uses sparser boxes and reads the dimension low")
         fit = replace(fit, flags=tuple(fit.flags) + ("undersampled",), warning=(fit.warning + " " + msg).strip())
-        warnings.warn(FractalRangeWarning(msg), stacklevel=3)
+        warnings.warn(FractalRangeWarning(msg), stacklevel=user_stacklevel())
     return fit
 
 

@@ -26,6 +26,7 @@ from typing import Any, Dict, Tuple
 import numpy as np
 
 from fractalgeo_rs._backend import array_kind
+from fractalgeo_rs._warn import user_stacklevel
 
 FLAG_BELOW_2 = 1
 FLAG_ABOVE_3 = 2
@@ -96,7 +97,7 @@ def warn_out_of_range(dmap: np.ndarray, method: str) -> None:
     if parts:
         warnings.warn(f"{method}: {' and '.join(parts)} of the valid windows are outside [2, 3], not "
                       f"dimensions of a surface; return_fit=True gives their flag layer (docs/transform.md)",
-                      FractalRangeWarning, stacklevel=4)
+                      FractalRangeWarning, stacklevel=user_stacklevel())
 
 
 class TransformFit(tuple):
