@@ -172,7 +172,10 @@ class DimensionFit:
         Causes: ``"below_domain"`` (smooth at the fitted scales),
         ``"above_domain"`` (rougher than any graph: noise or speckle),
         ``"pinned"`` (search bound), ``"range_restricted"`` (the default fit
-        dropped a regime outside the domain and fitted the fractal range).
+        dropped a regime outside the domain and fitted the fractal range),
+        ``"unresolved"`` (point box counting: fewer than 3 fitted box sizes
+        with distinct counts, not an estimate; ``valid`` is False),
+        ``"undersampled"`` (point box counting: too few points per box).
     warning : str
         The warning's text ("" when none).
     ranges : tuple of ScaleSegment
