@@ -46,3 +46,19 @@ def test_given_sizes_keep_the_old_path():
     fit = fg.box_counting_points(square, box_sizes=[1 / 4, 1 / 8, 1 / 16, 1 / 32])
     assert abs(fit.dimension - 2.0) < 0.01
     assert "base" not in fit.extra
+
+
+@pytest.mark.parametrize("box_sizes", [None, [0.1, 0.2, 0.4]])
+def test_saturated_counts_are_not_an_estimate(box_sizes):
+    # two points: N(s) = 2 at every size, a perfect line of slope 0 that measures nothing
+    with pytest.warns(fg.FractalRangeWarning, match="distinct box count"):
+        fit = fg.box_counting_points(np.array([[0, 0], [1, 1.0]]), box_sizes=box_sizes)
+    assert not fit.valid and "unresolved" in fit.flags
+    assert np.isnan(fit.ci95[0]) and np.isnan(fit.ci95[1]) and np.isnan(fit.stderr)
+
+
+@pytest.mark.parametrize("pts", [np.zeros((1, 2)), np.ones((5, 3))])
+@pytest.mark.parametrize("box_sizes", [None, [0.1, 0.2, 0.4]])
+def test_fewer_than_two_distinct_points_is_a_value_error(pts, box_sizes):
+    with pytest.raises(ValueError, match="^points: need at least 2 distinct points"):
+        fg.box_counting_points(pts, box_sizes=box_sizes)

@@ -44,7 +44,9 @@ def test_white_noise_variogram_map_flags_and_warns_with_the_fraction():
     with pytest.warns(fg.FractalRangeWarning, match="above 3") as rec:
         plain = fg.fractal_transform(z, 9, method="variogram")
     np.testing.assert_array_equal(plain, d)
-    pct = float(re.search(r"([\d.]+) % above 3", str(rec[0].message)).group(1))
+    msg = str(rec[0].message)
+    pct = float(re.search(r"D is above 3 on ([\d.]+) % of the valid windows", msg).group(1))
+    assert msg.startswith("variogram: D is above 3 on ") and "outside [2, 3]" not in msg
     assert pct == pytest.approx(100 * above[np.isfinite(d)].mean(), abs=0.05)
 
 
@@ -70,8 +72,8 @@ def test_gls_windows_pinned_on_white_noise_are_flagged():
     from fractalgeo_rs.dimension.gls import H_GRID
 
     z = _noise(40, seed=3)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", fg.FractalRangeWarning)
+    with warnings.catch_warnings():  # with return_fit the flags carry it: no warning, as for every method
+        warnings.simplefilter("error", fg.FractalRangeWarning)
         out = fg.fractal_transform(z, 17, method="gls", return_fit=True)
     d = out[0]
     pinned = np.abs(d - (3 - H_GRID[0])) <= 1e-4
@@ -106,3 +108,8 @@ def test_dask_and_xarray_flags_equal_in_memory():
     np.testing.assert_array_equal(xo.flags.values, ref.flags)
     assert xo.flags.attrs["flag_meanings"] == "below_2 above_3 pinned too_few_valid"
     np.testing.assert_array_equal(xo.flags.x.values, xa.x.values)
+
+
+def test_gls_pinned_windows_warn_without_return_fit():
+    with pytest.warns(fg.FractalRangeWarning, match=r"% of the windows are pinned at the lower end"):
+        fg.fractal_transform(_noise(40, seed=3), 17, method="gls")

@@ -12,6 +12,8 @@ from __future__ import annotations
 import functools
 import inspect
 import warnings
+
+from fractalgeo_rs._warn import user_stacklevel
 from typing import Callable, Dict, Sequence, TypeVar
 
 F = TypeVar("F", bound=Callable)
@@ -30,7 +32,7 @@ def renamed_parameters(renames: Dict[str, str], *, since: str) -> Callable[[F], 
                     warnings.warn(
                         f"{func.__name__}: the parameter {old!r} is now called {new!r} (renamed in {since}; "
                         f"the old name will be removed in the next release)",
-                        DeprecationWarning, stacklevel=2)
+                        DeprecationWarning, stacklevel=user_stacklevel())
                     kwargs[new] = kwargs.pop(old)
             return func(*args, **kwargs)
 
@@ -64,7 +66,7 @@ def keyword_only_since(names: Sequence[str], *, since: str) -> Callable[[F], F]:
                 warnings.warn(
                     f"{func.__name__}: pass {', '.join(moved)} by keyword ({'=..., '.join(moved)}=...); "
                     f"positional use is deprecated since {since} and will be removed in the next release",
-                    DeprecationWarning, stacklevel=2)
+                    DeprecationWarning, stacklevel=user_stacklevel())
                 args = args[:n_pos]
             return func(*args, **kwargs)
 

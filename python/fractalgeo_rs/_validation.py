@@ -16,6 +16,8 @@ from typing import Iterator, Optional
 
 import numpy as np
 
+from fractalgeo_rs._warn import user_stacklevel
+
 __all__ = [
     "as_array",
     "check_real_array",
@@ -66,7 +68,7 @@ def _real_policy(arr: np.ndarray, name: str) -> np.ndarray:
         count = int(np.count_nonzero(inf))
         if count:
             warnings.warn(f"{name}: {count} value(s) are ±inf; they are treated as missing (NaN)",
-                          RuntimeWarning, stacklevel=4)
+                          RuntimeWarning, stacklevel=user_stacklevel())
             arr = np.where(inf, np.asarray(np.nan, dtype=arr.dtype), arr)
     return arr
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
+import warnings
 from typing import Optional, Sequence
 
 _DOMAIN_CLIS = (
@@ -51,7 +52,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         parser.print_help()
         return 2
     try:
-        return int(args.func(args) or 0)
+        with warnings.catch_warnings():
+            warnings.showwarning = _one_line_warning(args.command)
+            return int(args.func(args) or 0)
     except KeyboardInterrupt:
         if args.debug:
             raise
@@ -67,6 +70,17 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             raise
         print(f"fractalgeo {args.command}: error: {exc}", file=sys.stderr)
         return 1
+
+
+def _one_line_warning(command):
+    """A ``warnings.showwarning`` printing ``fractalgeo CMD: warning: ...``
+    on one line of stderr (no file name, line number or source line: they
+    would point into the package)."""
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        print(f"fractalgeo {command}: warning: {message}", file=sys.stderr if file is None else file)
+
+    return show
 
 
 #: Optional dependencies and the extra that installs them.

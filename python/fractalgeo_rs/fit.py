@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from fractalgeo_rs._scales import MIN_SEGMENT, find_break
+from fractalgeo_rs._warn import user_stacklevel
 
 __all__ = ["DimensionFit", "FractalRangeWarning", "ScaleSegment", "fit_loglog"]
 
@@ -171,7 +172,10 @@ class DimensionFit:
         Causes: ``"below_domain"`` (smooth at the fitted scales),
         ``"above_domain"`` (rougher than any graph: noise or speckle),
         ``"pinned"`` (search bound), ``"range_restricted"`` (the default fit
-        dropped a regime outside the domain and fitted the fractal range).
+        dropped a regime outside the domain and fitted the fractal range),
+        ``"unresolved"`` (point box counting: fewer than 3 fitted box sizes
+        with distinct counts, not an estimate; ``valid`` is False),
+        ``"undersampled"`` (point box counting: too few points per box).
     warning : str
         The warning's text ("" when none).
     ranges : tuple of ScaleSegment
@@ -618,7 +622,7 @@ def fit_loglog(
                    f"{good.scale_range[0]:g}..{good.scale_range[1]:g} only (D = {fit.dimension:.3f}); "
                    f"pass scale_range='all' to fit every scale")
             fit = replace(fit, flags=("range_restricted",), warning=msg)
-            warnings.warn(FractalRangeWarning(msg), stacklevel=3)
+            warnings.warn(FractalRangeWarning(msg), stacklevel=user_stacklevel())
     if validate:
         fit = check_domain(fit, open_domain=open_domain)
     return fit
@@ -695,18 +699,18 @@ def _ranges(s, used, m, dim_offset, dim_factor, dom, open_domain) -> Tuple[Scale
             seg(sb, su[-1], above, np.count_nonzero(x >= xb), True))
 
 
-def mark_invalid(fit: DimensionFit, flag: str, message: str, *, stacklevel: int = 3) -> DimensionFit:
+def mark_invalid(fit: DimensionFit, flag: str, message: str) -> DimensionFit:
     """``fit`` with ``valid=False``, ``flag`` added, NaN ``stderr`` and
     ``ci95``, and ``message`` as its warning (issued as a
     ``FractalRangeWarning``)."""
     nan = float("nan")
     out = replace(fit, valid=False, flags=tuple(fit.flags) + (flag,), stderr=nan, ci95=(nan, nan),
                   warning=(fit.warning + " " + message).strip())
-    warnings.warn(FractalRangeWarning(message), stacklevel=stacklevel)
+    warnings.warn(FractalRangeWarning(message), stacklevel=user_stacklevel())
     return out
 
 
-def check_domain(fit: DimensionFit, *, open_domain: bool = False, stacklevel: int = 4) -> DimensionFit:
+def check_domain(fit: DimensionFit, *, open_domain: bool = False) -> DimensionFit:
     """Flag and warn when ``fit.dimension`` lies outside ``fit.domain``.
 
     Below the domain (``H >= 1`` for a graph): the data are smooth at the
@@ -720,7 +724,7 @@ def check_domain(fit: DimensionFit, *, open_domain: bool = False, stacklevel: in
     a, b = fit.scale_range
     where = f"{fit.x_label} {a:g}..{b:g}"
     if not np.isfinite(fit.dimension):
-        return mark_invalid(fit, "undefined", f"{fit.method}: D is undefined over {where}", stacklevel=stacklevel)
+        return mark_invalid(fit, "undefined", f"{fit.method}: D is undefined over {where}")
     good = [r for r in fit.ranges if r.valid]
     hint = ""
     if good:
@@ -732,12 +736,11 @@ def check_domain(fit: DimensionFit, *, open_domain: bool = False, stacklevel: in
         msg = (f"{fit.method}: D = {fit.dimension:.3f} is outside [{dom[0]:g}, {dom[1]:g}] at {where}: not a "
                f"dimension of a set (too few occupied boxes or a saturated range); choose the scales with "
                f"scale_range{hint}")
-        return mark_invalid(fit, "below_domain" if _below(fit.dimension, dom) else "above_domain", msg,
-                            stacklevel=stacklevel)
+        return mark_invalid(fit, "below_domain" if _below(fit.dimension, dom) else "above_domain", msg)
     if _below(fit.dimension, dom):
         msg = (f"{fit.method}: D = {fit.dimension:.3f} is below {dom[0]:g} (H >= 1): the data are smooth at "
                f"{where}; use larger scales (scale_range, lags, box_sizes or epsilons above {b:g}){hint}")
-        return mark_invalid(fit, "below_domain", msg, stacklevel=stacklevel)
+        return mark_invalid(fit, "below_domain", msg)
     msg = (f"{fit.method}: D = {fit.dimension:.3f} is above {dom[1]:g} (H <= 0): the data are rougher than "
            f"a graph at {where} (white noise, speckle); use larger scales or smooth the data{hint}")
-    return mark_invalid(fit, "above_domain", msg, stacklevel=stacklevel)
+    return mark_invalid(fit, "above_domain", msg)

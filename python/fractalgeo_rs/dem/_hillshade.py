@@ -54,7 +54,12 @@ def metres_per_degree(latitude):
     >>> m_lon.round(1).tolist()
     [111319.3, 78846.9, 55799.9]
     """
-    p = np.deg2rad(np.asarray(latitude, dtype=np.float64))
+    if isinstance(latitude, (str, bytes)):
+        raise TypeError(f"latitude: expected a number or an array of degrees, got {type(latitude).__name__}")
+    try:
+        p = np.deg2rad(np.asarray(latitude, dtype=np.float64))
+    except (TypeError, ValueError) as exc:
+        raise TypeError(f"latitude: expected a number or an array of degrees, could not convert: {exc}") from None
     lat = 111132.92 - 559.82 * np.cos(2 * p) + 1.175 * np.cos(4 * p)
     lon = 111412.84 * np.cos(p) - 93.5 * np.cos(3 * p)
     return lat, lon

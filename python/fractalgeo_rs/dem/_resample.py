@@ -10,6 +10,7 @@ import numpy as np
 
 from fractalgeo_rs import _core
 from fractalgeo_rs._compat import renamed_parameters
+from fractalgeo_rs._warn import user_stacklevel
 from fractalgeo_rs._validation import (as_array, check_choice, check_memory, check_n_threads, check_nodata,
                                       check_positive_float)
 
@@ -71,7 +72,7 @@ class ResampleAnalysis:
         """Deprecated alias of :attr:`window_size` (renamed in 0.2.0)."""
         warnings.warn("ResampleAnalysis: the attribute 'window' is now called 'window_size' "
                       "(renamed in 0.2.0; the old name will be removed in the next release)",
-                      DeprecationWarning, stacklevel=2)
+                      DeprecationWarning, stacklevel=user_stacklevel())
         return self.window_size
 
 
@@ -136,6 +137,8 @@ def _check_window(window, shape=None):
         raise TypeError(f"window_size: expected an odd int >= 5, got {window!r}")
     if window < 5 or window % 2 == 0:
         raise ValueError(f"window_size: expected an odd int >= 5, got {window}")
+    if shape is not None and len(shape) != 2:
+        raise ValueError(f"dem: expected a 2D array, got shape {tuple(shape)}")
     if shape is not None and window > 2 * max(shape) + 1:
         raise ValueError(f"window_size: {window} is more than twice the DEM's side {max(shape)}; "
                          f"a window of at most {2 * max(shape) + 1} already covers it")
@@ -209,7 +212,7 @@ def resample_analysis(dem, *, window_size=33, support="point", block=2, nodata=N
 def _warn_clipped(frac):
     if frac > 0:
         warnings.warn(f"hurst: {100 * frac:.2g} % of the local H values were outside "
-                      f"{HURST_RANGE} and were clipped", RuntimeWarning, stacklevel=3)
+                      f"{HURST_RANGE} and were clipped", RuntimeWarning, stacklevel=user_stacklevel())
 
 
 def _as_float(dem, nodata):

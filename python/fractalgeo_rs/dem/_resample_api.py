@@ -130,6 +130,8 @@ def fractal_resample(dem, factor=2, *, hurst="local", sigma="local", window_size
     >>> bool(np.array_equal(fine[::4, ::4], z))
     True
     """
+    if dem is None or isinstance(dem, (str, bytes)):
+        raise TypeError(f"dem: expected an array (numpy, Dask or xarray), got {type(dem).__name__}")
     levels = _levels(factor)
     f = 1 << levels
     check_choice(support, "support", ("point", "area"))

@@ -28,6 +28,7 @@ import numpy as np
 
 from fractalgeo_rs import _core
 from fractalgeo_rs._compat import renamed_parameters
+from fractalgeo_rs._warn import user_stacklevel
 from fractalgeo_rs._validation import (
     as_array,
     check_choice,
@@ -46,7 +47,7 @@ from fractalgeo_rs.dimension._common import (
     dyadic_up_to,
     reduce_offsets,
 )
-from fractalgeo_rs.fit import DimensionFit, FractalRangeWarning, ScaleRange, fit_loglog
+from fractalgeo_rs.fit import DimensionFit, FractalRangeWarning, ScaleRange, fit_loglog, mark_invalid
 
 __all__ = [
     "box_counting",
@@ -334,7 +335,16 @@ def box_counting_points(
         candidate. Fewer points than 3 sizes of 20 points per box need give
         the flag ``"undersampled"`` and a
         :class:`~fractalgeo_rs.FractalRangeWarning` (the estimate is biased
-        low: sparse boxes miss parts of the set).
+        low: sparse boxes miss parts of the set). Fewer than 3 fitted
+        sizes with distinct counts (e.g. a few points, each alone in its box
+        at every size) give ``valid=False``, the flag ``"unresolved"`` and
+        NaN ``stderr`` and ``ci95``: not an estimate.
+
+    Raises
+    ------
+    ValueError
+        ``points``: fewer than 2 distinct points (or not an (N, d) array of
+        finite coordinates).
 
     Notes
     -----
@@ -385,6 +395,9 @@ def box_counting_points(
     if arr.shape[1] > 16:
         raise ValueError(f"points: at most 16 coordinates per point, got {arr.shape[1]}")
     pts = np.ascontiguousarray(arr, dtype=np.float64)
+    if not np.any(pts != pts[0]):
+        raise ValueError(f"points: need at least 2 distinct points for a box dimension, got "
+                         f"{pts.shape[0]} point(s) all at {pts[0].tolist()}")
     sizes = check_box_sizes(box_sizes, integer=False)
     offsets = check_positive_int(offsets, "offsets")
     check_choice(offset_reduce, "offset_reduce", ("mean", "min"))
@@ -393,11 +406,27 @@ def box_counting_points(
     if sizes is None:
         return _default_points_fit(pts, scale_range, n_threads)
     s, counts = _core.box_count_points(pts, sizes, offsets, n_threads)
-    return _lattice_fit(
+    return _check_resolved(_lattice_fit(
         "points", s, counts, offset_reduce, scale_range, "box size s", "occupied boxes N(s)",
         {"n_points": n, "offsets": offsets},
         (0.0, float(pts.shape[1])),
-    )
+    ))
+
+
+def _check_resolved(fit: DimensionFit) -> DimensionFit:
+    """Mark a point fit invalid (flag ``"unresolved"``, NaN interval) when
+    fewer than 3 of its fitted box sizes give distinct counts: the slope
+    then is not an estimate (e.g. every box holds one point at every size,
+    N(s) = number of points, D = 0 with a perfect line)."""
+    a, b = fit.scale_range
+    s = np.asarray(fit.scales, dtype=float)
+    m = np.asarray(fit.measures, dtype=float)[(s >= a) & (s <= b)]
+    if np.unique(m).size >= 3:
+        return fit
+    return mark_invalid(fit, "unresolved",
+                        f"points: only {np.unique(m).size} distinct box count(s) over box sizes {a:g}..{b:g} "
+                        f"({fit.extra.get('n_points')} points): the fit measures no scaling; use more points "
+                        f"or box sizes where boxes hold several points")
 
 
 #: Fewest points per box (mean over the aligned lattice) at the smallest
@@ -443,11 +472,13 @@ def _default_points_fit(pts: np.ndarray, scale_range: ScaleRange, n_threads) -> 
                "counts": {k: np.asarray(v) for k, v in lv.items() if k != "sizes"}},
         domain=(0.0, float(d)),
     )
+    fit = _check_resolved(fit)
     if undersampled:
         msg = (f"points: {n} points are too few for 3 box sizes holding {POINT_MIN_OCCUPANCY:g} points each "
                f"on average; the fit uses sparser boxes and reads the dimension low")
         fit = replace(fit, flags=tuple(fit.flags) + ("undersampled",), warning=(fit.warning + " " + msg).strip())
-        warnings.warn(FractalRangeWarning(msg), stacklevel=3)
+        if fit.valid:  # an invalid fit has had its warning
+            warnings.warn(FractalRangeWarning(msg), stacklevel=user_stacklevel())
     return fit
 
 

@@ -391,7 +391,7 @@ def gls_dimension(
     if msg:
         from fractalgeo_rs.fit import mark_invalid
 
-        fit = mark_invalid(fit, "pinned", f"gls: {msg}", stacklevel=3)
+        fit = mark_invalid(fit, "pinned", f"gls: {msg}")
     return fit
 
 
@@ -414,6 +414,7 @@ def warn_pinned_map(d: np.ndarray, off: float = 3.0) -> None:
     windows pinned at an end of the H grid, when there are any."""
     import warnings
 
+    from fractalgeo_rs._warn import user_stacklevel
     from fractalgeo_rs.fit import FractalRangeWarning
 
     v = d[np.isfinite(d)]
@@ -427,7 +428,7 @@ def warn_pinned_map(d: np.ndarray, off: float = 3.0) -> None:
             warnings.warn(f"gls: {100 * frac:.1f} % of the windows are pinned at the {end} end of the H grid "
                           f"(D = {off - (float(H_GRID[-1]) if end == 'upper' else float(H_GRID[0])):.2f}): "
                           f"the data there are {what}; those values are bounds, not estimates",
-                          FractalRangeWarning, stacklevel=4)
+                          FractalRangeWarning, stacklevel=user_stacklevel())
 
 
 def anisotropy_from_variations(V: np.ndarray, labels: Sequence[tuple], hurst: float) -> Tuple[float, float]:

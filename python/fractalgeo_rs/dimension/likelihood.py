@@ -481,7 +481,7 @@ def _assemble(h, se, nd, plot_data, method, extra):
         else:
             msg = (f"{method}: H = {h:.4f} is pinned at the search bound {_H_LO} (D = {offset - h:.3f}): the data "
                    f"are rougher than fBm (white noise, speckle); no valid interval")
-        fit = mark_invalid(fit, "pinned", msg, stacklevel=4)
+        fit = mark_invalid(fit, "pinned", msg)
         fit.extra["hurst_stderr"] = float("nan")
     return fit
 

@@ -54,7 +54,12 @@ def moran_dimension(ratios: Sequence[float]) -> float:
     >>> round(moran_dimension([0.5, 0.25, 0.25]), 12)  # 0.5 + 0.25 + 0.25 = 1: s = 1
     1.0
     """
-    r = np.asarray(ratios, dtype=float).ravel()
+    if isinstance(ratios, (str, bytes)):
+        raise TypeError(f"ratios: expected a sequence of numbers, got {type(ratios).__name__}")
+    try:
+        r = np.asarray(ratios, dtype=float).ravel()
+    except (TypeError, ValueError) as exc:
+        raise TypeError(f"ratios: expected a sequence of numbers, could not convert: {exc}") from None
     return float(_core.moran_dimension(r.tolist()))
 
 

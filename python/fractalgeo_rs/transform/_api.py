@@ -220,9 +220,11 @@ def fractal_transform(
         ``flags`` is the flag layer (uint8 bits: 1 ``D < 2``, 2 ``D > 3``,
         4 pinned at an end of the ``H`` grid, 8 too few valid pixels; 0 =
         valid; ``fractalgeo_rs.transform.FLAGS``) and ``params`` the method, window, step and
-        ``z_scale`` used. Without it an in-memory map with values outside
+        ``z_scale`` used, and no warning is issued (the flags carry the
+        information). Without it an in-memory map with values outside
         ``[2, 3]`` raises one :class:`~fractalgeo_rs.FractalRangeWarning`
-        giving their fractions.
+        giving their fractions, and a ``"gls"`` map with pinned windows one
+        giving the pinned fraction.
     dilations : int, default 2
         ``"gls"``: largest dilation ``k`` of the increment filters (``8 k``
         filters; the window must exceed ``4 k``).
@@ -314,9 +316,9 @@ def fractal_transform(
                      prepare=prepare if array_kind(arr) == "dask" else None, names=names,
                      progress=_progress.resolve(progress), desc=f"fractal_transform ({method})")
     lazy = array_kind(arr) == "dask"  # (a lazy map is not read here)
-    if spec.warn_map is not None and not lazy:
-        spec.warn_map(np.asarray(out[0]))
-    if not return_fit and not lazy:
+    if not return_fit and not lazy:  # with return_fit the flag layer carries this
+        if spec.warn_map is not None:
+            spec.warn_map(np.asarray(out[0]))
         warn_out_of_range(out[0], method)
     params = {"method": method, "window_size": w, "step": step, "z_scale": z_used,
               "z_units": None if z_used is None else "image units per pixel"}

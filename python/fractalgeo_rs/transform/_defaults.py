@@ -27,6 +27,8 @@ from typing import Optional
 
 import numpy as np
 
+from fractalgeo_rs._validation import as_array
+
 __all__ = ["default_z_scale"]
 
 MAD_TO_SIGMA = 1.4826  # 1 / Phi^-1(3/4): the MAD of a normal sample times this is its sigma
@@ -78,6 +80,8 @@ def default_z_scale(image, nodata: Optional[float] = None) -> float:
     >>> round(default_z_scale(3.0 * i + 4.0 * j), 4)  # median of |3| and |4| steps
     5.1891
     """
+    if not hasattr(image, "shape"):
+        image = as_array(image, "image")
     shape = image.shape
     if len(shape) != 2:
         raise ValueError(f"image: expected a 2D image, got {len(shape)} dimensions")

@@ -26,6 +26,7 @@ from typing import Any, Dict, Tuple
 import numpy as np
 
 from fractalgeo_rs._backend import array_kind
+from fractalgeo_rs._warn import user_stacklevel
 
 FLAG_BELOW_2 = 1
 FLAG_ABOVE_3 = 2
@@ -88,15 +89,19 @@ def warn_out_of_range(dmap: np.ndarray, method: str) -> None:
         return
     lo = float(np.mean(v < 2.0 - RANGE_TOLERANCE))
     hi = float(np.mean(v > 3.0 + RANGE_TOLERANCE))
-    parts = []
-    if lo > 0:
-        parts.append(f"{100 * lo:.1f} % below 2 (smoother than a surface at the window's scales)")
-    if hi > 0:
-        parts.append(f"{100 * hi:.1f} % above 3 (rougher than a surface: noise or speckle)")
-    if parts:
-        warnings.warn(f"{method}: {' and '.join(parts)} of the valid windows are outside [2, 3], not "
-                      f"dimensions of a surface; return_fit=True gives their flag layer (docs/transform.md)",
-                      FractalRangeWarning, stacklevel=4)
+    smooth = "smoother than a surface at the window's scales"
+    rough = "rougher than a surface: noise or speckle"
+    if lo > 0 and hi > 0:
+        what = (f"D is below 2 on {100 * lo:.1f} % of the valid windows ({smooth}) and above 3 on "
+                f"{100 * hi:.1f} % ({rough})")
+    elif lo > 0:
+        what = f"D is below 2 on {100 * lo:.1f} % of the valid windows ({smooth})"
+    elif hi > 0:
+        what = f"D is above 3 on {100 * hi:.1f} % of the valid windows ({rough})"
+    else:
+        return
+    warnings.warn(f"{method}: {what}, so those values are not dimensions of a surface; return_fit=True "
+                  f"gives their flag layer (docs/transform.md)", FractalRangeWarning, stacklevel=user_stacklevel())
 
 
 class TransformFit(tuple):
