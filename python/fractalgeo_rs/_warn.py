@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import os
 import sys
+from types import FrameType
+from typing import Optional
 
 __all__ = ["user_stacklevel"]
 
@@ -25,7 +27,7 @@ def user_stacklevel(skip: int = 1) -> int:
     frames above this call point at the first frame outside the package
     (``skip=1``: the function calling ``user_stacklevel`` issues the
     warning)."""
-    frame = sys._getframe(skip)
+    frame: Optional[FrameType] = sys._getframe(skip)
     level = 1
     while frame is not None and _in_package(frame.f_code.co_filename):
         frame = frame.f_back

@@ -118,6 +118,7 @@ def _run_resample(args: argparse.Namespace) -> int:
     detail = R._detail(levels, cell, args.min_scale)
     seed = resolve_seed(args.seed)
     window = R._check_window(args.window)
+    da: Any
     try:
         import dask.array as da
     except ImportError as exc:
