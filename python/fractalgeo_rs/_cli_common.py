@@ -60,6 +60,11 @@ def add_n_threads(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--threads", "--workers", dest="n_threads", type=int, help=argparse.SUPPRESS)
 
 
+def is_geographic(crs) -> bool:
+    """True for a rasterio CRS in degrees (e.g. EPSG:4326); False for None."""
+    return crs is not None and bool(getattr(crs, "is_geographic", False))
+
+
 def georeference_of_grid(rows: int, cell_size: float):
     """Transform of a synthetic grid: ``cell_size`` square cells, the
     upper-left corner at (0, rows * cell_size) so that y grows to the north,

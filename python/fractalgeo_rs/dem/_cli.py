@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from fractalgeo_rs._cli_common import (HelpFormatter, add_band, add_cell_size, add_n_threads, add_progress,
-                                        add_raster_io)
+                                        add_raster_io, is_geographic)
 
 
 def add_parsers(sub) -> None:
@@ -76,7 +76,7 @@ def _ground_cell(tr, crs, rows):
     map units on a projected grid; on a geographic one the larger of the x
     and y spacings in metres at the centre latitude (WGS84,
     :func:`~fractalgeo_rs.dem.metres_per_degree`)."""
-    if crs is None or not getattr(crs, "is_geographic", False):
+    if not is_geographic(crs):
         return abs(tr.a), ""
     from fractalgeo_rs.dem import metres_per_degree
 
@@ -180,8 +180,7 @@ def _run_hillshade(args: argparse.Namespace) -> int:
         nodata = prof.get("nodata")
         if t is not None:
             cell = (abs(t.e), abs(t.a))
-            crs = prof.get("crs")
-            if crs is not None and getattr(crs, "is_geographic", False):
+            if is_geographic(prof.get("crs")):
                 latitude = t.f + t.e * (np.arange(z.shape[0]) + 0.5)
     if args.cell_size is not None:
         cell = args.cell_size

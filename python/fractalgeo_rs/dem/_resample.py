@@ -137,8 +137,6 @@ def _check_window(window, shape=None):
         raise TypeError(f"window_size: expected an odd int >= 5, got {window!r}")
     if window < 5 or window % 2 == 0:
         raise ValueError(f"window_size: expected an odd int >= 5, got {window}")
-    if shape is not None and len(shape) != 2:
-        raise ValueError(f"dem: expected a 2D array, got shape {tuple(shape)}")
     if shape is not None and window > 2 * max(shape) + 1:
         raise ValueError(f"window_size: {window} is more than twice the DEM's side {max(shape)}; "
                          f"a window of at most {2 * max(shape) + 1} already covers it")
@@ -343,7 +341,6 @@ def _finish(hraw, var1):
     hurst = np.where(ok, np.clip(np.where(ok, hraw, 0.5), lo, hi), 0.5)
     sigma = np.where(np.isfinite(var1) & ok, np.sqrt(np.where(np.isfinite(var1), var1, 0.0)), 0.0)
     return hurst, sigma, n_clip, n_ok
-
 
 
 # ------------------------------------------------------------------- main --

@@ -132,6 +132,8 @@ def fractal_resample(dem, factor=2, *, hurst="local", sigma="local", window_size
     """
     if dem is None or isinstance(dem, (str, bytes)):
         raise TypeError(f"dem: expected an array (numpy, Dask or xarray), got {type(dem).__name__}")
+    if np.ndim(dem) != 2:
+        raise ValueError(f"dem: expected a 2D array, got shape {np.shape(dem)}")
     levels = _levels(factor)
     f = 1 << levels
     check_choice(support, "support", ("point", "area"))

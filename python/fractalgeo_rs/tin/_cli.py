@@ -5,7 +5,7 @@ import argparse
 import sys
 import time
 
-from fractalgeo_rs._cli_common import HelpFormatter, add_cell_size, add_raster_io
+from fractalgeo_rs._cli_common import HelpFormatter, add_cell_size, add_raster_io, is_geographic
 
 
 def add_parsers(sub) -> None:
@@ -42,8 +42,7 @@ def _run_tin(args: argparse.Namespace) -> int:
     if prof:
         transform = prof.get("transform")
         nodata = prof.get("nodata")
-        crs = prof.get("crs")
-        if crs is not None and getattr(crs, "is_geographic", False) and args.cell_size is None:
+        if is_geographic(prof.get("crs")) and args.cell_size is None:
             print("fractalgeo tin: warning: the DEM's CRS is geographic, so the mesh has x, y in degrees and "
                   "z in metres; a projected DEM (e.g. UTM) gives a metric mesh", file=sys.stderr)
     cell = args.cell_size if transform is None else None
