@@ -14,7 +14,17 @@
 //! | [`dem`] | DEM work: shaded relief, lakes, resampling |
 //! | [`lsystem`] | L-systems, turtle geometry and IFS |
 //! | [`transform`] | moving-window maps of local dimension |
+//!
+//! Crate-level services that every domain may use (and that use no domain):
+//!
+//! | module | what |
+//! |---|---|
+//! | [`rng`] | counter-based random streams keyed by `(seed, stream, index)` |
+//! | [`sample`] | the sample types (`f32`, `f64`) raster kernels read |
 //! | [`progress`] | a work counter kernels tick for progress bars |
+//! | [`window`] | the moving-window driver and summed-area tables |
+//! | [`parallel`] | thread pools sized by `n_threads`, and shared output buffers |
+//! | [`checks`] | value checks that name the parameter |
 
 #![warn(clippy::undocumented_unsafe_blocks)]
 
@@ -27,9 +37,12 @@ pub mod io;
 pub mod lsystem;
 pub mod parallel;
 pub mod progress;
+pub mod rng;
+pub mod sample;
 pub mod synth;
 pub mod tin;
 pub mod transform;
+pub mod window;
 
 #[cfg(test)]
 mod testdata;

@@ -172,6 +172,36 @@ where
     }
 }
 
+/// The address of a buffer that the tasks of one parallel loop share, for
+/// loops whose tasks write disjoint cells and read only cells no task writes
+/// (a checkerboard pass, rows that each own their cells).
+///
+/// Making one is safe; every dereference of [`SharedMut::get`] is `unsafe`
+/// and its caller states why no two tasks touch one cell mutably and why the
+/// cell lies inside the buffer, which must outlive the loop.
+#[derive(Debug, Clone, Copy)]
+pub struct SharedMut<T>(*mut T);
+
+// SAFETY: the value is only an address; sending it to another thread is
+// sound because every dereference is an `unsafe` block of the caller, under
+// the disjointness rule it states (see the type's documentation).
+unsafe impl<T: Send> Send for SharedMut<T> {}
+// SAFETY: as for Send: sharing the address allows nothing by itself.
+unsafe impl<T: Send> Sync for SharedMut<T> {}
+
+impl<T> SharedMut<T> {
+    /// The address of `buf`'s first element.
+    pub fn new(buf: &mut [T]) -> Self {
+        SharedMut(buf.as_mut_ptr())
+    }
+
+    /// The shared address.
+    #[inline]
+    pub fn get(&self) -> *mut T {
+        self.0
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -13,6 +13,7 @@ mod dem;
 mod dimension;
 mod io;
 mod lsystem;
+mod progress;
 mod synth;
 mod tin;
 mod transform;
@@ -37,6 +38,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     io::register(m)?;
     synth::register(m)?;
     lsystem::register(m)?;
+    progress::register(m)?;
     transform::register(m)?;
     tin::register(m)?;
     Ok(())

@@ -1,47 +1,13 @@
 //! Bindings of `crate::synth`.
 use super::convert::{array1, c_order, run};
-use crate::progress::Progress;
+use super::progress::{counter, ProgressCounter};
+use crate::rng;
 use crate::synth::additions::{self, AdditionsParams};
 use crate::synth::davies_harte;
 use crate::synth::midpoint::{self, RefineParams};
-use crate::synth::rng;
 use crate::synth::spectral;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
-use std::sync::Arc;
-
-/// A work counter a kernel ticks while it runs with the GIL released:
-/// `done` and `total` can be read from another Python thread meanwhile.
-#[pyclass(frozen, module = "fractalgeo_rs._core")]
-pub struct ProgressCounter {
-    inner: Arc<Progress>,
-}
-
-#[pymethods]
-impl ProgressCounter {
-    #[new]
-    fn new() -> Self {
-        Self {
-            inner: Arc::new(Progress::new()),
-        }
-    }
-
-    /// Units of work done so far.
-    #[getter]
-    fn done(&self) -> u64 {
-        self.inner.done()
-    }
-
-    /// Units of work announced so far by the kernels given this counter.
-    #[getter]
-    fn total(&self) -> u64 {
-        self.inner.total()
-    }
-}
-
-fn counter(p: Option<&Bound<'_, ProgressCounter>>) -> Option<Arc<Progress>> {
-    p.map(|c| Arc::clone(&c.get().inner))
-}
 
 /// `n` standard normals of stream `(seed, stream)` at indices `start ..`.
 #[pyfunction]
@@ -253,7 +219,6 @@ fn davies_harte_fbm<'py>(
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_class::<ProgressCounter>()?;
     m.add_function(wrap_pyfunction!(normal_noise, m)?)?;
     m.add_function(wrap_pyfunction!(midpoint_refine_1d, m)?)?;
     m.add_function(wrap_pyfunction!(midpoint_refine_2d, m)?)?;

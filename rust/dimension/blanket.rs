@@ -141,38 +141,27 @@ fn stream_sums(
             let in_sum = (s0..s1).contains(&r);
             let cs = &mut colsum[(e - 1) * cols..e * cols];
             let kk = k - e * 3 * pw;
-            if up_missing {
-                // a missing row above: the upper row is the frame value
-                let fu = vec![f64::NEG_INFINITY; pw];
-                let fb = vec![f64::INFINITY; pw];
-                step_row(
-                    &fu,
-                    &prev_u[kc..kc + pw],
-                    &prev_u[kd..kd + pw],
-                    &fb,
-                    &prev_b[kc..kc + pw],
-                    &prev_b[kd..kd + pw],
-                    &mu[m..m + cols],
-                    &mb[m..m + cols],
-                    &mut cur_u[kk..kk + pw],
-                    &mut cur_b[kk..kk + pw],
-                    in_sum.then_some(cs),
-                );
+            // a missing row above: the upper row is the frame value
+            let frame;
+            let (up_u, up_b): (&[f64], &[f64]) = if up_missing {
+                frame = (vec![f64::NEG_INFINITY; pw], vec![f64::INFINITY; pw]);
+                (&frame.0, &frame.1)
             } else {
-                step_row(
-                    &prev_u[ku..ku + pw],
-                    &prev_u[kc..kc + pw],
-                    &prev_u[kd..kd + pw],
-                    &prev_b[ku..ku + pw],
-                    &prev_b[kc..kc + pw],
-                    &prev_b[kd..kd + pw],
-                    &mu[m..m + cols],
-                    &mb[m..m + cols],
-                    &mut cur_u[kk..kk + pw],
-                    &mut cur_b[kk..kk + pw],
-                    in_sum.then_some(cs),
-                );
-            }
+                (&prev_u[ku..ku + pw], &prev_b[ku..ku + pw])
+            };
+            step_row(
+                up_u,
+                &prev_u[kc..kc + pw],
+                &prev_u[kd..kd + pw],
+                up_b,
+                &prev_b[kc..kc + pw],
+                &prev_b[kd..kd + pw],
+                &mu[m..m + cols],
+                &mb[m..m + cols],
+                &mut cur_u[kk..kk + pw],
+                &mut cur_b[kk..kk + pw],
+                in_sum.then_some(cs),
+            );
         }
     }
     colsum.chunks(cols).map(|c| c.iter().sum::<f64>()).collect()
@@ -211,17 +200,7 @@ pub fn blanket_areas(
             (sums, n)
         })
         .collect();
-    let mut sums = vec![0.0f64; eps_max];
-    let mut n = 0;
-    for (s, c) in parts {
-        for (a, b) in sums.iter_mut().zip(s) {
-            *a += b;
-        }
-        n += c;
-    }
-    if n == 0 {
-        return Err(CoreError::invalid("data", "no valid value (all NaN)"));
-    }
+    let (sums, n) = super::sum_parts(parts, eps_max)?;
     let areas = sums
         .iter()
         .enumerate()

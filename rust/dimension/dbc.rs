@@ -11,24 +11,8 @@
 //! hold, like the binary counter. NaN marks nodata and is skipped.
 use super::lattice::{best_source, box_range, lattice_shifts, n_boxes, validate_box_sizes, Shape3};
 use crate::error::{CoreError, CoreResult};
+pub use crate::sample::Sample;
 use rayon::prelude::*;
-
-/// A sample type the counter reads (`f32` or `f64`).
-pub trait Sample: Copy + Send + Sync {
-    fn to_f64(self) -> f64;
-}
-impl Sample for f32 {
-    #[inline]
-    fn to_f64(self) -> f64 {
-        self as f64
-    }
-}
-impl Sample for f64 {
-    #[inline]
-    fn to_f64(self) -> f64 {
-        self
-    }
-}
 
 /// Minimum and maximum per block; empty blocks hold (+inf, -inf).
 pub(crate) struct MinMax {
@@ -161,6 +145,15 @@ pub fn dbc_count<T: Sample>(
         return Err(CoreError::invalid("offsets", "must be a positive integer"));
     }
     let sizes = validate_box_sizes(box_sizes, rows.max(cols))?;
+    if sizes[0] < 2 {
+        return Err(CoreError::invalid(
+            "box_sizes",
+            format!(
+                "DBC needs block sides of at least 2 pixels (a 1-pixel block spans no \
+                 height range: it always holds one box), got {sizes:?}"
+            ),
+        ));
+    }
     let shifts = lattice_shifts(2, n_offsets, *sizes.last().unwrap());
     let mut counts = vec![vec![0f64; shifts.len()]; sizes.len()];
     for (j, g) in shifts.iter().enumerate() {
@@ -239,7 +232,7 @@ mod tests {
                 .into_iter()
                 .map(|u| if u < 0.1 { f64::NAN } else { u * 50.0 })
                 .collect();
-            let sizes = [1usize, 2, 3, 4, 6, 8, 12, 16];
+            let sizes = [2usize, 3, 4, 6, 8, 12, 16];
             let sizes: Vec<usize> = sizes.into_iter().filter(|&s| s <= rows.max(cols)).collect();
             let r = dbc_count(&data, rows, cols, &sizes, 1, 0.0, 0.7).unwrap();
             for (i, &s) in r.box_sizes.iter().enumerate() {

@@ -69,12 +69,10 @@ pub fn validate_box_sizes(box_sizes: &[usize], max_len: usize) -> CoreResult<Vec
         ));
     }
     if v.len() < 3 {
+        let n = v.len();
         return Err(CoreError::invalid(
             "box_sizes",
-            format!(
-                "need at least 3 distinct box sizes for a fit, got {}",
-                v.len()
-            ),
+            format!("need at least 3 distinct box sizes for a fit, got {n}"),
         ));
     }
     if let Some(&s) = v.last() {

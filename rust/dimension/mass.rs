@@ -13,8 +13,8 @@
 //! D    = -slope of log N(L) against log L
 //! ```
 use crate::checks::positive_finite;
-use crate::dimension::dbc::Sample;
 use crate::error::{CoreError, CoreResult};
+use crate::sample::Sample;
 use rayon::prelude::*;
 
 /// `m_p(L)` for every pixel of rows `[r0, r1)` and every box size; invalid
@@ -326,7 +326,7 @@ pub fn mass_curve(
     order.sort_by_key(|&i| box_sizes[i]);
     let ks: Vec<usize> = order.iter().map(|&i| box_sizes[i] / 2).collect();
     let band = 64usize;
-    let partial: Vec<(Vec<f64>, f64)> = (0..rows.div_ceil(band))
+    let partial: Vec<(Vec<f64>, usize)> = (0..rows.div_ceil(band))
         .into_par_iter()
         .map_init(MassBuf::default, |buf, b| {
             let (r0, r1) = (b * band, ((b + 1) * band).min(rows));
@@ -341,7 +341,7 @@ pub fn mass_curve(
             };
             box_masses_into(&job, buf);
             let m = &buf.planes;
-            let n = m[0].iter().filter(|&&v| v > 0.0).count() as f64;
+            let n = m[0].iter().filter(|&&v| v > 0.0).count();
             let sums = m
                 .iter()
                 .map(|plane| plane.iter().filter(|&&v| v > 0.0).map(|v| 1.0 / v).sum())
@@ -349,17 +349,9 @@ pub fn mass_curve(
             (sums, n)
         })
         .collect();
-    let mut sums = vec![0.0f64; ks.len()];
-    let mut n = 0.0;
-    for (s, c) in partial {
-        for (a, b) in sums.iter_mut().zip(s) {
-            *a += b;
-        }
-        n += c;
-    }
-    if n == 0.0 {
-        return Err(CoreError::invalid("data", "no valid value (all NaN)"));
-    }
+    let (sums, n) = super::sum_parts(partial, ks.len())?;
+    // an exact integer count (below 2^53), as the band counts' f64 sum was
+    let n = n as f64;
     let mut out = vec![0.0f64; box_sizes.len()];
     for (slot, &i) in order.iter().enumerate() {
         out[i] = sums[slot] / n;

@@ -19,3 +19,27 @@ pub mod higuchi;
 pub mod lattice;
 pub mod mass;
 pub mod points;
+
+/// The sums of per-band parts `(sums, valid count)`, added in band order
+/// (so the result does not depend on the thread count), and the total
+/// count; no valid value at all is an error naming `data`.
+pub(crate) fn sum_parts(
+    parts: Vec<(Vec<f64>, usize)>,
+    len: usize,
+) -> crate::CoreResult<(Vec<f64>, usize)> {
+    let mut sums = vec![0.0f64; len];
+    let mut n = 0;
+    for (s, c) in parts {
+        for (a, b) in sums.iter_mut().zip(s) {
+            *a += b;
+        }
+        n += c;
+    }
+    if n == 0 {
+        return Err(crate::CoreError::invalid(
+            "data",
+            "no valid value (all NaN)",
+        ));
+    }
+    Ok((sums, n))
+}

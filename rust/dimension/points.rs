@@ -16,6 +16,20 @@ pub struct PointCounts {
     pub counts: Vec<Vec<u64>>,
 }
 
+/// `n` points of `d` finite coordinates each (row-major `coords`).
+fn check_points(coords: &[f64], n: usize, d: usize) -> CoreResult<()> {
+    if n == 0 || d == 0 || coords.len() != n * d {
+        return Err(CoreError::invalid("data", "point set is empty"));
+    }
+    if coords.iter().any(|v| !v.is_finite()) {
+        return Err(CoreError::invalid(
+            "data",
+            "coordinates must be finite (no NaN or inf)",
+        ));
+    }
+    Ok(())
+}
+
 /// Count occupied boxes of an `n x d` row-major coordinate array.
 pub fn point_box_count(
     coords: &[f64],
@@ -24,19 +38,11 @@ pub fn point_box_count(
     box_sizes: &[f64],
     n_offsets: usize,
 ) -> CoreResult<PointCounts> {
-    if n == 0 || d == 0 || coords.len() != n * d {
-        return Err(CoreError::invalid("data", "point set is empty"));
-    }
+    check_points(coords, n, d)?;
     if d > 16 {
         return Err(CoreError::invalid(
             "data",
             format!("at most 16 coordinates per point, got {d}"),
-        ));
-    }
-    if coords.iter().any(|v| !v.is_finite()) {
-        return Err(CoreError::invalid(
-            "data",
-            "coordinates must be finite (no NaN or inf)",
         ));
     }
     if n_offsets == 0 {
@@ -133,19 +139,11 @@ pub fn point_lattice_levels(
     min_occupancy: f64,
     max_levels: usize,
 ) -> CoreResult<Vec<LatticeLevel>> {
-    if n == 0 || d == 0 || coords.len() != n * d {
-        return Err(CoreError::invalid("data", "point set is empty"));
-    }
+    check_points(coords, n, d)?;
     if !(2..=16).contains(&base) {
         return Err(CoreError::invalid(
             "base",
             format!("expected 2..=16, got {base}"),
-        ));
-    }
-    if coords.iter().any(|v| !v.is_finite()) {
-        return Err(CoreError::invalid(
-            "data",
-            "coordinates must be finite (no NaN or inf)",
         ));
     }
     let (lo, hi) = bounds(coords, d);

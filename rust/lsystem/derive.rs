@@ -22,11 +22,26 @@ pub const DEFAULT_MAX_LENGTH: usize = 100_000_000;
 /// otherwise let a huge `n` run for hours).
 pub const MAX_STEPS: usize = 1_000_000;
 
-pub use crate::synth::rng::{chain_hash3 as hash3, chain_unit3 as unit3};
+pub use crate::rng::{chain_hash3 as hash3, chain_unit3 as unit3};
 
 /// Rule of each symbol of a context-free, condition-free, non-parametric
 /// system: ASCII by code (`u32::MAX` = none), others by map.
 type SimpleTable = (Vec<u32>, HashMap<char, u32>);
+
+/// The successor of `rule` that module `i` of generation `generation` takes:
+/// the only one, or the first whose cumulative weight exceeds the module's
+/// uniform `unit3(seed, generation, i)` (a stochastic rule).
+#[inline]
+fn successor_index(rule: &Rule, seed: u64, generation: u64, i: usize) -> usize {
+    if rule.successors.len() == 1 {
+        return 0;
+    }
+    let u = unit3(seed, generation, i as u64);
+    rule.cum_weights
+        .iter()
+        .position(|&w| u < w)
+        .unwrap_or(rule.cum_weights.len() - 1)
+}
 
 /// A compiled L-system.
 #[derive(Debug, Clone)]
@@ -297,16 +312,7 @@ impl LSystem {
                         continue;
                     }
                 }
-                let k = if rule.successors.len() == 1 {
-                    0
-                } else {
-                    let u = unit3(seed, generation, i as u64);
-                    rule.cum_weights
-                        .iter()
-                        .position(|&w| u < w)
-                        .unwrap_or(rule.cum_weights.len() - 1)
-                };
-                let succ = &rule.successors[k];
+                let succ = &rule.successors[successor_index(rule, seed, generation, i)];
                 if self.parametric {
                     for m in &succ.modules {
                         out.syms.push(m.sym);
@@ -436,16 +442,7 @@ impl LSystem {
                 return None;
             }
             let rule = &self.rules[r as usize];
-            let k = if rule.successors.len() == 1 {
-                0
-            } else {
-                let u = unit3(seed, generation, i as u64);
-                rule.cum_weights
-                    .iter()
-                    .position(|&w| u < w)
-                    .unwrap_or(rule.cum_weights.len() - 1)
-            };
-            Some(&rule.successors[k].syms)
+            Some(&rule.successors[successor_index(rule, seed, generation, i)].syms)
         };
         let n = s.len();
         let threads = rayon::current_num_threads().max(1);

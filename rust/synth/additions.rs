@@ -30,9 +30,9 @@
 //! coarse rows it reads and computes the centre rows it reads (3 more than
 //! its own) into per-thread scratch, then writes its fine rows with their
 //! noise; there is no padded copy of a whole grid and no grid of centres.
-use super::rng::StreamKey;
 use crate::error::{CoreError, CoreResult};
 use crate::progress::{add_total, tick, Progress};
+use crate::rng::StreamKey;
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
 
@@ -69,28 +69,11 @@ const PH_A2: u64 = 2;
 const PH_E: u64 = 3;
 
 fn key(p: &AdditionsParams, phase: u64) -> StreamKey {
-    StreamKey::new(p.seed, STREAM_BASE + (p.level as u64) * 8 + phase)
+    super::level_key(p.seed, STREAM_BASE, p.level, phase)
 }
 
 fn check(p: &AdditionsParams) -> CoreResult<()> {
-    if !(p.hurst > 0.0 && p.hurst < 1.0) {
-        return Err(CoreError::invalid(
-            "hurst",
-            format!("expected a number in (0, 1), got {}", p.hurst),
-        ));
-    }
-    if !(p.sigma.is_finite() && p.sigma >= 0.0) {
-        return Err(CoreError::invalid(
-            "sigma",
-            format!("expected a finite number >= 0, got {}", p.sigma),
-        ));
-    }
-    if !(p.coarse_spacing.is_finite() && p.coarse_spacing > 0.0) {
-        return Err(CoreError::invalid(
-            "coarse_spacing",
-            format!("expected a positive number, got {}", p.coarse_spacing),
-        ));
-    }
+    super::check_level(p.hurst, p.sigma, p.coarse_spacing)?;
     if !(p.tension.is_finite() && p.tension.abs() <= 0.25) {
         return Err(CoreError::invalid(
             "tension",
@@ -367,25 +350,8 @@ pub fn refine_2d(
     progress: Option<&Progress>,
 ) -> CoreResult<Array2<f64>> {
     check(p)?;
-    let (r, c) = coarse.dim();
-    if !p.periodic && (r < 2 || c < 2) {
-        return Err(CoreError::invalid(
-            "coarse",
-            format!("need at least 2 x 2 samples, got {r} x {c}"),
-        ));
-    }
-    if r < 1 || c < 1 {
-        return Err(CoreError::invalid("coarse", "empty grid"));
-    }
-    let coarse = coarse.as_standard_layout();
-    let cs: &[f64] = coarse
-        .as_slice()
-        .ok_or_else(|| CoreError::Internal("coarse grid not contiguous".into()))?;
-    let (fr, fc) = if p.periodic {
-        (2 * r, 2 * c)
-    } else {
-        (2 * r - 1, 2 * c - 1)
-    };
+    let (coarse, (r, c), (fr, fc)) = super::refine_input(coarse, p.periodic)?;
+    let cs = super::as_slice(&coarse)?;
     let (or, oc) = window_shape(shape, (fr, fc))?;
     // Centres: (nr, nc) of them at fine (2a+1, 2b+1).
     let (nr, nc) = if p.periodic { (r, c) } else { (r - 1, c - 1) };

@@ -15,9 +15,9 @@
 //! `W_0 <- z[0]`, `W_m <- z[1]`, `Re W_k <- z[k + 1]`, `Im W_k <- z[m + k]`
 //! (`k = 1 .. m-1`): the same layout as the former scipy implementation, so a
 //! seed gives the same path up to rounding.
-use super::rng::StreamKey;
 use crate::error::{CoreError, CoreResult};
 use crate::progress::{add_total, tick, Progress};
+use crate::rng::StreamKey;
 use rayon::prelude::*;
 use realfft::num_complex::Complex;
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};

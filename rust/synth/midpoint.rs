@@ -24,9 +24,10 @@
 //! in the refined grid)` (see [`super::rng`]), so the output does not depend on
 //! the number of threads, and the noise at a global position is the same
 //! whichever tile (`origin`) computes it.
-use super::rng::StreamKey;
 use crate::error::{CoreError, CoreResult};
+use crate::parallel::SharedMut;
 use crate::progress::{add_total, tick, Progress};
+use crate::rng::StreamKey;
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
 
@@ -61,29 +62,31 @@ const PHASE_ADD_SQ: u64 = 3;
 pub const STREAM_BASE: u64 = 1 << 20;
 
 fn key(p: &RefineParams, phase: u64) -> StreamKey {
-    StreamKey::new(p.seed, STREAM_BASE + (p.level as u64) * 8 + phase)
+    super::level_key(p.seed, STREAM_BASE, p.level, phase)
 }
 
 fn check(p: &RefineParams) -> CoreResult<()> {
-    if !(p.hurst > 0.0 && p.hurst < 1.0) {
-        return Err(CoreError::invalid(
-            "hurst",
-            format!("expected a number in (0, 1), got {}", p.hurst),
-        ));
+    super::check_level(p.hurst, p.sigma, p.coarse_spacing)
+}
+
+/// The neighbour index before `k` on a line of `n` (wrapping on a torus).
+#[inline]
+fn before(k: usize, n: usize, periodic: bool) -> Option<usize> {
+    if k > 0 {
+        Some(k - 1)
+    } else {
+        periodic.then(|| n - 1)
     }
-    if !(p.sigma.is_finite() && p.sigma >= 0.0) {
-        return Err(CoreError::invalid(
-            "sigma",
-            format!("expected a finite number >= 0, got {}", p.sigma),
-        ));
+}
+
+/// The neighbour index after `k` on a line of `n` (wrapping on a torus).
+#[inline]
+fn after(k: usize, n: usize, periodic: bool) -> Option<usize> {
+    if k + 1 < n {
+        Some(k + 1)
+    } else {
+        periodic.then_some(0)
     }
-    if !(p.coarse_spacing.is_finite() && p.coarse_spacing > 0.0) {
-        return Err(CoreError::invalid(
-            "coarse_spacing",
-            format!("expected a positive number, got {}", p.coarse_spacing),
-        ));
-    }
-    Ok(())
 }
 
 /// Constant `k` of the 1D schedule (see the module docs).
@@ -164,25 +167,8 @@ pub fn refine_2d(
     progress: Option<&Progress>,
 ) -> CoreResult<Array2<f64>> {
     check(p)?;
-    let (r, c) = coarse.dim();
-    if !p.periodic && (r < 2 || c < 2) {
-        return Err(CoreError::invalid(
-            "coarse",
-            format!("need at least 2 x 2 samples, got {r} x {c}"),
-        ));
-    }
-    if p.periodic && (r < 1 || c < 1) {
-        return Err(CoreError::invalid("coarse", "empty grid"));
-    }
-    let coarse = coarse.as_standard_layout();
-    let cs: &[f64] = coarse
-        .as_slice()
-        .ok_or_else(|| CoreError::Internal("coarse grid not contiguous".into()))?;
-    let (fr, fc) = if p.periodic {
-        (2 * r, 2 * c)
-    } else {
-        (2 * r - 1, 2 * c - 1)
-    };
+    let (coarse, (r, c), (fr, fc)) = super::refine_input(coarse, p.periodic)?;
+    let cs = super::as_slice(&coarse)?;
     let s = p.coarse_spacing;
     let kk = k2(p.hurst, p.additions);
     // Diamond step: the coarse side is s; square step: the lattice side is s / sqrt 2.
@@ -244,22 +230,9 @@ pub fn refine_2d(
 
     // Pass B (square step), in place: it writes only the samples with i + j
     // odd and reads only samples with i + j even (written by pass A), so the
-    // rows can be processed in parallel through a shared pointer.
-    struct Shared(*mut f64);
-    // SAFETY: the pointer is shared by the rows of pass B only, and they
-    // never touch the same cell mutably: row i writes its own odd-parity
-    // cells and reads only even-parity cells, which no row writes in this
-    // pass; `fine` outlives the parallel loop and is not otherwise borrowed.
-    unsafe impl Sync for Shared {}
-    // SAFETY: as for Sync: the raw pointer is only dereferenced inside the
-    // loop below, under the parity rule stated there.
-    unsafe impl Send for Shared {}
-    impl Shared {
-        fn get(&self) -> *mut f64 {
-            self.0
-        }
-    }
-    let ptr = Shared(fine.as_mut_ptr());
+    // rows can be processed in parallel through a shared pointer (row i
+    // writes its own odd-parity cells only; `fine` outlives the loop).
+    let ptr = SharedMut::new(&mut fine);
     let periodic = p.periodic;
     (0..fr).into_par_iter().for_each(|i| {
         let base = ptr.get();
@@ -267,52 +240,18 @@ pub fn refine_2d(
         // row i only; both are inside the fr * fc buffer.
         let get = |ii: usize, jj: usize| unsafe { *base.add(ii * fc + jj) };
         let gbase = (o0 + i as u64) * gc + o1;
-        let up = if i > 0 {
-            Some(i - 1)
-        } else if periodic {
-            Some(fr - 1)
-        } else {
-            None
-        };
-        let down = if i + 1 < fr {
-            Some(i + 1)
-        } else if periodic {
-            Some(0)
-        } else {
-            None
-        };
+        let (up, down) = (before(i, fr, periodic), after(i, fr, periodic));
         let mut j = if i % 2 == 0 { 1 } else { 0 };
         while j < fc {
-            let left = if j > 0 {
-                Some(j - 1)
-            } else if periodic {
-                Some(fc - 1)
-            } else {
-                None
-            };
-            let right = if j + 1 < fc {
-                Some(j + 1)
-            } else if periodic {
-                Some(0)
-            } else {
-                None
-            };
-            let mut sum = 0.0;
-            let mut cnt = 0.0;
-            if let Some(u) = up {
-                sum += get(u, j);
-                cnt += 1.0;
-            }
-            if let Some(d) = down {
-                sum += get(d, j);
-                cnt += 1.0;
-            }
-            if let Some(l) = left {
-                sum += get(i, l);
-                cnt += 1.0;
-            }
-            if let Some(rr) = right {
-                sum += get(i, rr);
+            let (left, right) = (before(j, fc, periodic), after(j, fc, periodic));
+            let (mut sum, mut cnt) = (0.0, 0.0);
+            // the neighbours present, in the order up, down, left, right
+            let cells = [up.map(|u| (u, j)), down.map(|d| (d, j))];
+            let cells = cells
+                .into_iter()
+                .chain([left.map(|l| (i, l)), right.map(|r| (i, r))]);
+            for (ii, jj) in cells.flatten() {
+                sum += get(ii, jj);
                 cnt += 1.0;
             }
             let mean = sum / cnt;

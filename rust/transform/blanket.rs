@@ -27,11 +27,11 @@
 //! `e`. The cost per pixel is `O(w e_max^2)`: it still grows with the window,
 //! linearly instead of as `w^2`.
 //!
-use super::driver::{Grid, LogFit, MapOut};
+use super::driver::{scale_list, Grid, LogFit, MapOut};
 use super::sat::{band_rows, rect, sat};
 use crate::checks::positive_finite;
 use crate::dimension::blanket::{fmax, step_row};
-use crate::error::{CoreError, CoreResult};
+use crate::error::CoreResult;
 
 /// Planes of `(rows + 2) x (cols + 2)` samples framed by one missing pixel:
 /// upper and lower blankets (missing: `-inf`, `+inf`), their next step, and
@@ -321,22 +321,12 @@ pub fn blanket_transform(
     cols: usize,
     opt: &BlanketMapOptions,
 ) -> CoreResult<MapOut> {
-    let w = opt.window;
-    let grid = Grid::new(z.len(), rows, cols, w, opt.min_valid, opt.step)?;
-    let (min_pixels, ocols) = (grid.min_pixels, grid.ocols);
-    let mut eps = opt.epsilons.clone();
-    eps.sort_unstable();
-    eps.dedup();
-    if eps.len() < 3 || eps[0] == 0 {
-        return Err(CoreError::invalid(
-            "epsilons",
-            format!(
-                "need at least 3 distinct positive thicknesses, got {:?}",
-                opt.epsilons
-            ),
-        ));
-    }
     positive_finite(opt.z_scale, "z_scale")?;
+    let grid = Grid::new(z.len(), rows, cols, opt.window, opt.min_valid, opt.step)?;
+    let eps = scale_list(&opt.epsilons, "epsilons", 3, "positive thicknesses", |e| {
+        e > 0
+    })?;
+    let (w, min_pixels, ocols) = (grid.w, grid.min_pixels, grid.ocols);
     let emax = *eps.last().unwrap();
     let fit = LogFit::new(&eps, |slope| 2.0 - slope);
     let (h, step) = (grid.h, grid.step);

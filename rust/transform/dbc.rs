@@ -23,11 +23,11 @@
 //! O(1) per pixel); a window's `N(s)` is then a sum over a lattice of stride
 //! `s`, read from a summed-area table strided by `s` (one table holds every
 //! grid offset). The cost per pixel does not grow with the window.
-use super::driver::{Grid, LogFit, MapOut};
+use super::driver::{scale_list, Grid, LogFit, MapOut};
 use super::sat::{band_rows, rect, sat};
 use super::sliding::rect_minmax;
 use crate::checks::{finite, positive_finite};
-use crate::error::{CoreError, CoreResult};
+use crate::error::CoreResult;
 
 /// Options of [`dbc_transform`].
 #[derive(Debug, Clone)]
@@ -89,23 +89,22 @@ pub fn dbc_transform(
     cols: usize,
     opt: &DbcMapOptions,
 ) -> CoreResult<MapOut> {
-    let w = opt.window;
-    let grid = Grid::new(z.len(), rows, cols, w, opt.min_valid, opt.step)?;
-    let (min_pixels, ocols) = (grid.min_pixels, grid.ocols);
-    let mut sizes = opt.box_sizes.clone();
-    sizes.sort_unstable();
-    sizes.dedup();
-    if sizes.len() < 3 || sizes[0] == 0 || *sizes.last().unwrap() > w {
-        return Err(CoreError::invalid(
-            "box_sizes",
-            format!(
-                "need at least 3 distinct box sizes in [1, {w}], got {:?}",
-                opt.box_sizes
-            ),
-        ));
-    }
-    positive_finite(opt.z_unit, "z_scale")?;
-    finite(opt.z0, "z0")?;
+    let (z_unit, z0) = (
+        positive_finite(opt.z_unit, "z_scale")?,
+        finite(opt.z0, "z0")?,
+    );
+    let grid = Grid::new(z.len(), rows, cols, opt.window, opt.min_valid, opt.step)?;
+    let (w, min_pixels, ocols) = (grid.w, grid.min_pixels, grid.ocols);
+    // [2, w], as the Python layer and the whole-image counter: a 1-pixel
+    // block spans no height range (it always holds one box)
+    let in_range = |s| (2..=w).contains(&s);
+    let sizes = scale_list(
+        &opt.box_sizes,
+        "box_sizes",
+        3,
+        &format!("block sides in [2, {w}]"),
+        in_range,
+    )?;
     let (h, step) = (grid.h, grid.step);
     let fit = LogFit::new(&sizes, |slope| -slope);
     grid.drive_pair(|_: &mut (), band, outs| {
@@ -148,14 +147,14 @@ pub fn dbc_transform(
             let npix = (k1 - k0) * nq;
             let mut counts = vec![vec![0.0f64; npix]; sizes.len()];
             for (si, &s) in sizes.iter().enumerate() {
-                let hgt = s as f64 * opt.z_unit;
+                let hgt = s as f64 * z_unit;
                 let nf = w / s;
                 let t = w % s;
                 let si_ = s as isize;
                 let last = ((nf - 1) * s) as isize;
                 // full blocks: table strided by s
                 let wss = nc - s + 1;
-                let mut tss = count_field(&lo, &hi, nr, nc, s, s, opt.z0, hgt);
+                let mut tss = count_field(&lo, &hi, nr, nc, s, s, z0, hgt);
                 let nss = nr - s + 1;
                 for row in tss.chunks_mut(wss) {
                     for v in s..wss {
@@ -171,20 +170,20 @@ pub fn dbc_transform(
                 }
                 // partial blocks: bottom row (t x s), right column (s x t), corner (t x t)
                 let partial = (t > 0 && opt.partial_blocks).then(|| {
-                    let mut pts = count_field(&lo, &hi, nr, nc, t, s, opt.z0, hgt);
+                    let mut pts = count_field(&lo, &hi, nr, nc, t, s, z0, hgt);
                     for u in 0..nr - t + 1 {
                         for v in s..wss {
                             pts[u * wss + v] += pts[u * wss + v - s];
                         }
                     }
                     let wst = nc - t + 1;
-                    let mut pst = count_field(&lo, &hi, nr, nc, s, t, opt.z0, hgt);
+                    let mut pst = count_field(&lo, &hi, nr, nc, s, t, z0, hgt);
                     for u in s..nr - s + 1 {
                         for v in 0..wst {
                             pst[u * wst + v] += pst[(u - s) * wst + v];
                         }
                     }
-                    let ptt = count_field(&lo, &hi, nr, nc, t, t, opt.z0, hgt);
+                    let ptt = count_field(&lo, &hi, nr, nc, t, t, z0, hgt);
                     (pts, pst, ptt, wst)
                 });
                 let out = &mut counts[si];
@@ -277,7 +276,7 @@ mod tests {
         let z = image(rows, cols, 4);
         for (w, sizes, step) in [
             (9usize, vec![2usize, 3, 4], 1usize),
-            (11, vec![1, 2, 5, 11], 1),
+            (11, vec![2, 3, 5, 11], 1),
             (15, vec![2, 4, 8], 3),
         ] {
             let o = DbcMapOptions {
@@ -330,6 +329,10 @@ mod tests {
             },
             DbcMapOptions {
                 box_sizes: vec![2, 4, 14],
+                ..o.clone()
+            },
+            DbcMapOptions {
+                box_sizes: vec![1, 2, 4],
                 ..o.clone()
             },
             DbcMapOptions {

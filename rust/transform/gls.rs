@@ -16,8 +16,8 @@
 //! [`super::variation`]), so the cost per pixel does not grow with the window
 //! and the result does not depend on the thread count.
 use super::driver::{Band, Grid, MapOut};
-use crate::dimension::dbc::Sample;
 use crate::error::{CoreError, CoreResult};
+use crate::sample::Sample;
 
 const DIRS: [(isize, isize); 4] = [(0, 1), (1, 0), (1, 1), (1, -1)];
 
@@ -814,7 +814,7 @@ fn gls_transform_on<T: Sample>(
         let _ = allow_avx2;
         false
     };
-    let mut maps = grid.drive(&[true, true, an, an], |sc: &mut GlsScratch, band, outs| {
+    let maps = grid.drive(&[true, true, an, an], |sc: &mut GlsScratch, band, outs| {
         #[cfg(target_arch = "x86_64")]
         if avx2 {
             // SAFETY: the CPU has AVX2 and FMA (checked above)
@@ -823,16 +823,7 @@ fn gls_transform_on<T: Sample>(
         }
         gls_band(&cx, sc, band, outs);
     })?;
-    let extra = maps.split_off(2);
-    let r2 = maps.pop().unwrap_or_default();
-    let d = maps.pop().unwrap_or_default();
-    Ok(MapOut {
-        rows: grid.orows,
-        cols: grid.ocols,
-        d,
-        r2,
-        extra,
-    })
+    Ok(grid.map_out(maps))
 }
 
 #[cfg(test)]

@@ -16,12 +16,12 @@
 //! window sums come from summed-area tables: the cost per pixel is the box
 //! neighbourhood (`L_max^2`), independent of the window. The box masses and
 //! the image-wide curve are in `crate::dimension::mass`.
-use super::driver::{valid_sat, Grid, LogFit, MapOut};
+use super::driver::{scale_list, valid_sat, Grid, LogFit, MapOut};
 use super::sat::{rect, sat_into};
 use crate::checks::positive_finite;
-use crate::dimension::dbc::Sample;
 use crate::dimension::mass::{box_masses_into, Band, MassBuf};
-use crate::error::{CoreError, CoreResult};
+use crate::error::CoreResult;
+use crate::sample::Sample;
 
 /// Options of [`mass_transform`].
 #[derive(Debug, Clone)]
@@ -44,20 +44,16 @@ pub fn mass_transform<T: Sample>(
     cols: usize,
     opt: &MassOptions,
 ) -> CoreResult<MapOut> {
-    let w = opt.window;
-    let grid = Grid::new(z.len(), rows, cols, w, opt.min_valid, opt.step)?;
-    let mut sizes = opt.box_sizes.clone();
-    sizes.sort_unstable();
-    sizes.dedup();
-    if sizes.len() < 2 || sizes.iter().any(|&l| l < 3 || l % 2 == 0 || l > w) {
-        return Err(CoreError::invalid(
-            "box_sizes",
-            format!(
-                "need at least 2 distinct odd box sides in [3, {w}], got {:?}",
-                opt.box_sizes
-            ),
-        ));
-    }
+    let grid = Grid::new(z.len(), rows, cols, opt.window, opt.min_valid, opt.step)?;
+    let w = grid.w;
+    let odd_side = |l| l >= 3 && l % 2 == 1 && l <= w;
+    let sizes = scale_list(
+        &opt.box_sizes,
+        "box_sizes",
+        2,
+        &format!("odd box sides in [3, {w}]"),
+        odd_side,
+    )?;
     positive_finite(opt.z_scale, "z_scale")?;
     let ks: Vec<usize> = sizes.iter().map(|l| l / 2).collect();
     let fit = LogFit::new(&sizes, |slope| -slope);

@@ -12,16 +12,17 @@
 //! * [`gls`]: GLS fit of H over the log quadratic variations of increment
 //!   filters (summed-area tables).
 //! * [`driver`]: the moving-window driver (grid, bands, gate, fit, result)
-//!   every map kernel runs on.
+//!   every map kernel runs on (`crate::window::driver`, re-exported).
 //! * [`dbc`]: differential box counting per window (sliding min/max and
 //!   summed-area tables strided by the box size).
 
 pub mod blanket;
 pub mod dbc;
-pub mod driver;
 pub mod gls;
 pub mod lacunarity;
 pub mod mass;
-mod sat;
 mod sliding;
 pub mod variation;
+
+pub use crate::window::driver;
+use crate::window::sat;

@@ -14,11 +14,11 @@
 //! increment powers and counts, built per band of rows at fixed positions,
 //! so the cost per pixel is independent of `w` and the result does not
 //! depend on the thread count.
-use super::driver::{valid_sat, Grid, LogFit, MapOut};
+use super::driver::{scale_list, valid_sat, Grid, LogFit, MapOut};
 use super::sat::{rect, sats_into};
 use crate::checks::positive_finite;
-use crate::dimension::dbc::Sample;
-use crate::error::{CoreError, CoreResult};
+use crate::error::CoreResult;
+use crate::sample::Sample;
 
 /// Which increments.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -49,21 +49,12 @@ pub fn variation_transform<T: Sample>(
     cols: usize,
     opt: &VariationOptions,
 ) -> CoreResult<MapOut> {
-    let w = opt.window;
-    let grid = Grid::new(z.len(), rows, cols, w, opt.min_valid, opt.step)?;
-    let mut lags = opt.lags.clone();
-    lags.sort_unstable();
-    lags.dedup();
-    if lags.len() < 2 || lags[0] == 0 || *lags.last().unwrap() >= w {
-        return Err(CoreError::invalid(
-            "lags",
-            format!(
-                "need at least 2 distinct lags in [1, {}), got {:?}",
-                w, opt.lags
-            ),
-        ));
-    }
     let p = positive_finite(opt.p, "p")?;
+    let grid = Grid::new(z.len(), rows, cols, opt.window, opt.min_valid, opt.step)?;
+    let w = grid.w;
+    let lags = scale_list(&opt.lags, "lags", 2, &format!("lags in [1, {w})"), |l| {
+        l > 0 && l < w
+    })?;
     let fit = LogFit::new(&lags, |slope| 3.0 - slope / p);
     let power = move |d: f64| -> f64 {
         if p == 2.0 {

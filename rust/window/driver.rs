@@ -11,7 +11,7 @@
 //! `n_threads`.
 use super::sat::{band_rows, check_window, line_fit, log_axis, rect, sat_into};
 use crate::checks::step_grid;
-use crate::error::CoreResult;
+use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 
 /// Maps on the grid of every `step`-th pixel, row-major `rows x cols`:
@@ -69,6 +69,29 @@ impl Band {
     pub fn nr(&self) -> usize {
         self.i1 - self.i0
     }
+}
+
+/// The scale list of a map kernel (box sizes, lags, thicknesses): its
+/// distinct values in ascending order, or an error naming `param` when fewer
+/// than `min_count` are distinct or one of them fails `ok` (`expected` says
+/// what the values must be, e.g. "lags in [1, 9)").
+pub fn scale_list(
+    values: &[usize],
+    param: &str,
+    min_count: usize,
+    expected: &str,
+    ok: impl Fn(usize) -> bool,
+) -> CoreResult<Vec<usize>> {
+    let mut v = values.to_vec();
+    v.sort_unstable();
+    v.dedup();
+    if v.len() < min_count || !v.iter().all(|&x| ok(x)) {
+        return Err(CoreError::invalid(
+            param,
+            format!("need at least {min_count} distinct {expected}, got {values:?}"),
+        ));
+    }
+    Ok(v)
 }
 
 impl Grid {
@@ -177,16 +200,20 @@ impl Grid {
         S: Default + Send,
         K: Fn(&mut S, &Band, &mut [&mut [f32]]) + Sync + Send,
     {
-        let mut maps = self.drive(&[true, true], kernel)?;
-        let r2 = maps.pop().unwrap_or_default();
-        let d = maps.pop().unwrap_or_default();
-        Ok(MapOut {
+        Ok(self.map_out(self.drive(&[true, true], kernel)?))
+    }
+
+    /// The [`MapOut`] of this grid from the maps of [`Grid::drive`] in
+    /// order: `D`, the second map, then any further maps.
+    pub fn map_out(&self, maps: Vec<Vec<f32>>) -> MapOut {
+        let mut maps = maps.into_iter();
+        MapOut {
             rows: self.orows,
             cols: self.ocols,
-            d,
-            r2,
-            extra: Vec::new(),
-        })
+            d: maps.next().unwrap_or_default(),
+            r2: maps.next().unwrap_or_default(),
+            extra: maps.collect(),
+        }
     }
 
     /// Every window of the band whose valid-pixel count (from `vsat`, a
