@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 
 import fractalgeo_rs as fg
-from fractalgeo_rs.dimension.likelihood import _FILTERS_1D, _FILTERS_2D, _Model, _apply_filter, _periodogram
+from fractalgeo_rs.dimension.likelihood import FILTERS_1D, FILTERS_2D, _Model, apply_filter, _periodogram
 
 
 def _stencil(name, nd):
-    f = (_FILTERS_1D if nd == 1 else _FILTERS_2D)[name]
+    f = (FILTERS_1D if nd == 1 else FILTERS_2D)[name]
     return np.array(list(f.keys())), np.array(list(f.values()), dtype=float)
 
 
@@ -74,7 +74,7 @@ def test_expected_periodogram_equals_mean_periodogram_of_simulated_fbm(nd, hurst
     grams = []
     for s in range(m):
         z = fg.fbm(n, hurst, method="exact", seed=s) if nd == 1 else fg.fbm_surface((n, n), hurst, method="exact", seed=s)
-        y = _apply_filter(z, off, w)
+        y = apply_filter(z, off, w)
         g = np.full(y.shape, 1.0 / np.sqrt(y.size))
         grams.append(_periodogram(y, g))
     grams = np.array(grams)

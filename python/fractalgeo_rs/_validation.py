@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 import numbers
 import os
+import secrets
 import tempfile
 import warnings
 from contextlib import contextmanager
@@ -32,8 +33,11 @@ __all__ = [
     "check_z_factor",
     "check_integer_lags",
     "check_positive_int",
+    "check_nonnegative_int",
     "check_positive_float",
     "check_choice",
+    "check_seed",
+    "check_window",
     "atomic_write_path",
 ]
 
@@ -265,6 +269,15 @@ def check_positive_int(value, name: str) -> int:
     return int(value)
 
 
+def check_nonnegative_int(value, name: str = "n") -> int:
+    """An int ``>= 0`` (e.g. a number of derivation steps)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name}: expected a non-negative int, got {value!r}")
+    if value < 0:
+        raise ValueError(f"{name}: expected a non-negative int, got {value}")
+    return int(value)
+
+
 def check_fraction(value, name: str) -> float:
     """A number in [0, 1] (e.g. ``min_valid``), as a float."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real) or not (0.0 <= float(value) <= 1.0):
@@ -279,6 +292,48 @@ def check_positive_float(value, name: str) -> float:
     if not np.isfinite(value) or value <= 0:
         raise ValueError(f"{name}: expected a positive finite number, got {value}")
     return value
+
+
+def check_seed(seed, name: str = "seed") -> int:
+    """The package's one seed policy: ``None`` draws a fresh 64-bit seed from
+    the operating system's entropy; otherwise an int in ``[0, 2**64)``.
+
+    Every random result is a pure function of the seed (counter-based
+    streams keyed by seed and position, ``rust/rng.rs``), so a given seed
+    gives the same result for any ``n_threads``, tiling or machine.
+    """
+    if seed is None:
+        return secrets.randbits(64)
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral):
+        raise TypeError(f"{name}: expected an int in [0, 2**64) or None, got {seed!r}")
+    if not 0 <= int(seed) < 2**64:
+        raise ValueError(f"{name}: expected an int in [0, 2**64) or None, got {seed}")
+    return int(seed)
+
+
+def check_window(value, name: str = "window_size", *, minimum: int = 3, shape=None, cover: bool = False) -> int:
+    """An odd window side ``>= minimum`` (pixels), the one window check.
+
+    With ``shape`` the window is also bounded by the image: at most its
+    longer side (``cover=False``: a moving window that lies inside the image,
+    as the fractal transform's), or at most ``2 * max(shape) + 1`` (``cover=True``:
+    a window centred on any pixel that may reach past the edges, as the
+    resampling analysis's; a larger one covers nothing more).
+    """
+    expected = f"expected an odd int >= {minimum}"
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name}: {expected}, got {value!r}")
+    w = int(value)
+    if w < minimum or w % 2 == 0:
+        raise ValueError(f"{name}: {expected}, got {w}")
+    if shape is not None:
+        side = max(shape)
+        if cover and w > 2 * side + 1:
+            raise ValueError(f"{name}: {w} is more than twice the image's side {side}; "
+                             f"a window of at most {2 * side + 1} already covers it")
+        if not cover and w > side:
+            raise ValueError(f"{name}: window {w} is larger than the image {tuple(shape)}")
+    return w
 
 
 def check_nodata(nodata) -> Optional[float]:

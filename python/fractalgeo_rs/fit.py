@@ -53,9 +53,8 @@ class FractalRangeWarning(UserWarning):
 
     References
     ----------
-    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
-    dimension: assessing the roughness of time series and spatial data,
-    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the bibliography,
+    :ref:`ref-gneiting2012`.
 
     Examples
     --------
@@ -196,12 +195,10 @@ class DimensionFit:
 
     References
     ----------
-    K. Falconer, *Fractal Geometry: Mathematical Foundations and
-    Applications*, Wiley, 1990.
+    Falconer (1990); full entry in the bibliography, :ref:`ref-falconer1990`.
 
-    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
-    dimension: assessing the roughness of time series and spatial data,
-    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the bibliography,
+    :ref:`ref-gneiting2012`.
 
     Examples
     --------
@@ -537,9 +534,8 @@ def fit_loglog(
     K. Falconer, *Fractal Geometry: Mathematical Foundations and
     Applications*, Wiley, 1990, chapter 3 (box-counting dimension).
 
-    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
-    dimension: assessing the roughness of time series and spatial data,
-    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the bibliography,
+    :ref:`ref-gneiting2012`.
 
     Examples
     --------

@@ -56,12 +56,11 @@ def srtm_alps() -> Tuple[np.ndarray, Dict[str, Any]]:
 
     References
     ----------
-    T. G. Farr et al., The Shuttle Radar Topography Mission, *Reviews of
-    Geophysics* 45 (2007) RG2004, doi:10.1029/2005RG000183.
+    Farr et al. (2007), doi:10.1029/2005RG000183; full entry in the bibliography,
+    :ref:`ref-farr2007`.
 
-    NASA JPL, NASA Shuttle Radar Topography Mission Global 3 arc second,
-    NASA EOSDIS Land Processes DAAC, 2013,
-    doi:10.5067/MEaSUREs/SRTM/SRTMGL3.003.
+    NASA JPL (2013), doi:10.5067/MEaSUREs/SRTM/SRTMGL3.003; full entry in the bibliography,
+    :ref:`ref-nasa2013`.
 
     Examples
     --------
@@ -87,12 +86,11 @@ def srtm_po_plain() -> Tuple[np.ndarray, Dict[str, Any]]:
 
     References
     ----------
-    T. G. Farr et al., The Shuttle Radar Topography Mission, *Reviews of
-    Geophysics* 45 (2007) RG2004, doi:10.1029/2005RG000183.
+    Farr et al. (2007), doi:10.1029/2005RG000183; full entry in the bibliography,
+    :ref:`ref-farr2007`.
 
-    NASA JPL, NASA Shuttle Radar Topography Mission Global 3 arc second,
-    NASA EOSDIS Land Processes DAAC, 2013,
-    doi:10.5067/MEaSUREs/SRTM/SRTMGL3.003.
+    NASA JPL (2013), doi:10.5067/MEaSUREs/SRTM/SRTMGL3.003; full entry in the bibliography,
+    :ref:`ref-nasa2013`.
 
     Examples
     --------
@@ -174,10 +172,8 @@ def sentinel1_vv_db() -> Tuple[np.ndarray, Dict[str, Any]]:
 
     References
     ----------
-    D. Bonafilia, B. Tellman, T. Anderson and E. Issenberg, Sen1Floods11: a
-    georeferenced dataset to train and test deep learning flood algorithms
-    for Sentinel-1, *CVPR Workshops* (2020) 835-845,
-    doi:10.1109/CVPRW50498.2020.00113.
+    Bonafilia et al. (2020), doi:10.1109/CVPRW50498.2020.00113; full entry in the bibliography,
+    :ref:`ref-bonafilia2020`.
 
     Examples
     --------
@@ -204,10 +200,8 @@ def sentinel1_vh_db() -> Tuple[np.ndarray, Dict[str, Any]]:
 
     References
     ----------
-    D. Bonafilia, B. Tellman, T. Anderson and E. Issenberg, Sen1Floods11: a
-    georeferenced dataset to train and test deep learning flood algorithms
-    for Sentinel-1, *CVPR Workshops* (2020) 835-845,
-    doi:10.1109/CVPRW50498.2020.00113.
+    Bonafilia et al. (2020), doi:10.1109/CVPRW50498.2020.00113; full entry in the bibliography,
+    :ref:`ref-bonafilia2020`.
 
     Examples
     --------

@@ -132,14 +132,10 @@ def dimension(data, method: str = "box", **options) -> DimensionFit:
 
     References
     ----------
-    M. Datcu and K. Seidel, Fractal and multiresolution techniques for the
-    understanding of geo-information, in *Fractals in Geoscience and Remote
-    Sensing*, Proceedings of a Joint JRC/EARSeL Expert Meeting, Ispra, 1994
-    (published 1995).
+    Datcu and Seidel (1994), the seed paper; full entry in the bibliography, :ref:`ref-datcu1994`.
 
-    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
-    dimension: assessing the roughness of time series and spatial data,
-    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the bibliography,
+    :ref:`ref-gneiting2012`.
 
     Examples
     --------

@@ -7,7 +7,7 @@ from typing import List, Optional
 
 import numpy as np
 
-from fractalgeo_rs._validation import check_choice
+from fractalgeo_rs._validation import as_array, check_choice, check_nodata
 
 
 def check_box_sizes(box_sizes, *, integer: bool = True, name: str = "box_sizes") -> Optional[list]:
@@ -198,3 +198,31 @@ def sampling_start(sizes, counts, *, min_sizes: int = 3) -> int:
     while len(x) - k > min_sizes and abs(local[k] - local[k + 1]) > SAMPLING_SLOPE_CHANGE:
         k += 1
     return k
+
+
+def real_array(data, ndims, name="data") -> np.ndarray:
+    """``data`` as a float64 array of one of the dimensions ``ndims``: real,
+    non-empty, no inf (NaN marks missing samples)."""
+    arr = as_array(data, name)
+    if arr.dtype.kind == "b" or arr.dtype.kind not in "iuf":
+        raise TypeError(f"{name}: expected a real numeric array, got dtype {arr.dtype}")
+    if arr.ndim not in ndims:
+        want = " or ".join(f"{d}D" for d in ndims)
+        raise ValueError(f"{name}: expected a {want} array, got {arr.ndim} dimensions")
+    if arr.size == 0:
+        raise ValueError(f"{name}: array is empty (shape {arr.shape})")
+    z = arr.astype(np.float64)
+    if np.isinf(z).any():
+        raise ValueError(f"{name}: contains inf; mark invalid samples with NaN or nodata")
+    return z
+
+
+def with_nodata(z: np.ndarray, data, nodata) -> np.ndarray:
+    """``z`` with the samples where ``data == nodata`` set to NaN (a copy)."""
+    nodata = check_nodata(nodata)
+    if nodata is None:
+        return z
+    if not np.isnan(nodata):
+        z = z.copy()
+        z[np.asarray(data) == nodata] = np.nan
+    return z

@@ -131,7 +131,7 @@ def _bounds(b: np.ndarray):
     return tuple(lo), tuple(hi)
 
 
-def _binary_bytes(data) -> Tuple[np.ndarray, bool]:
+def binary_bytes(data) -> Tuple[np.ndarray, bool]:
     """A C-contiguous uint8 view (0/1) of a binary set, and whether the axes
     were reversed (a Fortran-ordered input is counted through its transpose,
     which has the same counts, without a copy)."""
@@ -233,13 +233,9 @@ def box_counting(
 
     References
     ----------
-    K. Falconer, *Fractal Geometry: Mathematical Foundations and
-    Applications*, Wiley, 1990.
+    Falconer (1990); full entry in the bibliography, :ref:`ref-falconer1990`.
 
-    M. Datcu and K. Seidel, Fractal and multiresolution techniques for the
-    understanding of geo-information, in *Fractals in Geoscience and Remote
-    Sensing*, Proceedings of a Joint JRC/EARSeL Expert Meeting, Ispra, 1994
-    (published 1995).
+    Datcu and Seidel (1994), the seed paper; full entry in the bibliography, :ref:`ref-datcu1994`.
 
     Examples
     --------
@@ -252,7 +248,7 @@ def box_counting(
     >>> round(fit.dimension, 6), round(float(np.log(3) / np.log(2)), 6)
     (1.584963, 1.584963)
     """
-    b, transposed = _binary_bytes(data)
+    b, transposed = binary_bytes(data)
     sizes = check_box_sizes(box_sizes)
     offsets = check_positive_int(offsets, "offsets")
     check_choice(offset_reduce, "offset_reduce", ("mean", "min"))
@@ -369,8 +365,7 @@ def box_counting_points(
 
     References
     ----------
-    K. Falconer, *Fractal Geometry: Mathematical Foundations and
-    Applications*, Wiley, 1990.
+    Falconer (1990); full entry in the bibliography, :ref:`ref-falconer1990`.
 
     Examples
     --------
@@ -731,8 +726,7 @@ def self_affine_box_counting(
     B. B. Mandelbrot, Self-affine fractals and fractal dimension, *Physica
     Scripta* 32 (1985) 257-260, doi:10.1088/0031-8949/32/4/001.
 
-    K. Falconer, *Fractal Geometry: Mathematical Foundations and
-    Applications*, Wiley, 1990.
+    Falconer (1990); full entry in the bibliography, :ref:`ref-falconer1990`.
 
     Examples
     --------

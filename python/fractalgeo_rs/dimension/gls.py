@@ -69,7 +69,7 @@ from typing import Any, Optional, Sequence, Tuple
 import numpy as np
 
 from fractalgeo_rs._validation import check_positive_int
-from fractalgeo_rs.dimension.variation import _real_array, _with_nodata
+from fractalgeo_rs.dimension._common import real_array, with_nodata
 from fractalgeo_rs.fit import DimensionFit
 
 __all__ = ["gls_dimension", "anisotropy_from_variations"]
@@ -265,7 +265,7 @@ def quadratic_variations(z: np.ndarray, dilations: int):
     return V, n
 
 
-def _check_dilations(dilations) -> int:
+def check_dilations(dilations) -> int:
     k = check_positive_int(dilations, "dilations")
     if k > 8:
         raise ValueError(f"dilations: expected an int in [1, 8], got {k}")
@@ -359,10 +359,10 @@ def gls_dimension(
     >>> abs(fit.dimension - 2.5) < 4 * fit.stderr
     True
     """
-    z = _with_nodata(_real_array(data, (1, 2)), data, nodata)
+    z = with_nodata(real_array(data, (1, 2)), data, nodata)
     if not isinstance(anisotropy, (bool, np.bool_)):
         raise TypeError(f"anisotropy: expected True or False, got {anisotropy!r}")
-    k = _check_dilations(dilations)
+    k = check_dilations(dilations)
     shape = _design(z.shape, design)
     t = tables(shape, k)
     V, n = quadratic_variations(z, k)
@@ -472,7 +472,7 @@ def gls_grid(z: np.ndarray, w: int, dilations: int, min_valid: float, step: int,
     [D, se of D] (and [angle, ratio] with ``anisotropy``), float32."""
     from fractalgeo_rs import _core
 
-    k = _check_dilations(dilations)
+    k = check_dilations(dilations)
     if 4 * k >= w:
         raise ValueError(f"dilations: {k} needs a window of at least {4 * k + 1} pixels, got {w}")
     t = tables((w, w), k)

@@ -43,13 +43,11 @@ class Lacunarity:
 
     References
     ----------
-    C. Allain and M. Cloitre, Characterizing the lacunarity of random and
-    deterministic fractal sets, *Physical Review A* 44 (1991) 3552-3558,
-    doi:10.1103/PhysRevA.44.3552.
+    Allain and Cloitre (1991), doi:10.1103/PhysRevA.44.3552; full entry in the bibliography,
+    :ref:`ref-allain1991`.
 
-    R. E. Plotnick, R. H. Gardner and R. V. O'Neill, Lacunarity indices as
-    measures of landscape texture, *Landscape Ecology* 8(3) (1993) 201-211,
-    doi:10.1007/BF00125351.
+    Plotnick, Gardner and O'Neill (1993), doi:10.1007/BF00125351; full entry in the bibliography,
+    :ref:`ref-plotnick1993`.
 
     Examples
     --------
@@ -94,13 +92,11 @@ def lacunarity(data, *, box_sizes: Optional[Sequence[int]] = None) -> Lacunarity
 
     References
     ----------
-    C. Allain and M. Cloitre, Characterizing the lacunarity of random and
-    deterministic fractal sets, *Physical Review A* 44 (1991) 3552-3558,
-    doi:10.1103/PhysRevA.44.3552.
+    Allain and Cloitre (1991), doi:10.1103/PhysRevA.44.3552; full entry in the bibliography,
+    :ref:`ref-allain1991`.
 
-    R. E. Plotnick, R. H. Gardner and R. V. O'Neill, Lacunarity indices as
-    measures of landscape texture, *Landscape Ecology* 8(3) (1993) 201-211,
-    doi:10.1007/BF00125351.
+    Plotnick, Gardner and O'Neill (1993), doi:10.1007/BF00125351; full entry in the bibliography,
+    :ref:`ref-plotnick1993`.
 
     Examples
     --------

@@ -46,17 +46,17 @@ from typing import Dict, Optional, Tuple
 import numpy as np
 
 from fractalgeo_rs._validation import check_choice, check_positive_float
-from fractalgeo_rs.dimension.variation import _real_array, _with_nodata
+from fractalgeo_rs.dimension._common import real_array, with_nodata
 from fractalgeo_rs.fit import DimensionFit, mark_invalid
 
 __all__ = ["whittle", "fbm_mle"]
 
 # Increment filters: {name: {offset: weight}}, weights sum to zero.
-_FILTERS_1D: Dict[str, Dict[Tuple[int, ...], float]] = {
+FILTERS_1D: Dict[str, Dict[Tuple[int, ...], float]] = {
     "first": {(0,): -1.0, (1,): 1.0},
     "second": {(0,): 1.0, (1,): -2.0, (2,): 1.0},
 }
-_FILTERS_2D: Dict[str, Dict[Tuple[int, ...], float]] = {
+FILTERS_2D: Dict[str, Dict[Tuple[int, ...], float]] = {
     # 5-point Laplacian
     "laplacian": {(1, 1): -4.0, (0, 1): 1.0, (2, 1): 1.0, (1, 0): 1.0, (1, 2): 1.0},
     # square increment (mixed second difference, Chan and Wood 2000)
@@ -71,12 +71,12 @@ _POOLED = {"first": ("rows", "columns")}
 # shared with the Whittle map (fractalgeo_rs.transform._whittle):
 _H_LO, _H_HI = 0.001, 0.999  # bounds of the search of H
 _PIN_TOL = 1e-3  # an estimate this close to a bound is pinned there
-_MIN_FILTERED = 16  # fewest valid filtered samples of a fit
-_F_FLOOR = 1e-300  # expected periodogram floor, relative to its largest value
-_VANISH = 1e-24  # a filtered field whose mean power is below this times max |z|^2 vanishes
+MIN_FILTERED = 16  # fewest valid filtered samples of a fit
+F_FLOOR = 1e-300  # expected periodogram floor, relative to its largest value
+VANISH = 1e-24  # a filtered field whose mean power is below this times max |z|^2 vanishes
 
 
-def _apply_filter(z: np.ndarray, offsets: np.ndarray, weights: np.ndarray) -> np.ndarray:
+def apply_filter(z: np.ndarray, offsets: np.ndarray, weights: np.ndarray) -> np.ndarray:
     """``Y(x) = sum_a w_a z(x + x_a)`` on the 'valid' part (NaN propagates)."""
     ext = offsets.max(axis=0)
     out_shape = tuple(n - e for n, e in zip(z.shape, ext))
@@ -97,7 +97,7 @@ def _lag_autocorrelation(offsets: np.ndarray, weights: np.ndarray) -> Dict[Tuple
     return {d: w for d, w in v.items() if w != 0.0}
 
 
-class _LagPowers:
+class LagPowers:
     """``sum_d v_d |h + d|^{2H}`` on the lag grid ``h = -n..n-1`` per axis
     (index ``j`` <-> lag ``j - n``), ``v`` the filter's autocorrelation:
     ``-1/2`` of it is the filtered field's autocovariance under fBm. The
@@ -130,7 +130,7 @@ class _LagPowers:
         return c
 
 
-def _lag_kernel(g: np.ndarray) -> np.ndarray:
+def lag_kernel(g: np.ndarray) -> np.ndarray:
     """``K(h) = sum_x g(x) g(x + h)`` on the lag grid of ``g`` (index ``j``
     <-> lag ``j - n``)."""
     from scipy import fft
@@ -140,7 +140,7 @@ def _lag_kernel(g: np.ndarray) -> np.ndarray:
     return fft.fftshift(fft.irfftn(np.abs(G) ** 2, s=pad))
 
 
-def _fold_spectrum(c: np.ndarray, shape, half: bool = False) -> np.ndarray:
+def fold_spectrum(c: np.ndarray, shape, half: bool = False) -> np.ndarray:
     """``E I(k) = sum_h c(h) K(h) exp(-2 pi i k h / n)`` from ``c K`` on the
     lag grid (leading axes batched): lags folded modulo ``n``, then one FFT
     (the result is real). ``half``: the ``rfft`` half spectrum along the
@@ -164,13 +164,13 @@ class _Model:
 
     def __init__(self, shape, offsets, weights, g, spacing):
         self.shape = tuple(int(n) for n in shape)
-        self.powers = _LagPowers(self.shape, offsets, weights, spacing)
-        self.kern = _lag_kernel(g)
+        self.powers = LagPowers(self.shape, offsets, weights, spacing)
+        self.kern = lag_kernel(g)
 
     def expected(self, hurst: float) -> np.ndarray:
         c = self.powers.sums(np.array([hurst]))[0]
         c *= -0.5 * self.kern
-        return _fold_spectrum(c, self.shape)
+        return fold_spectrum(c, self.shape)
 
 
 def _periodogram(y: np.ndarray, g: np.ndarray) -> np.ndarray:
@@ -352,9 +352,9 @@ def whittle(
     >>> round(fit.dimension, 3), round(fit.extra["hurst"], 3), round(fit.stderr, 3)
     (2.283, 0.717, 0.019)
     """
-    z = _with_nodata(_real_array(data, (1, 2)), data, nodata)
+    z = with_nodata(real_array(data, (1, 2)), data, nodata)
     nd = z.ndim
-    table = _FILTERS_1D if nd == 1 else _FILTERS_2D
+    table = FILTERS_1D if nd == 1 else FILTERS_2D
     names = tuple(table) + (tuple(_POOLED) if nd == 2 else ())
     if filter is None:
         filter = "first" if nd == 1 else "laplacian"
@@ -400,11 +400,11 @@ def _whittle_contrast(z, nd, table, parts, taper, spacing, exclude_zero):
         ext = off.max(axis=0)
         if any(n - e < 4 for n, e in zip(z.shape, ext)):
             raise ValueError(f"data: shape {z.shape} is too small for filter {name!r} (at least {4 + int(ext.max())} samples per axis)")
-        y = _apply_filter(z, off, w)
+        y = apply_filter(z, off, w)
         valid = ~np.isnan(y)
         nv = int(np.count_nonzero(valid))
-        if nv < _MIN_FILTERED:
-            raise ValueError(f"data: only {nv} valid filtered samples (NaN or nodata), need at least {_MIN_FILTERED}")
+        if nv < MIN_FILTERED:
+            raise ValueError(f"data: only {nv} valid filtered samples (NaN or nodata), need at least {MIN_FILTERED}")
         g = _taper(y.shape, taper) * valid
         g = g / math.sqrt(float(np.sum(g**2)))
         I = _periodogram(y, g)
@@ -417,7 +417,7 @@ def _whittle_contrast(z, nd, table, parts, taper, spacing, exclude_zero):
     # scale-free: divide the periodograms by their mean level
     level = float(np.mean(np.concatenate(grams)))
     zmax = float(np.nanmax(np.abs(z)))
-    if not level > _VANISH * zmax**2 or zmax == 0:
+    if not level > VANISH * zmax**2 or zmax == 0:
         raise ValueError("data: the filtered field vanishes (constant or planar data), the dimension is undefined")
     grams = [I / level for I in grams]
     n_ord = sum(I.size for I in grams)
@@ -426,7 +426,7 @@ def _whittle_contrast(z, nd, table, parts, taper, spacing, exclude_zero):
         out = []
         for (m, keep), I in zip(models, grams):
             f = m.expected(h)[keep]
-            out.append(np.maximum(f, _F_FLOOR * np.max(np.abs(f))))
+            out.append(np.maximum(f, F_FLOOR * np.max(np.abs(f))))
         return out
 
     def contrast(h):
@@ -567,7 +567,7 @@ def fbm_mle(
 
     from fractalgeo_rs._validation import check_positive_int
 
-    z = _with_nodata(_real_array(data, (1, 2)), data, nodata)
+    z = with_nodata(real_array(data, (1, 2)), data, nodata)
     nd = z.ndim
     spacing = _check_cell_size(cell_size, nd)
     max_samples = check_positive_int(max_samples, "max_samples")
@@ -610,7 +610,7 @@ def fbm_mle(
     h, fun, se = _minimise(contrast)
     extra = {"n_valid": nv, "contrast": fun, "cell_size": spacing}
     if nv == z.size:
-        table = _FILTERS_1D if nd == 1 else _FILTERS_2D
+        table = FILTERS_1D if nd == 1 else FILTERS_2D
         name = "first" if nd == 1 else "laplacian"
         _, plot_data, _ = _whittle_contrast(z, nd, table, (name,), "none", spacing, True)
         fit = _assemble(h, se, nd, plot_data, "mle", extra)

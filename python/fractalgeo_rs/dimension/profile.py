@@ -20,7 +20,7 @@ import numpy as np
 from fractalgeo_rs import _core
 from fractalgeo_rs._compat import renamed_parameters
 from fractalgeo_rs._validation import check_n_threads, check_positive_int
-from fractalgeo_rs.dimension.variation import _real_array, _with_nodata
+from fractalgeo_rs.dimension._common import real_array, with_nodata
 from fractalgeo_rs.fit import DimensionFit, ScaleRange, fit_loglog
 
 __all__ = ["higuchi", "scale_space", "wavelet_dimension"]
@@ -82,7 +82,7 @@ def higuchi(data, *, k_max: Optional[int] = None, nodata: Optional[float] = None
     >>> round(fg.higuchi(x).dimension, 1)
     1.5
     """
-    z = _with_nodata(_real_array(data, (1,)), data, nodata)
+    z = with_nodata(real_array(data, (1,)), data, nodata)
     _gap_free(z, "Higuchi's method")
     n = z.size
     if k_max is None:
@@ -177,9 +177,8 @@ def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, cell_size: fl
     T. Lindeberg, *Scale-Space Theory in Computer Vision*, Kluwer, 1994,
     doi:10.1007/978-1-4757-6465-9.
 
-    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
-    dimension: assessing the roughness of time series and spatial data,
-    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the bibliography,
+    :ref:`ref-gneiting2012`.
 
     Examples
     --------
@@ -188,7 +187,7 @@ def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, cell_size: fl
     >>> round(fg.scale_space(x).dimension, 1)
     1.5
     """
-    z = _with_nodata(_real_array(data, (1,)), data, nodata)
+    z = with_nodata(real_array(data, (1,)), data, nodata)
     _gap_free(z, "scale space")
     if isinstance(cell_size, bool) or not isinstance(cell_size, numbers.Real) or not cell_size >= 0:
         raise ValueError(f"cell_size: expected a number >= 0, got {cell_size!r}")
@@ -264,7 +263,7 @@ def wavelet_dimension(data, *, levels: Optional[Sequence[int]] = None, nodata: O
     >>> round(fg.wavelet_dimension(x).dimension, 1)
     1.5
     """
-    z = _with_nodata(_real_array(data, (1, 2)), data, nodata)
+    z = with_nodata(real_array(data, (1, 2)), data, nodata)
     _gap_free(z, "the wavelet estimator")
     det = _haar_details(z)
     min_n = 8 if z.ndim == 1 else 48

@@ -26,7 +26,7 @@ import numpy as np
 
 from fractalgeo_rs._compat import renamed_parameters
 from fractalgeo_rs._validation import check_choice, check_positive_int
-from fractalgeo_rs.dimension.variation import _real_array, _with_nodata
+from fractalgeo_rs.dimension._common import real_array, with_nodata
 from fractalgeo_rs.fit import DimensionFit, ScaleRange, fit_loglog
 
 __all__ = ["spectral_dimension"]
@@ -103,10 +103,7 @@ def spectral_dimension(
     H.-O. Peitgen and D. Saupe (eds.), *The Science of Fractal Images*,
     Springer, 1988, 21-70, doi:10.1007/978-1-4612-3784-6_1.
 
-    M. Datcu and K. Seidel, Fractal and multiresolution techniques for the
-    understanding of geo-information, in *Fractals in Geoscience and Remote
-    Sensing*, Proceedings of a Joint JRC/EARSeL Expert Meeting, Ispra, 1994
-    (published 1995).
+    Datcu and Seidel (1994), the seed paper; full entry in the bibliography, :ref:`ref-datcu1994`.
 
     Examples
     --------
@@ -118,7 +115,7 @@ def spectral_dimension(
     >>> round(fg.spectral_dimension(x).dimension, 1)
     1.5
     """
-    z = _with_nodata(_real_array(data, (1, 2)), data, nodata)
+    z = with_nodata(real_array(data, (1, 2)), data, nodata)
     if np.isnan(z).any():
         raise ValueError("data: NaN or nodata present; the spectrum needs gap-free data (fill or crop first)")
     check_choice(taper, "taper", ("hann", "none"))

@@ -18,8 +18,8 @@ import numpy as np
 
 from fractalgeo_rs._validation import as_array, check_choice, check_n_threads, check_positive_int
 from fractalgeo_rs._zscale import resolve_z_scale
-from fractalgeo_rs.dimension.boxcount import _binary_bytes
-from fractalgeo_rs.dimension.variation import _real_array, _with_nodata
+from fractalgeo_rs.dimension.boxcount import binary_bytes
+from fractalgeo_rs.dimension._common import real_array, with_nodata
 from fractalgeo_rs.fit import DimensionFit, ScaleRange, fit_loglog
 
 __all__ = ["minkowski", "mass_dimension", "blanket"]
@@ -70,10 +70,7 @@ def minkowski(data, *, radii: Optional[Sequence[float]] = None, scale_range: Sca
     Evaluating the fractal dimension of profiles, *Physical Review A* 39
     (1989) 1500-1512, doi:10.1103/PhysRevA.39.1500.
 
-    M. Datcu and K. Seidel, Fractal and multiresolution techniques for the
-    understanding of geo-information, in *Fractals in Geoscience and Remote
-    Sensing*, Proceedings of a Joint JRC/EARSeL Expert Meeting, Ispra, 1994
-    (published 1995).
+    Datcu and Seidel (1994), the seed paper; full entry in the bibliography, :ref:`ref-datcu1994`.
 
     Examples
     --------
@@ -88,7 +85,7 @@ def minkowski(data, *, radii: Optional[Sequence[float]] = None, scale_range: Sca
     """
     from scipy.ndimage import distance_transform_edt
 
-    b, transposed = _binary_bytes(data)
+    b, transposed = binary_bytes(data)
     mask = b.view(bool)
     coords = np.argwhere(mask)
     if coords.size == 0:
@@ -124,7 +121,7 @@ def minkowski(data, *, radii: Optional[Sequence[float]] = None, scale_range: Sca
                       x_label="radius r (samples)", y_label="sausage volume V(r)")
 
 
-def _sat(a: np.ndarray) -> np.ndarray:
+def summed_area_table(a: np.ndarray) -> np.ndarray:
     """Summed-area table with a zero first row and column."""
     s = np.zeros((a.shape[0] + 1, a.shape[1] + 1), dtype=np.float64)
     s[1:, 1:] = a.cumsum(0).cumsum(1)
@@ -188,10 +185,7 @@ def mass_dimension(
     R. F. Voss, Characterization and measurement of random fractals,
     *Physica Scripta* T13 (1986) 27-32, doi:10.1088/0031-8949/1986/T13/004.
 
-    M. Datcu and K. Seidel, Fractal and multiresolution techniques for the
-    understanding of geo-information, in *Fractals in Geoscience and Remote
-    Sensing*, Proceedings of a Joint JRC/EARSeL Expert Meeting, Ispra, 1994
-    (published 1995).
+    Datcu and Seidel (1994), the seed paper; full entry in the bibliography, :ref:`ref-datcu1994`.
 
     Examples
     --------
@@ -204,7 +198,7 @@ def mass_dimension(
     if kind == "auto":
         kind = "binary" if arr.dtype == bool else "grayscale"
     if kind == "binary":
-        b, _ = _binary_bytes(arr)
+        b, _ = binary_bytes(arr)
         mask = b.view(bool)
         if mask.ndim != 2:
             raise ValueError(f"data: expected a 2D binary image, got {mask.ndim} dimensions")
@@ -213,12 +207,12 @@ def mass_dimension(
             raise ValueError("data: the set is empty (no foreground sample)")
         extent = float(max(mask.shape))
     elif kind == "points":
-        pts = _real_array(arr, (2,), "data")
+        pts = real_array(arr, (2,), "data")
         if np.isnan(pts).any():
             raise ValueError("data: coordinates must be finite (no NaN)")
         extent = float((pts.max(0) - pts.min(0)).max())
     else:
-        z = _real_array(arr, (2,), "data")
+        z = real_array(arr, (2,), "data")
         ok = ~np.isnan(z)
         if not ok.any():
             raise ValueError("data: no valid value (all NaN)")
@@ -237,7 +231,7 @@ def mass_dimension(
         raise ValueError(f"box_sizes: boxes centred on pixels need odd sides, got {sizes}")
     N = []
     if kind == "binary":
-        sat = _sat(mask.astype(np.float64))
+        sat = summed_area_table(mask.astype(np.float64))
         for L in sizes:
             m = _box_sums_centred(sat, ij, L // 2, mask.shape)
             N.append(float(np.mean(1.0 / m)))
@@ -330,7 +324,7 @@ def blanket(data, *, epsilons: Optional[Sequence[int]] = None, z_scale: Union[fl
     from fractalgeo_rs import _core
     from fractalgeo_rs._validation import check_n_threads
 
-    z = _with_nodata(_real_array(data, (2,)), data, nodata)
+    z = with_nodata(real_array(data, (2,)), data, nodata)
     if np.isnan(z).all():
         raise ValueError("data: no valid value (all NaN or nodata)")
     if np.isinf(z).any():

@@ -29,35 +29,11 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from fractalgeo_rs._validation import as_array, check_choice, check_integer_lags, check_nodata, check_positive_float
+from fractalgeo_rs._validation import check_choice, check_integer_lags, check_positive_float
+from fractalgeo_rs.dimension._common import real_array, with_nodata
 from fractalgeo_rs.fit import DimensionFit, ScaleRange, check_domain, fit_loglog
 
 __all__ = ["power_variation", "variogram", "madogram", "surface_variation"]
-
-
-def _real_array(data, ndims, name="data") -> np.ndarray:
-    arr = as_array(data, name)
-    if arr.dtype.kind == "b" or arr.dtype.kind not in "iuf":
-        raise TypeError(f"{name}: expected a real numeric array, got dtype {arr.dtype}")
-    if arr.ndim not in ndims:
-        want = " or ".join(f"{d}D" for d in ndims)
-        raise ValueError(f"{name}: expected a {want} array, got {arr.ndim} dimensions")
-    if arr.size == 0:
-        raise ValueError(f"{name}: array is empty (shape {arr.shape})")
-    z = arr.astype(np.float64)
-    if np.isinf(z).any():
-        raise ValueError(f"{name}: contains inf; mark invalid samples with NaN or nodata")
-    return z
-
-
-def _with_nodata(z: np.ndarray, data, nodata) -> np.ndarray:
-    nodata = check_nodata(nodata)
-    if nodata is None:
-        return z
-    if not np.isnan(nodata):
-        z = z.copy()
-        z[np.asarray(data) == nodata] = np.nan
-    return z
 
 
 def _check_lags(lags, n_max: int, name="lags") -> np.ndarray:
@@ -167,14 +143,11 @@ def power_variation(
 
     References
     ----------
-    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
-    dimension: assessing the roughness of time series and spatial data,
-    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the bibliography,
+    :ref:`ref-gneiting2012`.
 
-    J. T. Kent and A. T. A. Wood, Estimating the fractal dimension of a
-    locally self-similar Gaussian process by using increments, *Journal of
-    the Royal Statistical Society B* 59(3) (1997) 679-699,
-    doi:10.1111/1467-9868.00091.
+    Kent and Wood (1997), doi:10.1111/1467-9868.00091; full entry in the bibliography,
+    :ref:`ref-kent1997`.
 
     Examples
     --------
@@ -185,7 +158,7 @@ def power_variation(
     >>> round(fg.power_variation(x, p=2.0, order=1).dimension, 1)  # the variogram
     1.5
     """
-    z = _with_nodata(_real_array(data, (1,)), data, nodata)
+    z = with_nodata(real_array(data, (1,)), data, nodata)
     p = check_positive_float(p, "p")
     if order not in (1, 2) or isinstance(order, bool):
         raise ValueError(f"order: expected 1 or 2, got {order!r}")
@@ -242,9 +215,8 @@ def variogram(data, *, lags: Sequence[int] = (1, 2), nodata: Optional[float] = N
 
     References
     ----------
-    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
-    dimension: assessing the roughness of time series and spatial data,
-    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the bibliography,
+    :ref:`ref-gneiting2012`.
 
     Examples
     --------
@@ -287,9 +259,8 @@ def madogram(data, *, lags: Sequence[int] = (1, 2), nodata: Optional[float] = No
 
     References
     ----------
-    T. Gneiting, H. Sevcikova and D. B. Percival, Estimators of fractal
-    dimension: assessing the roughness of time series and spatial data,
-    *Statistical Science* 27(2) (2012) 247-277, doi:10.1214/11-STS370.
+    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the bibliography,
+    :ref:`ref-gneiting2012`.
 
     Examples
     --------
@@ -354,10 +325,8 @@ def surface_variation(
     dimension for two-dimensional surface data, *Statistica Sinica* 10
     (2000) 343-376.
 
-    J. T. Kent and A. T. A. Wood, Estimating the fractal dimension of a
-    locally self-similar Gaussian process by using increments, *Journal of
-    the Royal Statistical Society B* 59(3) (1997) 679-699,
-    doi:10.1111/1467-9868.00091.
+    Kent and Wood (1997), doi:10.1111/1467-9868.00091; full entry in the bibliography,
+    :ref:`ref-kent1997`.
 
     Examples
     --------
@@ -369,7 +338,7 @@ def surface_variation(
     >>> round(fg.surface_variation(z, estimator='transect').dimension, 1)
     2.3
     """
-    z = _with_nodata(_real_array(data, (2,)), data, nodata)
+    z = with_nodata(real_array(data, (2,)), data, nodata)
     check_choice(estimator, "estimator", ("square", "first", "transect"))
     p = check_positive_float(p, "p")
     lg = _check_lags(lags, min(z.shape) - 1)

@@ -7,12 +7,11 @@ from __future__ import annotations
 
 import numbers
 import os
-import secrets
 from typing import Any, Mapping, Optional, Sequence, Union
 
 
 from fractalgeo_rs import _core
-from fractalgeo_rs._validation import MemoryLimitError, check_memory, check_n_threads
+from fractalgeo_rs._validation import MemoryLimitError, check_memory, check_n_threads, check_nonnegative_int, check_seed
 
 __all__ = ["LSystem", "LString", "DEFAULT_MAX_LENGTH"]
 
@@ -34,24 +33,6 @@ def _modules(lower: int, upper: int) -> str:
         return f"more than {float(lower):.3g}"
     n = str(lower) if lower < 10**12 else f"{float(lower):.3g}"
     return f"exactly {n}" if lower == upper else f"at least {n}"
-
-
-def _check_seed(seed, name: str = "seed") -> int:
-    if seed is None:
-        return secrets.randbits(63)
-    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral):
-        raise TypeError(f"{name}: expected a non-negative int or None, got {seed!r}")
-    if not 0 <= int(seed) < 2**64:
-        raise ValueError(f"{name}: expected an int in [0, 2**64), got {seed}")
-    return int(seed)
-
-
-def _check_n(n) -> int:
-    if isinstance(n, bool) or not isinstance(n, numbers.Integral):
-        raise TypeError(f"n: expected a non-negative int, got {n!r}")
-    if n < 0:
-        raise ValueError(f"n: expected a non-negative int, got {n}")
-    return int(n)
 
 
 def _rule_lines(rules: RulesLike) -> list:
@@ -246,7 +227,7 @@ class LSystem:
         if isinstance(max_length, bool) or not isinstance(max_length, numbers.Integral) or max_length < 1:
             raise ValueError(f"max_length: expected a positive int, got {max_length!r}")
         self._lines: tuple = tuple(_rule_lines(rules))
-        self._seed: int = _check_seed(seed)
+        self._seed: int = check_seed(seed)
         self._ignore: str = ignore or ""
         self._axiom: str = axiom
         self._max_length: int = int(max_length)
@@ -354,8 +335,8 @@ class LSystem:
             expansion (only possible when the count is not exact), or a
             parametric production gives a non-finite value.
         """
-        n = _check_n(n)
-        s = None if seed is None else _check_seed(seed)
+        n = check_nonnegative_int(n)
+        s = None if seed is None else check_seed(seed)
         n_threads = check_n_threads(n_threads)
         lower, upper = self._core.length_bounds(n)
         what = _modules(lower, upper)
@@ -393,8 +374,8 @@ class LSystem:
 
         References
         ----------
-        P. Prusinkiewicz and A. Lindenmayer, *The Algorithmic Beauty of Plants*,
-        Springer, 1990, section 1.2.
+        Prusinkiewicz and Lindenmayer (1990), section 1.2; full entry in the bibliography,
+        :ref:`ref-prusinkiewicz1990`.
 
         Examples
         --------
@@ -405,9 +386,9 @@ class LSystem:
         >>> LSystem("F", {"F": "F" * 10}).length_bounds(30)[0] == 10**30
         True
         """
-        return self._core.length_bounds(_check_n(n))
+        return self._core.length_bounds(check_nonnegative_int(n))
 
     def generations(self, n: int, *, n_threads: Optional[int] = None) -> list:
         """The strings of steps 0, 1, ..., n (each with the same seed)."""
-        n = _check_n(n)
+        n = check_nonnegative_int(n)
         return [self.derive(k, n_threads=n_threads) for k in range(n + 1)]

@@ -201,8 +201,8 @@ def turtle_2d(lstring: Union[LString, str], *, angle: float = 90.0, step: float 
 
     References
     ----------
-    P. Prusinkiewicz and A. Lindenmayer, *The Algorithmic Beauty of Plants*,
-    Springer, 1990, section 1.2.
+    Prusinkiewicz and Lindenmayer (1990), section 1.2; full entry in the bibliography,
+    :ref:`ref-prusinkiewicz1990`.
 
     Examples
     --------

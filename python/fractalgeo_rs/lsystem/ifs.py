@@ -9,8 +9,7 @@ from typing import Optional, Sequence, Tuple
 import numpy as np
 
 from fractalgeo_rs import _core
-from fractalgeo_rs._validation import check_n_threads, check_positive_int
-from fractalgeo_rs.lsystem.core import _check_seed
+from fractalgeo_rs._validation import check_n_threads, check_positive_int, check_seed
 
 __all__ = ["IFS", "IFS_PRESETS", "ifs_preset", "moran_dimension", "rasterize_points"]
 
@@ -195,7 +194,7 @@ class IFS:
         points on any number of threads.
         """
         n = check_positive_int(n_points, "n_points")
-        return _core.ifs_chaos_game(self.maps, self.probabilities.tolist(), n, _check_seed(seed), check_n_threads(n_threads))
+        return _core.ifs_chaos_game(self.maps, self.probabilities.tolist(), n, check_seed(seed), check_n_threads(n_threads))
 
     def iterate(self, depth: int, *, max_points: int = 1 << 24, n_threads: Optional[int] = None) -> np.ndarray:
         """Deterministic iteration: the ``k**depth`` images of the first

@@ -7,8 +7,8 @@ from typing import Optional, Sequence, Tuple
 import numpy as np
 
 from fractalgeo_rs import _core
-from fractalgeo_rs._validation import as_array, check_n_threads, check_positive_float
-from fractalgeo_rs.lsystem.core import LSystem, _check_n, _check_seed
+from fractalgeo_rs._validation import as_array, check_n_threads, check_nonnegative_int, check_positive_float, check_seed
+from fractalgeo_rs.lsystem.core import LSystem
 from fractalgeo_rs.lsystem.geometry import Mesh, turtle_args
 
 __all__ = ["plants_on_terrain"]
@@ -95,8 +95,8 @@ def plants_on_terrain(
     args = turtle_args(angle=angle, step=step, width=width, width_factor=width_factor, tropism=tropism,
                        elasticity=elasticity)
     arrays, bases = _core.plants_on_terrain(
-        lsystem._core, _check_n(n), z, check_positive_float(cell_size, "cell_size"), float(density),
-        _check_seed(seed), check_positive_float(scale, "scale"), int(max_plants), args, int(sides),
+        lsystem._core, check_nonnegative_int(n), z, check_positive_float(cell_size, "cell_size"), float(density),
+        check_seed(seed), check_positive_float(scale, "scale"), int(max_plants), args, int(sides),
         check_n_threads(n_threads),
     )
     return Mesh(*arrays), bases

@@ -2,11 +2,10 @@
 from __future__ import annotations
 
 import numbers
-import secrets
 
 import numpy as np
 
-from fractalgeo_rs._validation import check_positive_float
+from fractalgeo_rs._validation import check_positive_float, check_seed
 
 # Random streams of the counter-based generator (one per use of a seed), so
 # that no two parts of one synthesis ever share random numbers.
@@ -39,15 +38,9 @@ def check_sigma(sigma) -> float:
     return s
 
 
-def resolve_seed(seed) -> int:
-    """``None`` -> a fresh random seed; otherwise an int in [0, 2**64)."""
-    if seed is None:
-        return secrets.randbits(64)
-    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral):
-        raise TypeError(f"seed: expected an int in [0, 2**64) or None, got {seed!r}")
-    if not (0 <= int(seed) < 2**64):
-        raise ValueError(f"seed: expected an int in [0, 2**64) or None, got {seed}")
-    return int(seed)
+#: The package's seed policy (``_validation.check_seed``), under the name
+#: the synthesis code and its callers use.
+resolve_seed = check_seed
 
 
 def check_shape(shape, minimum: int = 2) -> tuple:

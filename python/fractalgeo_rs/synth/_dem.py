@@ -113,14 +113,9 @@ def synthetic_dem(shape, hurst, *, cell_size, relief, relief_lag=None, mean_elev
 
     References
     ----------
-    M. L. Stein, Fast and exact simulation of fractional Brownian surfaces,
-    *Journal of Computational and Graphical Statistics* 11(3) (2002)
-    587-599, doi:10.1198/106186002466.
+    Stein (2002), doi:10.1198/106186002466; full entry in the bibliography, :ref:`ref-stein2002`.
 
-    M. Datcu and K. Seidel, Fractal and multiresolution techniques for the
-    understanding of geo-information, in *Fractals in Geoscience and Remote
-    Sensing*, Proceedings of a Joint JRC/EARSeL Expert Meeting, Ispra, 1994
-    (published 1995).
+    Datcu and Seidel (1994), the seed paper; full entry in the bibliography, :ref:`ref-datcu1994`.
 
     Examples
     --------

@@ -24,7 +24,7 @@ Voss, R. F. (1986). Characterization and measurement of random fractals.
 from __future__ import annotations
 
 from fractalgeo_rs.transform._api import fractal_transform, lacunarity_map
-from fractalgeo_rs.transform._defaults import default_z_scale
+from fractalgeo_rs._zscale import default_z_scale
 from fractalgeo_rs.transform._methods import TRANSFORM_METHODS
 from fractalgeo_rs.transform._result import FLAGS, TransformFit
 from fractalgeo_rs.transform.segment import segment

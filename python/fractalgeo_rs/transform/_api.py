@@ -18,6 +18,7 @@ from fractalgeo_rs._validation import (
     check_n_threads,
     check_nodata,
     check_positive_int,
+    check_window,
 )
 from fractalgeo_rs._zscale import check_z_scale, resolve_z_scale
 from fractalgeo_rs.transform._methods import METHODS, MapOptions
@@ -25,14 +26,6 @@ from fractalgeo_rs.transform._result import TransformFit, flag_map, warn_out_of_
 
 __all__ = ["fractal_transform", "lacunarity_map"]
 
-
-def _check_window(window_size, shape) -> int:
-    w = check_positive_int(window_size, "window_size")
-    if w < 3 or w % 2 == 0:
-        raise ValueError(f"window_size: expected an odd integer >= 3, got {w}")
-    if w > max(shape):
-        raise ValueError(f"window_size: window {w} is larger than the image {tuple(shape)}")
-    return w
 
 
 def _float_dtype(dtype) -> type:
@@ -292,7 +285,7 @@ def fractal_transform(
         raise TypeError(f"lags: expected a sequence of positive ints, got {lags!r}") from None
 
     arr, image = _select_band(image, band)
-    w = _check_window(window_size, arr.shape)
+    w = check_window(window_size, shape=arr.shape)
     z_used: Optional[float] = None  # the height unit of the box and mass methods
     if spec.uses_z_scale:
         z_used = resolve_z_scale(z_scale, arr, nodata)
@@ -442,7 +435,7 @@ def lacunarity_map(
         if image.dtype == bool:
             image = image.astype(np.uint8)
     arr, image = _select_band(image, None)
-    w = _check_window(window_size, arr.shape)
+    w = check_window(window_size, shape=arr.shape)
     nodata = check_nodata(nodata)
     if box_sizes is None:
         sizes = [r for r in (1, 2, 4, 8) if r <= w]

@@ -130,9 +130,9 @@ def _configure_blanket(w: int, o: MapOptions, opts: Opts) -> int:
 
 
 def _configure_gls(w: int, o: MapOptions, opts: Opts) -> int:
-    from fractalgeo_rs.dimension.gls import _check_dilations
+    from fractalgeo_rs.dimension.gls import check_dilations
 
-    opts["dilations"] = _check_dilations(o.dilations)
+    opts["dilations"] = check_dilations(o.dilations)
     if 4 * opts["dilations"] >= w:
         raise ValueError(f"dilations: {opts['dilations']} needs a window of at least "
                          f"{4 * opts['dilations'] + 1} pixels, got {w}")
@@ -197,9 +197,9 @@ def _gls_pinned() -> Tuple[float, ...]:
 
 
 def _whittle_pinned() -> Tuple[float, ...]:
-    from fractalgeo_rs.transform._whittle import _H_GRID
+    from fractalgeo_rs.transform._whittle import WHITTLE_H_GRID
 
-    return (3.0 - float(_H_GRID[0]), 3.0 - float(_H_GRID[-1]))
+    return (3.0 - float(WHITTLE_H_GRID[0]), 3.0 - float(WHITTLE_H_GRID[-1]))
 
 
 def _gls_warn(d: np.ndarray) -> None:

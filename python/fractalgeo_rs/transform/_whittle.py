@@ -24,20 +24,20 @@ from typing import Dict, Tuple
 import numpy as np
 
 from fractalgeo_rs.dimension.likelihood import (
-    _F_FLOOR,
-    _FILTERS_2D,
-    _MIN_FILTERED,
-    _VANISH,
-    _apply_filter,
-    _fold_spectrum,
-    _lag_kernel,
-    _LagPowers,
+    F_FLOOR,
+    FILTERS_2D,
+    MIN_FILTERED,
+    VANISH,
+    apply_filter,
+    fold_spectrum,
+    lag_kernel,
+    LagPowers,
 )
-from fractalgeo_rs.dimension.surface import _sat
+from fractalgeo_rs.dimension.surface import summed_area_table
 
 # grid of H: the bounds of fractalgeo_rs.whittle's search, ~0.02 apart
-_H_GRID = np.linspace(0.001, 0.999, 51)
-_FILTER = _FILTERS_2D["square"]
+WHITTLE_H_GRID = np.linspace(0.001, 0.999, 51)
+_FILTER = FILTERS_2D["square"]
 _OFFSETS = np.array(list(_FILTER.keys()), dtype=np.int64)
 _WEIGHTS = np.array(list(_FILTER.values()), dtype=float)
 
@@ -50,7 +50,7 @@ class _Tables:
     def __init__(self, m: int):
         self.m = m
         # sum_d v_d |h + d|^{2H} for every grid H: shared by all masks
-        self.powers = _LagPowers((m, m), _OFFSETS, _WEIGHTS, (1.0, 1.0)).sums(_H_GRID)
+        self.powers = LagPowers((m, m), _OFFSETS, _WEIGHTS, (1.0, 1.0)).sums(WHITTLE_H_GRID)
         nk = m // 2 + 1
         wk = np.full((m, nk), 2.0)
         wk[:, 0] = 1.0
@@ -76,9 +76,9 @@ class _Tables:
             return hit
         m = self.m
         g = valid / math.sqrt(float(np.count_nonzero(valid)))
-        c = self.powers * (-0.5 * _lag_kernel(g))[None]
-        f = _fold_spectrum(c, (m, m), half=True).reshape(_H_GRID.size, -1)
-        f = np.maximum(f, _F_FLOOR * np.max(np.abs(f), axis=1, keepdims=True))
+        c = self.powers * (-0.5 * lag_kernel(g))[None]
+        f = fold_spectrum(c, (m, m), half=True).reshape(WHITTLE_H_GRID.size, -1)
+        f = np.maximum(f, F_FLOOR * np.max(np.abs(f), axis=1, keepdims=True))
         inv = np.ascontiguousarray((self.wk[None, :] / f).T)
         logsum = np.log(f) @ self.wk
         hit = (inv, logsum)
@@ -105,10 +105,10 @@ def _tables(m: int) -> _Tables:
 
 def _argmin_cubic(c: np.ndarray):
     """Minimiser and curvature of each row of contrasts ``c`` (n, n_H) on
-    ``_H_GRID``: a cubic through the four grid values around the grid
+    ``WHITTLE_H_GRID``: a cubic through the four grid values around the grid
     minimum, minimised between the minimum's neighbours."""
     n, nh = c.shape
-    dh = _H_GRID[1] - _H_GRID[0]
+    dh = WHITTLE_H_GRID[1] - WHITTLE_H_GRID[0]
     j = np.argmin(c, axis=1)
     rows = np.arange(n)
     # four consecutive points: the minimum, its neighbours and the next
@@ -139,7 +139,7 @@ def _argmin_cubic(c: np.ndarray):
     t = np.stack(cand, axis=1)
     vals = y[:, :1] + a1[:, None] * t + a2[:, None] * t * (t - 1) + a3[:, None] * t * (t - 1) * (t - 2)
     best = np.take_along_axis(t, np.argmin(vals, axis=1)[:, None], axis=1)[:, 0]
-    h = _H_GRID[s] + best * dh
+    h = WHITTLE_H_GRID[s] + best * dh
     curv = (2.0 * A * best + B) / dh**2
     return h, curv
 
@@ -147,7 +147,7 @@ def _argmin_cubic(c: np.ndarray):
 def _window_sums(a: np.ndarray, k: int) -> np.ndarray:
     """Sums of ``a`` over every ``k`` x ``k`` window anchored at its top-left
     pixel (exact counts for boolean ``a``: float64 holds integers to 2^53)."""
-    s = _sat(a)
+    s = summed_area_table(a)
     return s[k:, k:] - s[:-k, k:] - s[k:, :-k] + s[:-k, :-k]
 
 
@@ -187,7 +187,7 @@ def whittle_grid(z: np.ndarray, w: int, min_valid: float, step: int, n_threads: 
     zp = np.pad(z, half, mode="constant", constant_values=np.nan)
     # square increments of the padded image (the filter of fractalgeo_rs.whittle):
     # window (r, c) <-> y[r:r+m, c:c+m]
-    y = _apply_filter(zp, _OFFSETS, _WEIGHTS)
+    y = apply_filter(zp, _OFFSETS, _WEIGHTS)
     yvalid = ~np.isnan(y)
     y0 = np.where(yvalid, y, 0.0)
     # per-window counts from integral images: valid pixels, valid filtered
@@ -205,7 +205,7 @@ def whittle_grid(z: np.ndarray, w: int, min_valid: float, step: int, n_threads: 
     yv = sliding_window_view(y0, (m, m))[::step, ::step]
     mv = sliding_window_view(yvalid, (m, m))[::step, ::step]
     n_ord = tables.n_ord
-    ok = (frac >= min_valid - 1e-12) & (n_filt >= _MIN_FILTERED)
+    ok = (frac >= min_valid - 1e-12) & (n_filt >= MIN_FILTERED)
     ri, ci = np.nonzero(ok)  # row-major order
     chunk = max(1, (1 << 23) // (m * m))  # ~64 MB of windows at a time
     for k0 in range(0, ri.size, chunk):
@@ -215,12 +215,12 @@ def whittle_grid(z: np.ndarray, w: int, min_valid: float, step: int, n_threads: 
         spec = fft.rfft2(win, workers=workers)
         gram = (spec.real**2 + spec.imag**2).reshape(win.shape[0], -1)
         del spec, win
-        contrast = np.empty((gram.shape[0], _H_GRID.size))
+        contrast = np.empty((gram.shape[0], WHITTLE_H_GRID.size))
         with np.errstate(divide="ignore", invalid="ignore"):  # vanishing windows: found below
             _fill_contrast(contrast, gram, nf, mv, (r, c), m, n_ord, tables)
         # a vanishing filtered field (constant or planar window): no dimension
         level = gram @ tables.wk / n_ord / nf
-        alive = level > _VANISH * zabs[r, c] ** 2
+        alive = level > VANISH * zabs[r, c] ** 2
         alive &= np.all(np.isfinite(contrast), axis=1)
         h, curv = _argmin_cubic(np.where(alive[:, None], contrast, 0.0))
         with np.errstate(invalid="ignore", divide="ignore"):
