@@ -53,8 +53,8 @@ class FractalRangeWarning(UserWarning):
 
     References
     ----------
-    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the bibliography,
-    :ref:`ref-gneiting2012`.
+    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the
+    :ref:`bibliography <ref-gneiting2012>`.
 
     Examples
     --------
@@ -195,10 +195,10 @@ class DimensionFit:
 
     References
     ----------
-    Falconer (1990); full entry in the bibliography, :ref:`ref-falconer1990`.
+    Falconer (1990); full entry in the :ref:`bibliography <ref-falconer1990>`.
 
-    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the bibliography,
-    :ref:`ref-gneiting2012`.
+    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the
+    :ref:`bibliography <ref-gneiting2012>`.
 
     Examples
     --------
@@ -534,8 +534,8 @@ def fit_loglog(
     K. Falconer, *Fractal Geometry: Mathematical Foundations and
     Applications*, Wiley, 1990, chapter 3 (box-counting dimension).
 
-    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the bibliography,
-    :ref:`ref-gneiting2012`.
+    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the
+    :ref:`bibliography <ref-gneiting2012>`.
 
     Examples
     --------

@@ -218,8 +218,8 @@ def read_raster(path, band: Optional[int] = None) -> Tuple[np.ndarray, Optional[
 
     References
     ----------
-    GDAL/OGR contributors, doi:10.5281/zenodo.5884351; full entry in the bibliography,
-    :ref:`ref-gdal`.
+    GDAL/OGR contributors, doi:10.5281/zenodo.5884351; full entry in the
+    :ref:`bibliography <ref-gdal>`.
 
     Examples
     --------
@@ -383,8 +383,8 @@ def write_raster(path, data, *, profile: Optional[dict] = None, crs=None, transf
 
     References
     ----------
-    GDAL/OGR contributors, doi:10.5281/zenodo.5884351; full entry in the bibliography,
-    :ref:`ref-gdal`.
+    GDAL/OGR contributors, doi:10.5281/zenodo.5884351; full entry in the
+    :ref:`bibliography <ref-gdal>`.
 
     Examples
     --------

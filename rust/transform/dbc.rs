@@ -58,15 +58,13 @@ fn at(t: &[f64], width: usize, u: isize, v: isize) -> f64 {
     }
 }
 
-/// Box counts of every `bh x bw` block of the band planes, by top-left sample.
-#[allow(clippy::too_many_arguments)]
+/// Box counts of every `bh x bw` block of the `rows x cols` band planes, by
+/// top-left sample.
 fn count_field(
     lo: &[f64],
     hi: &[f64],
-    rows: usize,
-    cols: usize,
-    bh: usize,
-    bw: usize,
+    (rows, cols): (usize, usize),
+    (bh, bw): (usize, usize),
     z0: f64,
     h: f64,
 ) -> Vec<f64> {
@@ -154,7 +152,7 @@ pub fn dbc_transform(
                 let last = ((nf - 1) * s) as isize;
                 // full blocks: table strided by s
                 let wss = nc - s + 1;
-                let mut tss = count_field(&lo, &hi, nr, nc, s, s, z0, hgt);
+                let mut tss = count_field(&lo, &hi, (nr, nc), (s, s), z0, hgt);
                 let nss = nr - s + 1;
                 for row in tss.chunks_mut(wss) {
                     for v in s..wss {
@@ -170,20 +168,20 @@ pub fn dbc_transform(
                 }
                 // partial blocks: bottom row (t x s), right column (s x t), corner (t x t)
                 let partial = (t > 0 && opt.partial_blocks).then(|| {
-                    let mut pts = count_field(&lo, &hi, nr, nc, t, s, z0, hgt);
+                    let mut pts = count_field(&lo, &hi, (nr, nc), (t, s), z0, hgt);
                     for u in 0..nr - t + 1 {
                         for v in s..wss {
                             pts[u * wss + v] += pts[u * wss + v - s];
                         }
                     }
                     let wst = nc - t + 1;
-                    let mut pst = count_field(&lo, &hi, nr, nc, s, t, z0, hgt);
+                    let mut pst = count_field(&lo, &hi, (nr, nc), (s, t), z0, hgt);
                     for u in s..nr - s + 1 {
                         for v in 0..wst {
                             pst[u * wst + v] += pst[(u - s) * wst + v];
                         }
                     }
-                    let ptt = count_field(&lo, &hi, nr, nc, t, t, z0, hgt);
+                    let ptt = count_field(&lo, &hi, (nr, nc), (t, t), z0, hgt);
                     (pts, pst, ptt, wst)
                 });
                 let out = &mut counts[si];

@@ -2,6 +2,32 @@
 //! Werman 1993): about three comparisons per sample and pass, whatever the
 //! rectangle, so a box-count field costs O(1) per pixel.
 
+/// Row `cur` (offset) of running minima and maxima `run` over the rows of
+/// `src`: the source row itself at a block's first row (`from` is `None`),
+/// else its extrema with the running row at offset `from`; rows of `n`.
+#[inline]
+fn fold_row(
+    run: (&mut [f64], &mut [f64]),
+    src: (&[f64], &[f64]),
+    cur: usize,
+    from: Option<usize>,
+    n: usize,
+) {
+    let ((lo, hi), (slo, shi)) = (run, src);
+    match from {
+        None => {
+            lo[cur..cur + n].copy_from_slice(&slo[cur..cur + n]);
+            hi[cur..cur + n].copy_from_slice(&shi[cur..cur + n]);
+        }
+        Some(p) => {
+            for c in 0..n {
+                lo[cur + c] = lo[p + c].min(slo[cur + c]);
+                hi[cur + c] = hi[p + c].max(shi[cur + c]);
+            }
+        }
+    }
+}
+
 /// Minimum and maximum of every `bh x bw` rectangle of a row-major
 /// `rows x cols` pair of planes (`lo` for minima, `hi` for maxima; missing
 /// samples hold `+inf` in `lo` and `-inf` in `hi`). Returns
@@ -65,29 +91,16 @@ pub(crate) fn rect_minmax(
     let mut phi = vec![0.0f64; rows * oc];
     let mut slo = vec![0.0f64; rows * oc];
     let mut shi = vec![0.0f64; rows * oc];
+    let (h, acc) = ((&hlo[..], &hhi[..]), oc);
     for r in 0..rows {
-        let (cur, prev) = (r * oc, r.wrapping_sub(1).wrapping_mul(oc));
-        if r % bh == 0 {
-            plo[cur..cur + oc].copy_from_slice(&hlo[cur..cur + oc]);
-            phi[cur..cur + oc].copy_from_slice(&hhi[cur..cur + oc]);
-        } else {
-            for c in 0..oc {
-                plo[cur + c] = plo[prev + c].min(hlo[cur + c]);
-                phi[cur + c] = phi[prev + c].max(hhi[cur + c]);
-            }
-        }
+        // prefix: a block of bh rows starts at every multiple of bh
+        let from = (r % bh != 0).then(|| (r - 1) * oc);
+        fold_row((&mut plo, &mut phi), h, r * oc, from, acc);
     }
     for r in (0..rows).rev() {
-        let (cur, next) = (r * oc, (r + 1) * oc);
-        if r % bh == bh - 1 || r == rows - 1 {
-            slo[cur..cur + oc].copy_from_slice(&hlo[cur..cur + oc]);
-            shi[cur..cur + oc].copy_from_slice(&hhi[cur..cur + oc]);
-        } else {
-            for c in 0..oc {
-                slo[cur + c] = slo[next + c].min(hlo[cur + c]);
-                shi[cur + c] = shi[next + c].max(hhi[cur + c]);
-            }
-        }
+        // suffix: a block ends at bh - 1 modulo bh and at the last row
+        let from = (r % bh != bh - 1 && r != rows - 1).then(|| (r + 1) * oc);
+        fold_row((&mut slo, &mut shi), h, r * oc, from, acc);
     }
     let mut olo = vec![0.0f64; orows * oc];
     let mut ohi = vec![0.0f64; orows * oc];

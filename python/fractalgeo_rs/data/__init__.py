@@ -56,11 +56,11 @@ def srtm_alps() -> Tuple[np.ndarray, Dict[str, Any]]:
 
     References
     ----------
-    Farr et al. (2007), doi:10.1029/2005RG000183; full entry in the bibliography,
-    :ref:`ref-farr2007`.
+    Farr et al. (2007), doi:10.1029/2005RG000183; full entry in the
+    :ref:`bibliography <ref-farr2007>`.
 
-    NASA JPL (2013), doi:10.5067/MEaSUREs/SRTM/SRTMGL3.003; full entry in the bibliography,
-    :ref:`ref-nasa2013`.
+    NASA JPL (2013), doi:10.5067/MEaSUREs/SRTM/SRTMGL3.003; full entry in the
+    :ref:`bibliography <ref-nasa2013>`.
 
     Examples
     --------
@@ -86,11 +86,11 @@ def srtm_po_plain() -> Tuple[np.ndarray, Dict[str, Any]]:
 
     References
     ----------
-    Farr et al. (2007), doi:10.1029/2005RG000183; full entry in the bibliography,
-    :ref:`ref-farr2007`.
+    Farr et al. (2007), doi:10.1029/2005RG000183; full entry in the
+    :ref:`bibliography <ref-farr2007>`.
 
-    NASA JPL (2013), doi:10.5067/MEaSUREs/SRTM/SRTMGL3.003; full entry in the bibliography,
-    :ref:`ref-nasa2013`.
+    NASA JPL (2013), doi:10.5067/MEaSUREs/SRTM/SRTMGL3.003; full entry in the
+    :ref:`bibliography <ref-nasa2013>`.
 
     Examples
     --------
@@ -172,8 +172,8 @@ def sentinel1_vv_db() -> Tuple[np.ndarray, Dict[str, Any]]:
 
     References
     ----------
-    Bonafilia et al. (2020), doi:10.1109/CVPRW50498.2020.00113; full entry in the bibliography,
-    :ref:`ref-bonafilia2020`.
+    Bonafilia et al. (2020), doi:10.1109/CVPRW50498.2020.00113; full entry in the
+    :ref:`bibliography <ref-bonafilia2020>`.
 
     Examples
     --------
@@ -200,8 +200,8 @@ def sentinel1_vh_db() -> Tuple[np.ndarray, Dict[str, Any]]:
 
     References
     ----------
-    Bonafilia et al. (2020), doi:10.1109/CVPRW50498.2020.00113; full entry in the bibliography,
-    :ref:`ref-bonafilia2020`.
+    Bonafilia et al. (2020), doi:10.1109/CVPRW50498.2020.00113; full entry in the
+    :ref:`bibliography <ref-bonafilia2020>`.
 
     Examples
     --------

@@ -132,10 +132,10 @@ def dimension(data, method: str = "box", **options) -> DimensionFit:
 
     References
     ----------
-    Datcu and Seidel (1994), the seed paper; full entry in the bibliography, :ref:`ref-datcu1994`.
+    Datcu and Seidel (1994), the seed paper; full entry in the :ref:`bibliography <ref-datcu1994>`.
 
-    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the bibliography,
-    :ref:`ref-gneiting2012`.
+    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the
+    :ref:`bibliography <ref-gneiting2012>`.
 
     Examples
     --------

@@ -233,9 +233,9 @@ def box_counting(
 
     References
     ----------
-    Falconer (1990); full entry in the bibliography, :ref:`ref-falconer1990`.
+    Falconer (1990); full entry in the :ref:`bibliography <ref-falconer1990>`.
 
-    Datcu and Seidel (1994), the seed paper; full entry in the bibliography, :ref:`ref-datcu1994`.
+    Datcu and Seidel (1994), the seed paper; full entry in the :ref:`bibliography <ref-datcu1994>`.
 
     Examples
     --------
@@ -365,7 +365,7 @@ def box_counting_points(
 
     References
     ----------
-    Falconer (1990); full entry in the bibliography, :ref:`ref-falconer1990`.
+    Falconer (1990); full entry in the :ref:`bibliography <ref-falconer1990>`.
 
     Examples
     --------
@@ -726,7 +726,7 @@ def self_affine_box_counting(
     B. B. Mandelbrot, Self-affine fractals and fractal dimension, *Physica
     Scripta* 32 (1985) 257-260, doi:10.1088/0031-8949/32/4/001.
 
-    Falconer (1990); full entry in the bibliography, :ref:`ref-falconer1990`.
+    Falconer (1990); full entry in the :ref:`bibliography <ref-falconer1990>`.
 
     Examples
     --------

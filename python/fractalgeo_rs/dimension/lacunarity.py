@@ -43,11 +43,11 @@ class Lacunarity:
 
     References
     ----------
-    Allain and Cloitre (1991), doi:10.1103/PhysRevA.44.3552; full entry in the bibliography,
-    :ref:`ref-allain1991`.
+    Allain and Cloitre (1991), doi:10.1103/PhysRevA.44.3552; full entry in the
+    :ref:`bibliography <ref-allain1991>`.
 
-    Plotnick, Gardner and O'Neill (1993), doi:10.1007/BF00125351; full entry in the bibliography,
-    :ref:`ref-plotnick1993`.
+    Plotnick, Gardner and O'Neill (1993), doi:10.1007/BF00125351; full entry in the
+    :ref:`bibliography <ref-plotnick1993>`.
 
     Examples
     --------
@@ -92,11 +92,11 @@ def lacunarity(data, *, box_sizes: Optional[Sequence[int]] = None) -> Lacunarity
 
     References
     ----------
-    Allain and Cloitre (1991), doi:10.1103/PhysRevA.44.3552; full entry in the bibliography,
-    :ref:`ref-allain1991`.
+    Allain and Cloitre (1991), doi:10.1103/PhysRevA.44.3552; full entry in the
+    :ref:`bibliography <ref-allain1991>`.
 
-    Plotnick, Gardner and O'Neill (1993), doi:10.1007/BF00125351; full entry in the bibliography,
-    :ref:`ref-plotnick1993`.
+    Plotnick, Gardner and O'Neill (1993), doi:10.1007/BF00125351; full entry in the
+    :ref:`bibliography <ref-plotnick1993>`.
 
     Examples
     --------

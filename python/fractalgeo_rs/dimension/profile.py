@@ -177,8 +177,8 @@ def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, cell_size: fl
     T. Lindeberg, *Scale-Space Theory in Computer Vision*, Kluwer, 1994,
     doi:10.1007/978-1-4757-6465-9.
 
-    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the bibliography,
-    :ref:`ref-gneiting2012`.
+    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the
+    :ref:`bibliography <ref-gneiting2012>`.
 
     Examples
     --------

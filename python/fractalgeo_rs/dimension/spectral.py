@@ -103,7 +103,7 @@ def spectral_dimension(
     H.-O. Peitgen and D. Saupe (eds.), *The Science of Fractal Images*,
     Springer, 1988, 21-70, doi:10.1007/978-1-4612-3784-6_1.
 
-    Datcu and Seidel (1994), the seed paper; full entry in the bibliography, :ref:`ref-datcu1994`.
+    Datcu and Seidel (1994), the seed paper; full entry in the :ref:`bibliography <ref-datcu1994>`.
 
     Examples
     --------

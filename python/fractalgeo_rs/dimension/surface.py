@@ -70,7 +70,7 @@ def minkowski(data, *, radii: Optional[Sequence[float]] = None, scale_range: Sca
     Evaluating the fractal dimension of profiles, *Physical Review A* 39
     (1989) 1500-1512, doi:10.1103/PhysRevA.39.1500.
 
-    Datcu and Seidel (1994), the seed paper; full entry in the bibliography, :ref:`ref-datcu1994`.
+    Datcu and Seidel (1994), the seed paper; full entry in the :ref:`bibliography <ref-datcu1994>`.
 
     Examples
     --------
@@ -185,7 +185,7 @@ def mass_dimension(
     R. F. Voss, Characterization and measurement of random fractals,
     *Physica Scripta* T13 (1986) 27-32, doi:10.1088/0031-8949/1986/T13/004.
 
-    Datcu and Seidel (1994), the seed paper; full entry in the bibliography, :ref:`ref-datcu1994`.
+    Datcu and Seidel (1994), the seed paper; full entry in the :ref:`bibliography <ref-datcu1994>`.
 
     Examples
     --------

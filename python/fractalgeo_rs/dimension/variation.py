@@ -143,11 +143,11 @@ def power_variation(
 
     References
     ----------
-    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the bibliography,
-    :ref:`ref-gneiting2012`.
+    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the
+    :ref:`bibliography <ref-gneiting2012>`.
 
-    Kent and Wood (1997), doi:10.1111/1467-9868.00091; full entry in the bibliography,
-    :ref:`ref-kent1997`.
+    Kent and Wood (1997), doi:10.1111/1467-9868.00091; full entry in the
+    :ref:`bibliography <ref-kent1997>`.
 
     Examples
     --------
@@ -215,8 +215,8 @@ def variogram(data, *, lags: Sequence[int] = (1, 2), nodata: Optional[float] = N
 
     References
     ----------
-    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the bibliography,
-    :ref:`ref-gneiting2012`.
+    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the
+    :ref:`bibliography <ref-gneiting2012>`.
 
     Examples
     --------
@@ -259,8 +259,8 @@ def madogram(data, *, lags: Sequence[int] = (1, 2), nodata: Optional[float] = No
 
     References
     ----------
-    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the bibliography,
-    :ref:`ref-gneiting2012`.
+    Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the
+    :ref:`bibliography <ref-gneiting2012>`.
 
     Examples
     --------
@@ -325,8 +325,8 @@ def surface_variation(
     dimension for two-dimensional surface data, *Statistica Sinica* 10
     (2000) 343-376.
 
-    Kent and Wood (1997), doi:10.1111/1467-9868.00091; full entry in the bibliography,
-    :ref:`ref-kent1997`.
+    Kent and Wood (1997), doi:10.1111/1467-9868.00091; full entry in the
+    :ref:`bibliography <ref-kent1997>`.
 
     Examples
     --------

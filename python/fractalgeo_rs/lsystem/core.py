@@ -374,8 +374,8 @@ class LSystem:
 
         References
         ----------
-        Prusinkiewicz and Lindenmayer (1990), section 1.2; full entry in the bibliography,
-        :ref:`ref-prusinkiewicz1990`.
+        Prusinkiewicz and Lindenmayer (1990), section 1.2; full entry in the
+        :ref:`bibliography <ref-prusinkiewicz1990>`.
 
         Examples
         --------

@@ -201,8 +201,8 @@ def turtle_2d(lstring: Union[LString, str], *, angle: float = 90.0, step: float 
 
     References
     ----------
-    Prusinkiewicz and Lindenmayer (1990), section 1.2; full entry in the bibliography,
-    :ref:`ref-prusinkiewicz1990`.
+    Prusinkiewicz and Lindenmayer (1990), section 1.2; full entry in the
+    :ref:`bibliography <ref-prusinkiewicz1990>`.
 
     Examples
     --------

@@ -113,9 +113,9 @@ def synthetic_dem(shape, hurst, *, cell_size, relief, relief_lag=None, mean_elev
 
     References
     ----------
-    Stein (2002), doi:10.1198/106186002466; full entry in the bibliography, :ref:`ref-stein2002`.
+    Stein (2002), doi:10.1198/106186002466; full entry in the :ref:`bibliography <ref-stein2002>`.
 
-    Datcu and Seidel (1994), the seed paper; full entry in the bibliography, :ref:`ref-datcu1994`.
+    Datcu and Seidel (1994), the seed paper; full entry in the :ref:`bibliography <ref-datcu1994>`.
 
     Examples
     --------

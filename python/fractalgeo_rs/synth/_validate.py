@@ -58,7 +58,7 @@ class SurfaceReport:
 
     References
     ----------
-    Stein (2002), doi:10.1198/106186002466; full entry in the bibliography, :ref:`ref-stein2002`.
+    Stein (2002), doi:10.1198/106186002466; full entry in the :ref:`bibliography <ref-stein2002>`.
 
     Examples
     --------
@@ -250,7 +250,7 @@ def validate_surface(data, hurst=None, *, lags=None, periodic=None, coastline=Tr
 
     References
     ----------
-    Stein (2002), doi:10.1198/106186002466; full entry in the bibliography, :ref:`ref-stein2002`.
+    Stein (2002), doi:10.1198/106186002466; full entry in the :ref:`bibliography <ref-stein2002>`.
 
     H.-O. Peitgen and D. Saupe (eds.), *The Science of Fractal Images*,
     Springer, 1988, doi:10.1007/978-1-4612-3784-6.
