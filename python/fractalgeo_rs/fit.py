@@ -93,8 +93,8 @@ class ScaleSegment:
 
     References
     ----------
-    G. Schwarz, Estimating the dimension of a model, *Annals of Statistics*
-    6(2) (1978) 461-464, doi:10.1214/aos/1176344136.
+    Schwarz (1978), doi:10.1214/aos/1176344136; full entry in the
+    :ref:`bibliography <ref-schwarz1978>`.
 
     Examples
     --------
@@ -531,8 +531,8 @@ def fit_loglog(
 
     References
     ----------
-    K. Falconer, *Fractal Geometry: Mathematical Foundations and
-    Applications*, Wiley, 1990, chapter 3 (box-counting dimension).
+    Falconer (1990), chapter 3 (box-counting dimension); full entry in the
+    :ref:`bibliography <ref-falconer1990>`.
 
     Gneiting, Sevcikova and Percival (2012), doi:10.1214/11-STS370; full entry in the
     :ref:`bibliography <ref-gneiting2012>`.

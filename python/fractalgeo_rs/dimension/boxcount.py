@@ -590,10 +590,8 @@ def differential_box_counting(
 
     References
     ----------
-    N. Sarkar and B. B. Chaudhuri, An efficient differential box-counting
-    approach to compute fractal dimension of image, *IEEE Transactions on
-    Systems, Man, and Cybernetics* 24(1) (1994) 115-120,
-    doi:10.1109/21.259692.
+    Sarkar and Chaudhuri (1994), doi:10.1109/21.259692; full entry in the
+    :ref:`bibliography <ref-sarkar1994>`.
 
     Examples
     --------

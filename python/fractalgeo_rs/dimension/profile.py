@@ -69,9 +69,8 @@ def higuchi(data, *, k_max: Optional[int] = None, nodata: Optional[float] = None
 
     References
     ----------
-    T. Higuchi, Approach to an irregular time series on the basis of the
-    fractal theory, *Physica D* 31 (1988) 277-283,
-    doi:10.1016/0167-2789(88)90081-4.
+    Higuchi (1988), doi:10.1016/0167-2789(88)90081-4; full entry in the
+    :ref:`bibliography <ref-higuchi1988>`.
 
     Examples
     --------

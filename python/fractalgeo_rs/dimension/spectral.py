@@ -99,9 +99,8 @@ def spectral_dimension(
 
     References
     ----------
-    R. F. Voss, Fractals in nature: from characterization to simulation, in
-    H.-O. Peitgen and D. Saupe (eds.), *The Science of Fractal Images*,
-    Springer, 1988, 21-70, doi:10.1007/978-1-4612-3784-6_1.
+    Voss (1988), doi:10.1007/978-1-4612-3784-6_1; full entry in the
+    :ref:`bibliography <ref-voss1988>`.
 
     Datcu and Seidel (1994), the seed paper; full entry in the :ref:`bibliography <ref-datcu1994>`.
 

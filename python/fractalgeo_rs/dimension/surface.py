@@ -182,8 +182,8 @@ def mass_dimension(
 
     References
     ----------
-    R. F. Voss, Characterization and measurement of random fractals,
-    *Physica Scripta* T13 (1986) 27-32, doi:10.1088/0031-8949/1986/T13/004.
+    Voss (1986), doi:10.1088/0031-8949/1986/T13/004; full entry in the
+    :ref:`bibliography <ref-voss1986>`.
 
     Datcu and Seidel (1994), the seed paper; full entry in the :ref:`bibliography <ref-datcu1994>`.
 

@@ -195,8 +195,8 @@ class LSystem:
 
     References
     ----------
-    P. Prusinkiewicz and A. Lindenmayer, *The Algorithmic Beauty of Plants*,
-    Springer, 1990.
+    Prusinkiewicz and Lindenmayer (1990); full entry in the
+    :ref:`bibliography <ref-prusinkiewicz1990>`.
 
     Examples
     --------

@@ -41,8 +41,8 @@ def moran_dimension(ratios: Sequence[float]) -> float:
     P. A. P. Moran, Additive functions of intervals and Hausdorff measure,
     *Proc. Camb. Phil. Soc.* 42 (1946) 15-23, doi:10.1017/S0305004100022684.
 
-    J. E. Hutchinson, Fractals and self-similarity, *Indiana Univ. Math. J.*
-    30 (1981) 713-747, doi:10.1512/iumj.1981.30.30055.
+    Hutchinson (1981), doi:10.1512/iumj.1981.30.30055; full entry in the
+    :ref:`bibliography <ref-hutchinson1981>`.
 
     Examples
     --------
@@ -98,8 +98,8 @@ def rasterize_points(points, shape, *, bounds: Optional[Sequence[float]] = None)
 
     References
     ----------
-    M. Barnsley, *Fractals Everywhere*, Academic Press, 1988 (attractors
-    drawn by the random iteration algorithm on a grid of pixels).
+    Barnsley (1988) (attractors drawn by the random iteration algorithm on a
+    grid of pixels); full entry in the :ref:`bibliography <ref-barnsley1988>`.
 
     Examples
     --------

@@ -43,9 +43,8 @@ def expected_relief_std(shape, hurst, cell_size=1.0, sigma=1.0):
 
     References
     ----------
-    B. B. Mandelbrot and J. W. Van Ness, Fractional Brownian motions,
-    fractional noises and applications, *SIAM Review* 10(4) (1968) 422-437,
-    doi:10.1137/1010093.
+    Mandelbrot and Van Ness (1968), doi:10.1137/1010093; full entry in the
+    :ref:`bibliography <ref-mandelbrot1968>`.
 
     Examples
     --------
