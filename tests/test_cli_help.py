@@ -88,3 +88,12 @@ def test_memory_limit_message_names_what_the_command_offers():
     assert "raise the limit with --max-memory or $FRACTALGEO_MAX_MEMORY" in synth
     tr = cli.cli_message(text, cli.option_names(_subcommands()["transform"]))
     assert "max_memory" not in tr and "--max-memory" not in tr and "$FRACTALGEO_MAX_MEMORY (bytes)" in tr
+
+
+def test_t_quantile_without_scipy_equals_scipys():
+    from scipy.special import stdtrit
+
+    from fractalgeo_rs.fit import t_quantile_975
+
+    for df in list(range(1, 1200)) + [5000, 10**6]:
+        assert abs(t_quantile_975(df) - float(stdtrit(df, 0.975))) < 1e-12, df

@@ -35,7 +35,6 @@ def _method_choices():
 #: fBm surfaces (bias of D at 256 x 256, H = 0.1-0.9): a note says so.
 BIASED = {"dbc": "low by 0.13-0.39", "blanket": "low by 0.06-0.84", "affine": "low by 0.02-0.33",
           "wavelet": "high by 0.04-0.24", "spectral": "off by up to 0.15"}
-DOCS_URL = "https://fractalgeo-rs.readthedocs.io/en/latest/accuracy.html"
 
 
 def add_parsers(sub) -> None:
@@ -49,7 +48,7 @@ def add_parsers(sub) -> None:
             "input kind decides the default estimator: a binary set (bool, or integers with 0 and at most "
             "one other value, or --threshold) is box-counted; a surface gets surface_variation with the "
             "transect estimator (the median of the row and column profile dimensions, plus 1) and a profile "
-            "the variogram, the estimators docs/accuracy.md finds accurate "
+            "the variogram, the estimators the accuracy tables of the documentation find accurate "
             "(DBC, blanket and self-affine boxes are biased by 0.1-0.8 on fBm). Prints the dimension, its "
             "95 %% interval, the scales fitted, and a warning with the reason when the answer is outside "
             "the valid domain."
@@ -184,7 +183,8 @@ def _run_dimension(args: argparse.Namespace) -> int:
     opts = {**defaults, **_options(func, given)}
     if method in BIASED and kind == "surface":
         print(f"fractalgeo dimension: note: --method {method} is biased on fBm surfaces (D {BIASED[method]} at "
-              f"256 x 256, {DOCS_URL}); surface_variation, variogram and whittle are accurate", file=sys.stderr)
+              f"256 x 256 in the accuracy tables of the documentation); surface_variation, variogram and whittle "
+              f"are accurate", file=sys.stderr)
     if method == "mle":
         print("fractalgeo dimension: note: --method mle is the exact Gaussian likelihood, O(n^3) in the samples "
               "(up to 4096 of them): it can take 10-20 s; --method whittle is fast and as accurate on large "

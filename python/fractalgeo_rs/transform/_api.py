@@ -218,8 +218,8 @@ def fractal_transform(
         estimators see the heights of the image surface, and linear
         intensity (a heavy right tail of speckle) gives other maps than dB
         (on linear intensity most windows fall below D = 2 and the
-        urban/non-urban ordering can flip). The defaults were validated on
-        dB (``docs/transform.md``, https://fractalgeo-rs.readthedocs.io).
+        urban/non-urban ordering can flip). The defaults and the worked
+        examples were validated on dB (Sentinel-1 sigma0 in dB).
         ``"linear"`` (intensity, sigma0) is converted to
         ``10 log10(image)``, ``"amplitude"`` to ``20 log10(image)``
         (non-positive values become NaN); ``"db"`` and ``None`` use the

@@ -2,12 +2,13 @@
 from __future__ import annotations
 
 import argparse
+import sys
 
 from fractalgeo_rs._cli_common import (HelpFormatter, LazyChoices, add_band, add_cell_size, add_n_threads, add_progress,
                                         add_raster_io, input_georef)
 
-#: Where the transform page is read (the wheel ships no docs/ folder).
-DOCS_URL = "https://fractalgeo-rs.readthedocs.io/en/latest/transform.html"
+#: Where the flags are explained in what the wheel ships (it has no docs/ folder).
+FLAGS_HELP = "python -m pydoc fractalgeo_rs.transform.TransformFit"
 
 
 def add_parsers(sub) -> None:
@@ -95,6 +96,9 @@ def _run(args: argparse.Namespace) -> int:
             raise ValueError("--z-scale: 'cell' needs the input's cell size: the input has no georeferencing, "
                              "give --cell-size")
         args.z_scale = cell
+        print(f"fractalgeo transform: note: --z-scale cell: {cell:.6g} height units per box step (cubic boxes), "
+              f"right only when heights and cells share a unit; on a DEM whose relief is small against its "
+              f"cells the map is then near 2 (use 'auto' to compare textures)", file=sys.stderr)
     show = _progress.resolve(args.progress, cli=True)
     opts = dict(method=args.method, nodata=nodata, n_threads=args.n_threads, z_scale=args.z_scale,
                 step=args.step, return_fit=True, scale=args.scale)
@@ -139,6 +143,6 @@ def _run(args: argparse.Namespace) -> int:
         out = [f"{100 * np.mean(flags & bit > 0):.1f} % {name}" for name, bit in FLAGS.items()
                if name != "too_few_valid" and np.any(flags & bit)]
         if out:
-            print("outside the valid domain: " + ", ".join(out) + f" (see {DOCS_URL})")
+            print("outside the valid domain: " + ", ".join(out) + f" (flags: {FLAGS_HELP})")
     print(f"map: {args.output}")
     return 0
