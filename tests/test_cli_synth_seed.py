@@ -73,3 +73,13 @@ def test_npy_input_gets_one_line_and_no_rasterio_warning(tmp_path, capsys, comma
     if out.endswith(".tif"):
         with rasterio.open(tmp_path / out) as ds:
             assert ds.crs.to_epsg() == 32633 and ds.transform.a > 0
+
+
+def test_memory_option_does_not_leak_into_the_process(tmp_path, monkeypatch):
+    import os
+
+    from fractalgeo_rs._validation import MAX_MEMORY_ENV
+
+    monkeypatch.delenv(MAX_MEMORY_ENV, raising=False)
+    assert main(["synth", str(tmp_path / "a.npy"), "--hurst", "0.7", "--size", "16", "16", "--max-memory", "1G"]) == 0
+    assert MAX_MEMORY_ENV not in os.environ

@@ -85,10 +85,25 @@ def _peak_rss_bytes() -> float:
 
 def _run_synth(args: argparse.Namespace) -> int:
     import os
+
+    from fractalgeo_rs._validation import MAX_MEMORY_ENV
+
+    old = os.environ.get(MAX_MEMORY_ENV)
+    if args.max_memory is not None:
+        os.environ[MAX_MEMORY_ENV] = str(args.max_memory)  # read by every memory check of this run
+    try:
+        return _synth(args)
+    finally:  # the process (a test, a script calling main) keeps its own limit
+        if old is None:
+            os.environ.pop(MAX_MEMORY_ENV, None)
+        else:
+            os.environ[MAX_MEMORY_ENV] = old
+
+
+def _synth(args: argparse.Namespace) -> int:
     import time
 
     from fractalgeo_rs import _progress
-    from fractalgeo_rs._validation import MAX_MEMORY_ENV
     from fractalgeo_rs.io import write_raster
     from fractalgeo_rs.synth import fbm, fbm_surface, synthetic_dem
     from fractalgeo_rs.synth._common import resolve_seed
@@ -100,8 +115,6 @@ def _run_synth(args: argparse.Namespace) -> int:
     if args.relief is None and any(v is not None for v in dem_opts):
         raise ValueError("--relief-lag, --mean-elevation: need --relief (a DEM in metres)")
     seed = resolve_seed(args.seed)
-    if args.max_memory is not None:
-        os.environ[MAX_MEMORY_ENV] = str(args.max_memory)  # read by every memory check of this process
     show = _progress.resolve(args.progress, cli=True)
     t0 = time.perf_counter()
     if dim == 1:
