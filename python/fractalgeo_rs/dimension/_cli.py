@@ -5,7 +5,7 @@ import argparse
 import sys
 
 from fractalgeo_rs._cli_common import (HelpFormatter, LazyChoices, add_band, add_cell_size, add_n_threads,
-                                        add_raster_io)
+                                        add_progress, add_raster_io)
 
 #: The default estimator of each input kind and its options: the ones
 #: ``docs/accuracy.md`` measures as accurate on fBm (transect madogram on
@@ -70,6 +70,7 @@ def add_parsers(sub) -> None:
     add_cell_size(p)
     p.add_argument("--plot", default=None, metavar="PNG", help="write the log-log plot to this PNG (None: none)")
     add_n_threads(p)
+    add_progress(p)
     p.set_defaults(func=_run_dimension)
 
 
@@ -125,8 +126,8 @@ def _options(func, given: dict) -> dict:
         if value is None or key.startswith("_"):
             continue
         if key not in params:
-            if key in ("cell_size", "n_threads"):
-                continue  # dimensions are scale free; single-threaded methods
+            if key in ("cell_size", "n_threads", "progress"):
+                continue  # dimensions are scale free; single-threaded methods; no bar
 
             raise ValueError(f"{opt}: not an option of --method {given['_method'][1]}")
         out[key] = value
@@ -136,6 +137,7 @@ def _options(func, given: dict) -> dict:
 def _run_dimension(args: argparse.Namespace) -> int:
     import numpy as np
 
+    from fractalgeo_rs import _progress
     from fractalgeo_rs.dimension import METHODS
 
     data, profile = _read(args)
@@ -179,7 +181,7 @@ def _run_dimension(args: argparse.Namespace) -> int:
     given = {"_method": ("--method", method), "n_threads": ("--n-threads", args.n_threads),
              "scale_range": ("--scale-range", _parse_range(args.scale_range)),
              "box_sizes": ("--box-sizes", box_sizes), "offsets": ("--offsets", args.offsets),
-             "cell_size": ("--cell-size", args.cell_size)}
+             "cell_size": ("--cell-size", args.cell_size), "progress": ("--progress", _progress.resolve(args.progress, cli=True))}
     opts = {**defaults, **_options(func, given)}
     if method in BIASED and kind == "surface":
         print(f"fractalgeo dimension: note: --method {method} is biased on fBm surfaces (D {BIASED[method]} at "
