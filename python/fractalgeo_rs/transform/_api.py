@@ -386,9 +386,11 @@ def warn_if_linear(arr: np.ndarray, nodata=None) -> None:
 
         from fractalgeo_rs._warn import user_stacklevel
 
-        warnings.warn("image: looks like linear SAR intensity (non-negative with a heavy right tail); the maps "
-                      "were validated on dB: pass scale='linear' (CLI: --scale linear) to convert to 10 log10, "
-                      "or scale='db' if it is already on a log scale", UserWarning, stacklevel=user_stacklevel())
+        warnings.warn("image: looks like linear SAR intensity or amplitude (non-negative with a heavy right tail); "
+                      "the maps were validated on dB: pass scale='linear' (CLI: --scale linear) to convert "
+                      "intensity to 10 log10, scale='amplitude' (--scale amplitude) for amplitudes, or scale='db' "
+                      "(--scale db) if the image is on a log scale already", UserWarning,
+                      stacklevel=user_stacklevel())
 
 
 def _to_db(arr, image, nodata, factor: float):
