@@ -97,3 +97,27 @@ def test_t_quantile_without_scipy_equals_scipys():
 
     for df in list(range(1, 1200)) + [5000, 10**6]:
         assert abs(t_quantile_975(df) - float(stdtrit(df, 0.975))) < 1e-12, df
+
+
+def test_every_lazy_export_is_typed_and_resolves():
+    """Each row of ``_EXPORTS`` is also imported under ``TYPE_CHECKING`` (so
+    type checkers see it) and resolves to the object of its module."""
+    import ast
+    import importlib
+    from pathlib import Path
+
+    import fractalgeo_rs as fg
+
+    tree = ast.parse(Path(fg.__file__).read_text())
+    typed = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If) and getattr(node.test, "id", "") == "TYPE_CHECKING":
+            for imp in node.body:
+                typed |= {a.asname or a.name for a in getattr(imp, "names", [])}
+    assert set(fg._EXPORTS) == typed
+    for name, module in fg._EXPORTS.items():
+        obj = getattr(fg, name)
+        if module is None:
+            assert obj is importlib.import_module(f"fractalgeo_rs.{name}")
+        else:
+            assert obj is getattr(importlib.import_module(module), name)

@@ -14,7 +14,7 @@ fractalgeo_rs`` and the ``fractalgeo`` command start fast: ``_EXPORTS`` maps
 each public name to the module that defines it, and is the one list of the
 top-level API (``__all__`` is its keys in order). To add an export, add a
 ``"name": "fractalgeo_rs.module"`` row (a subpackage exported as a whole:
-``"name": None``), and the name to the ``TYPE_CHECKING`` imports below for
+``"name": None``), and the name to the ``TYPE_CHECKING`` imports above it for
 type checkers.
 """
 from __future__ import annotations
