@@ -42,3 +42,8 @@ def test_segment_seed_and_spectral_bins():
 def test_validate_surface_on_a_small_grid_has_no_spectral_slope():
     r = fg.validate_surface(fg.fbm_surface((32, 32), 0.7, seed=1), 0.7)
     assert np.isnan(r.spectral_slope) and np.isnan(r.hurst_spectrum) and np.isfinite(r.hurst_variogram)
+
+
+def test_auto_scale_range_on_two_scales_names_scale_range():
+    with pytest.raises(ValueError, match="^scale_range: 'auto' picks a range of at least 3"):
+        fg.variogram(Z, scale_range="auto")

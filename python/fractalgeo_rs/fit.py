@@ -574,6 +574,9 @@ def fit_loglog(
             raise ValueError(f"scale_range: expected None, 'all', 'auto' or (low, high), got {scale_range!r}")
         idx = np.flatnonzero(valid)
         n = len(idx)
+        if n < 3:
+            raise ValueError(f"scale_range: 'auto' picks a range of at least 3 of the scales and there are {n} "
+                             f"(give more scales, e.g. lags or box_sizes, or leave scale_range None)")
         mp = max(3, math.ceil(n / 2)) if min_points is None else int(min_points)
         if mp < 3 or mp > n:
             raise ValueError(f"min_points: expected an int in [3, {n}], got {min_points!r}")
