@@ -204,6 +204,10 @@ def _run_dimension(args: argparse.Namespace) -> int:
     print(f"method: {method}" + ("" if args.method else f" (the default for a {kind}{chosen})"))
     lo, hi = fit.ci95
     interval = f"95 % interval [{lo:.4f}, {hi:.4f}]" if np.isfinite(lo) and np.isfinite(hi) else "no interval"
+    if opts.get("estimator") == "transect" and np.isfinite(lo):
+        # the interval of the median takes the rows and columns as independent
+        interval += (" (of the median over rows and columns taken as independent, so narrower than the error: "
+                     "RMSE 0.002-0.037 on fBm surfaces of 256-512 samples a side in the accuracy tables)")
     hurst = f", H = {fit.extra['hurst']:.4f}" if "hurst" in fit.extra else ""
     print(f"D = {fit.dimension:.4f}, {interval}{hurst}")
     s_lo, s_hi = fit.scale_range
