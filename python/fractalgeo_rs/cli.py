@@ -147,6 +147,12 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             raise
         print(f"fractalgeo {args.command}: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader of stdout went away (e.g. | head): stop quietly, as Unix tools do
+        import os
+
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())  # no second error when Python flushes stdout at exit
+        return 0
     except ModuleNotFoundError as exc:
         if args.debug:
             raise
