@@ -21,12 +21,37 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 import re  # noqa: E402
+import warnings  # noqa: E402
 
 import fractalgeo_rs  # noqa: E402
 import _apigen  # noqa: E402
 
 _apigen.write_api_page(HERE / "api.rst")
 _apigen.write_cli_page(HERE / "cli.rst")
+
+
+def _demo_figure() -> None:
+    """Regenerate ``img/fractalgeo_demo.png`` (the README's and the index's
+    figure) from the current code: the figure ``fractalgeo demo`` draws."""
+    import matplotlib.pyplot as plt
+
+    from fractalgeo_rs import demo
+    from fractalgeo_rs.plotting import save_figure
+
+    fig = demo.figure(demo.compute(), demo.local_map())
+    save_figure(fig, HERE / "img" / "fractalgeo_demo.png")
+    plt.close(fig)
+
+
+_demo_figure()
+
+
+def _warning_line(message, category, filename, lineno, line=None):
+    """Warnings in the gallery's output without the build machine's paths."""
+    return f"{category.__name__}: {message}\n"
+
+
+warnings.formatwarning = _warning_line
 
 project = "fractalgeo_rs"
 author = "The fractalgeo_rs developers"

@@ -38,7 +38,7 @@ def test_dimension_npy_and_plot(tmp_path, capsys):
     plot = tmp_path / "fit.png"
     code, out, _ = run(["dimension", str(path), "--plot", str(plot)], capsys)
     assert code == 0
-    assert "method='box'" in out and "dimension=1.5850" in out
+    assert "method: box (the default for a set)" in out and "D = 1.5850," in out
     assert plot.exists() and plot.stat().st_size > 1000
 
 
@@ -48,7 +48,7 @@ def test_dimension_png_16bit_and_threshold(tmp_path, capsys):
     fg.write_raster(path, carpet.astype(np.uint16) * 40000)
     code, out, _ = run(["dimension", str(path), "--threshold", "100"], capsys)
     assert code == 0
-    assert f"dimension={LN(8) / LN(3):.4f}" in out
+    assert f"D = {LN(8) / LN(3):.4f}," in out
 
 
 def test_dimension_geotiff_via_rasterio(tmp_path, capsys):
@@ -63,7 +63,7 @@ def test_dimension_geotiff_via_rasterio(tmp_path, capsys):
     code, out, _ = run(["dimension", str(path), "--method", "dbc", "--box-sizes", "2,4,8,16"], capsys)
     assert code == 0
     expect = fg.differential_box_counting(z, box_sizes=[2, 4, 8, 16])
-    assert f"dimension={expect.dimension:.4f}" in out
+    assert f"D = {expect.dimension:.4f}," in out
 
 
 def test_dimension_errors_are_clean(tmp_path, capsys):

@@ -69,9 +69,9 @@ def test_transform_keeps_georeferencing(tmp_path, dem_tif):
 @pytest.mark.parametrize("argv,needle", [
     (["transform", "IN", "OUT.tif", "--chunks", "0"], "--chunks"),
     (["synth", "DIR", "--hurst", "0.5", "--size", "8", "8"], "directory"),
-    (["hillshade", "IN", "OUT.png", "--z-factor", "-1"], "z_factor"),
-    (["synth", "o.npy", "--hurst", "0.5", "--size", "1000000000000"], "max_memory"),
-    (["synth", "o.npy", "--hurst", "0.5", "--size", "64", "--n-threads", "100000"], "n_threads"),
+    (["hillshade", "IN", "OUT.png", "--z-factor", "-1"], "--z-factor"),
+    (["synth", "o.npy", "--hurst", "0.5", "--size", "1000000000000"], "--max-memory"),
+    (["synth", "o.npy", "--hurst", "0.5", "--size", "64", "--n-threads", "100000"], "--n-threads"),
 ])
 def test_user_errors_are_one_line(tmp_path, dem_tif, capsys, argv, needle):
     argv = [str(dem_tif) if a == "IN" else str(tmp_path / a) if a.startswith(("OUT", "o.")) else

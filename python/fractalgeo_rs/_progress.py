@@ -64,8 +64,8 @@ class _NoBar:
 
 
 @contextlib.contextmanager
-def bar(total: int, desc: str, enabled: bool, unit: str = "it"):
-    """A tqdm bar of ``total`` steps (of ``unit``, scaled with k/M prefixes
+def bar(total: Optional[int], desc: str, enabled: bool, unit: str = "it"):
+    """A tqdm bar of ``total`` steps (``None``: a counter without a total) (of ``unit``, scaled with k/M prefixes
     unless ``"it"``) on stderr when ``enabled`` and tqdm is importable, else
     an object whose ``update`` does nothing."""
     b = _NoBar()

@@ -21,6 +21,7 @@ from fractalgeo_rs._warn import user_stacklevel
 
 __all__ = [
     "as_array",
+    "as_list",
     "check_real_array",
     "check_memory",
     "resolve_max_memory",
@@ -259,6 +260,14 @@ def check_integer_lags(lags, name: str = "lags", *, minimum: int = 1) -> list:
             raise ValueError(f"{name}: lags must be >= {minimum}, got {v}")
         out.append(v)
     return sorted(set(out))
+
+
+def as_list(value, name: str, what: str = "numbers") -> list:
+    """The items of a sequence argument (e.g. ``box_sizes``, ``radii``), or
+    a TypeError naming it when it is a scalar, a string or not iterable."""
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
+        raise TypeError(f"{name}: expected a sequence of {what}, got {value!r}")
+    return list(value)
 
 
 def check_positive_int(value, name: str) -> int:

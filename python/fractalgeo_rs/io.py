@@ -35,6 +35,7 @@ available memory) the reader raises :class:`RasterMemoryError`, an
 from __future__ import annotations
 
 import os
+import warnings
 from typing import Any, Dict, Optional, Tuple
 
 import numpy as np
@@ -311,7 +312,10 @@ def read_raster(path, band: Optional[int] = None) -> Tuple[np.ndarray, Optional[
             "8/16-bit .tif are read natively; other formats need pip install 'fractalgeo_rs[geo]'"
         )
     try:
-        src = rio.open(p)
+        with warnings.catch_warnings():
+            # a TIFF without georeferencing is read as such (profile transform = identity, crs None)
+            warnings.simplefilter("ignore", rio.errors.NotGeoreferencedWarning)
+            src = rio.open(p)
     except rio.errors.RasterioIOError as exc:
         raise OSError(f"path: unsupported or unreadable raster {p!r}: {exc}") from None
     with src:
@@ -459,7 +463,9 @@ def write_raster(path, data, *, profile: Optional[dict] = None, crs=None, transf
             prof["nodata"] = nodata
         if a.dtype == bool:
             raise TypeError("data: convert boolean masks to uint8 before writing GeoTIFF")
-        with atomic_write_path(p) as tmp:
+        with atomic_write_path(p) as tmp, warnings.catch_warnings():
+            # an array without georeferencing is written without it (not a fault)
+            warnings.simplefilter("ignore", rio.errors.NotGeoreferencedWarning)
             with rio.open(tmp, "w", **prof) as dst:
                 dst.write(a, 1)
                 if tags:

@@ -5,10 +5,8 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-import numpy as np
-
 from fractalgeo_rs._cli_common import (HelpFormatter, add_band, add_cell_size, add_n_threads, add_progress,
-                                        add_raster_io, is_geographic)
+                                        add_raster_io, input_georef, is_geographic, pixel_size)
 
 
 def add_parsers(sub) -> None:
@@ -22,15 +20,16 @@ def add_parsers(sub) -> None:
         "the memory limit) it is computed in blocks of --chunks input cells and written block by block; "
         "without dask a result that fits in memory is computed in one piece (the same values).",
     )
-    p.add_argument("input", help="input DEM (GeoTIFF or any format rasterio reads)")
+    p.add_argument("input", help="input DEM (GeoTIFF or any format rasterio reads; .npy with --cell-size)")
     p.add_argument("output", help="output GeoTIFF (.tif or .tiff; float32, nodata NaN)")
     add_band(p)
+    add_cell_size(p)
     p.add_argument("--factor", type=int, default=2, help="refinement factor, a power of 2")
     p.add_argument("--min-scale", type=float, default=None,
                    help="no random detail in cells smaller than this, in ground units (metres on a "
                    "geographic grid such as EPSG:4326: the cell size in metres is the larger of its x and "
-                   "y spacings at the centre latitude)")
-    p.add_argument("--seed", type=int, default=None, help="seed in [0, 2**64); None draws one")
+                   "y spacings at the centre latitude; None: detail at every level)")
+    p.add_argument("--seed", type=int, default=None, help="seed in [0, 2**64) (None: one is drawn and printed)")
     p.add_argument("--hurst", default="local",
                    help="Hurst exponent: 'local' (estimated in each window) or a number in (0, 1)")
     p.add_argument("--sigma", default="local",
@@ -77,7 +76,7 @@ def _ground_cell(tr, crs, rows):
     and y spacings in metres at the centre latitude (WGS84,
     :func:`~fractalgeo_rs.dem.metres_per_degree`)."""
     if not is_geographic(crs):
-        return abs(tr.a), ""
+        return pixel_size(tr)[0], ""
     from fractalgeo_rs.dem import metres_per_degree
 
     lat = tr.f + tr.e * rows / 2.0
@@ -107,8 +106,8 @@ def _run_resample(args: argparse.Namespace) -> int:
     levels = R._levels(args.factor)
     f = 1 << levels
     z, profile = read_raster(args.input, band=args.band)
-    if profile is None or profile.get("transform") is None:
-        raise ValueError("input: expected a georeferenced raster (GeoTIFF)")
+    g = input_georef(args, profile, z.shape)
+    profile = dict(profile or {}, transform=g["transform"], crs=g["crs"], nodata=g["nodata"])
     tr = profile["transform"]
     cell, unit = _ground_cell(tr, profile.get("crs"), z.shape[0])
     z = R._as_float(z, profile.get("nodata"))
@@ -129,6 +128,8 @@ def _run_resample(args: argparse.Namespace) -> int:
             raise ModuleNotFoundError(f"{exc}", name="dask") from None
         da = None
     prof = dict(profile)
+    if prof.get("crs") is None:
+        prof.pop("crs")  # rasterio warns about nothing then
     prof.update(driver="GTiff", count=1, dtype="float32", nodata=float("nan"),
                 transform=R.fine_transform(tr, f, args.support), tiled=True,
                 blockxsize=256, blockysize=256, compress="deflate")
@@ -168,27 +169,25 @@ def _run_resample(args: argparse.Namespace) -> int:
 
 
 def _run_hillshade(args: argparse.Namespace) -> int:
+    import numpy as np
+
     from fractalgeo_rs.dem import hillshade
     from fractalgeo_rs.io import read_raster, write_raster
 
     z, prof = read_raster(args.dem, band=args.band)
-    cell: Any = 1.0
+    g = input_georef(args, prof, z.shape, name="dem")
+    t = g["transform"]
+    nodata = g["nodata"]
+    sx, sy = g["cell"]
+    cell: Any = (sy, sx)  # (row, column) spacing; sqrt(a^2 + d^2) etc. on rotated grids
     latitude = None
-    nodata = None
-    if prof:
-        t = prof.get("transform")
-        nodata = prof.get("nodata")
-        if t is not None:
-            cell = (abs(t.e), abs(t.a))
-            if is_geographic(prof.get("crs")):
-                latitude = t.f + t.e * (np.arange(z.shape[0]) + 0.5)
-    if args.cell_size is not None:
-        cell = args.cell_size
+    if is_geographic(g["crs"]) and args.cell_size is None:
+        latitude = t.f + t.e * (np.arange(z.shape[0]) + 0.5)
     s = hillshade(z, azimuth=args.azimuth, altitude=args.altitude, z_factor=args.z_factor, cell_size=cell,
                   nodata=nodata, multidirectional=args.multidirectional, latitude=latitude, byte=True,
                   n_threads=args.n_threads)
-    crs = (prof or {}).get("crs")
-    transform = (prof or {}).get("transform")
+    crs = g["crs"]
+    transform = t
     if str(args.output).lower().endswith((".tif", ".tiff")):
         write_raster(args.output, s, crs=crs, transform=transform, nodata=0)
     else:

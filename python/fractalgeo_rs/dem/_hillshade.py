@@ -187,7 +187,10 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
     if latitude is None:
         dx_rows = np.full(rows, dx)
     else:
-        lat = np.asarray(latitude, dtype=np.float64)
+        try:
+            lat = np.asarray(latitude, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise TypeError(f"latitude: expected degrees, a number or one per row, got {latitude!r}") from None
         if lat.ndim == 0:
             lat = np.full(rows, float(lat))
         if lat.shape != (rows,) or not np.all(np.abs(lat) < 90):

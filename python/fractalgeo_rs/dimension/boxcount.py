@@ -31,6 +31,7 @@ from fractalgeo_rs._compat import renamed_parameters
 from fractalgeo_rs._warn import user_stacklevel
 from fractalgeo_rs._validation import (
     as_array,
+    as_list,
     check_choice,
     check_memory,
     check_n_threads,
@@ -751,7 +752,10 @@ def self_affine_box_counting(
     ranges, ncols = _core.column_ranges(z2, sizes, n_threads)
     s = np.asarray(sizes, dtype=float)
     if scale_range is not None and not isinstance(scale_range, str):
-        lo, hi = scale_range
+        try:
+            lo, hi = (float(v) for v in as_list(scale_range, "scale_range", "two numbers (low, high)"))
+        except ValueError:
+            raise ValueError(f"scale_range: expected 'auto' or two numbers (low, high), got {scale_range!r}") from None
         sel = (s >= lo) & (s <= hi)
     else:
         sel = np.ones_like(s, dtype=bool)

@@ -23,7 +23,7 @@ from typing import Optional, Sequence
 import numpy as np
 
 from fractalgeo_rs._compat import keyword_only_since
-from fractalgeo_rs._validation import as_array, check_positive_int
+from fractalgeo_rs._validation import as_array, as_list, check_positive_int
 
 __all__ = ["Lacunarity", "lacunarity"]
 
@@ -125,7 +125,7 @@ def lacunarity(data, *, box_sizes: Optional[Sequence[int]] = None) -> Lacunarity
         raise ValueError("data: lacunarity needs non-negative masses (e.g. intensity, not dB)")
     if box_sizes is None:
         box_sizes = [2**k for k in range(20) if 2**k <= min(z.shape) / 4]
-    sizes = sorted(set(check_positive_int(v, "box_sizes") for v in box_sizes))
+    sizes = sorted(set(check_positive_int(v, "box_sizes") for v in as_list(box_sizes, "box_sizes", "ints")))
     if not sizes or sizes[-1] > min(z.shape):
         raise ValueError(f"box_sizes: sizes must be in [1, {min(z.shape)}], got {sizes}")
     holes = bool(nan.any())

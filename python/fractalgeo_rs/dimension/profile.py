@@ -19,7 +19,7 @@ import numpy as np
 
 from fractalgeo_rs import _core
 from fractalgeo_rs._compat import renamed_parameters
-from fractalgeo_rs._validation import check_n_threads, check_positive_int
+from fractalgeo_rs._validation import as_list, check_n_threads, check_positive_int
 from fractalgeo_rs.dimension._common import real_array, with_nodata
 from fractalgeo_rs.fit import DimensionFit, ScaleRange, fit_loglog
 
@@ -193,7 +193,10 @@ def scale_space(data, *, sigmas: Optional[Sequence[float]] = None, cell_size: fl
     dx = float(cell_size)
     if sigmas is None:
         sigmas = [2 ** (k / 2) for k in range(0, 40) if 2 ** (k / 2) <= min(z.size / 16, 256)]
-    sig = np.asarray(sorted(set(float(s) for s in sigmas)))
+    try:
+        sig = np.asarray(sorted(set(float(s) for s in as_list(sigmas, "sigmas"))))
+    except ValueError:
+        raise ValueError(f"sigmas: expected positive widths in samples, got {sigmas!r}") from None
     if sig.size < 3 or sig[0] <= 0 or not np.isfinite(sig).all():
         raise ValueError(f"sigmas: need at least 3 distinct positive widths, got {sig.tolist()}")
     lengths = np.array([np.sum(np.hypot(dx, np.diff(g))) for g in _gaussian_bank(z, sig)])
@@ -270,7 +273,7 @@ def wavelet_dimension(data, *, levels: Optional[Sequence[int]] = None, nodata: O
     if levels is None:
         sel = [int(j) for j in js if det[j - 1].size >= min_n]
     else:
-        sel = sorted(set(int(j) for j in levels))
+        sel = sorted(set(check_positive_int(j, "levels") for j in as_list(levels, "levels", "ints")))
         if not sel or sel[0] < 1 or sel[-1] > len(det):
             raise ValueError(f"levels: expected levels in [1, {len(det)}], got {list(levels)}")
     if len(sel) < 3:

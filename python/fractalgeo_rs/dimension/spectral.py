@@ -119,6 +119,9 @@ def spectral_dimension(
         raise ValueError("data: NaN or nodata present; the spectrum needs gap-free data (fill or crop first)")
     check_choice(taper, "taper", ("hann", "none"))
     n_bins = check_positive_int(n_bins, "n_bins")
+    if n_bins < 3 or n_bins > z.size:
+        raise ValueError(f"n_bins: expected 3 to {z.size} frequency bins (at most one per sample of the "
+                         f"{'x'.join(map(str, z.shape))} data), got {n_bins}")
     if min(z.shape) < 8:
         raise ValueError(f"data: shape {z.shape} is too small for a spectrum (at least 8 samples per axis)")
     from scipy import fft

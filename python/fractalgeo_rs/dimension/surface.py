@@ -16,7 +16,7 @@ from typing import Optional, Sequence, Union
 
 import numpy as np
 
-from fractalgeo_rs._validation import as_array, check_choice, check_n_threads, check_positive_int
+from fractalgeo_rs._validation import as_array, as_list, check_choice, check_n_threads, check_positive_int
 from fractalgeo_rs._zscale import resolve_z_scale
 from fractalgeo_rs.dimension.boxcount import binary_bytes
 from fractalgeo_rs.dimension._common import real_array, with_nodata
@@ -101,7 +101,10 @@ def minkowski(data, *, radii: Optional[Sequence[float]] = None, scale_range: Sca
                              f"{8 * MIN_DEFAULT_RADIUS} samples); give radii")
         r = _radii_default(extent)
     else:
-        r = np.asarray(sorted(set(float(v) for v in radii)))
+        try:
+            r = np.asarray(sorted(set(float(v) for v in as_list(radii, "radii"))))
+        except ValueError:
+            raise ValueError(f"radii: expected positive numbers, got {radii!r}") from None
         if r.size < 3 or r[0] <= 0 or not np.isfinite(r).all():
             raise ValueError(f"radii: need at least 3 distinct positive radii, got {list(radii)}")
         if r[0] < extent <= r[-1]:
@@ -224,7 +227,7 @@ def mass_dimension(
         limit = extent / 8 if kind != "grayscale" else min(33.0, extent / 8)
         sizes = [2**k + 1 for k in range(1, 30) if 2**k + 1 <= limit]
     else:
-        sizes = sorted(set(check_positive_int(v, "box_sizes") for v in box_sizes))
+        sizes = sorted(set(check_positive_int(v, "box_sizes") for v in as_list(box_sizes, "box_sizes", "ints")))
     if len(sizes) < 3:
         raise ValueError(f"box_sizes: need at least 3 distinct sizes, got {sizes} (data extent {extent:g})")
     if any(s % 2 == 0 for s in sizes) and kind in ("binary", "grayscale"):
@@ -335,7 +338,7 @@ def blanket(data, *, epsilons: Optional[Sequence[int]] = None, z_scale: Union[fl
                          f"{BLANKET_MIN_SIDE} valid samples, got shape {z.shape} with {n_ok} valid (a smaller "
                          f"surface is all edge: its blanket measures the border, not the surface)")
     zs = resolve_z_scale(z_scale, z)
-    eps = list(range(1, 17)) if epsilons is None else sorted(set(check_positive_int(e, "epsilons") for e in epsilons))
+    eps = list(range(1, 17)) if epsilons is None else sorted(set(check_positive_int(e, "epsilons") for e in as_list(epsilons, "epsilons", "ints")))
     if len(eps) < 3:
         raise ValueError(f"epsilons: need at least 3 distinct thicknesses, got {eps}")
     areas, n_valid = _core.blanket_areas_image(np.ascontiguousarray(z, dtype=np.float64), eps[-1], zs,

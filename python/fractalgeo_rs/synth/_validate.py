@@ -163,6 +163,8 @@ def spectral_slope(z, fmin=None, fmax=None, periodic=False):
         if sel.any():
             xs.append(np.log(fr[sel].mean()))
             ys.append(np.log(pr[sel].mean()))
+    if len(xs) < 2:  # a grid under 33 cells has no wavelengths between 8 cells and a quarter of it
+        return float("nan")
     return float(np.polyfit(xs, ys, 1)[0])
 
 
@@ -270,7 +272,9 @@ def validate_surface(data, hurst=None, *, lags=None, periodic=None, coastline=Tr
         lags = tuple(v for v in (8, 16, 32, 64) if v <= min(z.shape) // 4) or (1, 2, 4)
         if len(lags) < 2:
             lags = (2, 4, 8)
-    lags = tuple(int(v) for v in lags)
+    from fractalgeo_rs._validation import as_list, check_positive_int
+
+    lags = tuple(check_positive_int(v, "lags") for v in as_list(lags, "lags", "positive ints"))
     if len(lags) < 2 or min(lags) < 1 or max(lags) >= min(z.shape):
         raise ValueError(f"lags: expected at least 2 positive lags below the array size, got {lags}")
     logl = np.log(lags)

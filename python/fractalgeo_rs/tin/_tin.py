@@ -239,28 +239,41 @@ class TIN:
             instances=zeros.copy(),
         )
 
-    def write_obj(self, path) -> None:
-        """Write the mesh as Wavefront OBJ (see :meth:`to_mesh`)."""
-        from fractalgeo_rs.lsystem.export import write_obj
+    def write_obj(self, path, *, coordinates: str = "local", crs=None) -> None:
+        """Write the mesh as Wavefront OBJ, georeferenced.
 
-        write_obj(self.to_mesh(), path)
+        Vertices ``v x y z`` in float64 text, relative to the offset
+        recorded in the header comment ``# offset X Y Z`` (``coordinates=
+        "local"``: the lower-left corner) or in map coordinates
+        (``"map"``); faces ``f i j k`` (1-based). A sidecar ``name.json``
+        records the offset, the CRS (WKT) and the DEM's transform; with a
+        ``crs`` its WKT is also written to ``name.prj``. Map ``x, y, z`` =
+        file ``x, y, z`` + offset.
+        """
+        from fractalgeo_rs.tin._export import write_tin
 
-    def write_ply(self, path) -> None:
-        """Write the mesh as binary PLY (see :meth:`to_mesh`)."""
-        from fractalgeo_rs.lsystem.export import write_ply
+        write_tin(self, path, coordinates=coordinates, crs=crs)
 
-        write_ply(self.to_mesh(), path)
+    def write_ply(self, path, *, coordinates: str = "local", crs=None) -> None:
+        """Write the mesh as binary little-endian PLY, georeferenced:
+        vertices ``x y z`` as doubles, the offset in the header comment
+        ``comment offset X Y Z`` and the sidecars of :meth:`write_obj`."""
+        from fractalgeo_rs.tin._export import write_tin
 
-    def write_png(self, path, *, azimuth: float = 315.0, altitude: float = 45.0) -> None:
+        write_tin(self, path, coordinates=coordinates, crs=crs)
+
+    def write_png(self, path, *, azimuth: float = 315.0, altitude: float = 45.0, crs=None) -> None:
         """Write a shaded-relief PNG preview of the mesh: :meth:`to_grid`
-        shaded by :func:`fractalgeo_rs.hillshade` (0 = no triangle)."""
+        shaded by :func:`fractalgeo_rs.hillshade` (0 = no triangle), on the
+        DEM's grid: georeferenced by a world file (``.pgw``) and, with a
+        ``crs``, its WKT in ``.prj``."""
         from fractalgeo_rs.dem import hillshade
         from fractalgeo_rs.io import write_raster
 
-        a, b, _, d, e, _ = self.transform
-        cell = float(np.sqrt(abs(a * e - b * d)))
+        a, b, c, d, e, f = self.transform
+        cell = (float(np.hypot(b, e)), float(np.hypot(a, d)))  # (row, column) spacing, rotated grids too
         shade = hillshade(self.to_grid(), azimuth=azimuth, altitude=altitude, cell_size=cell, byte=True)
-        write_raster(path, shade)
+        write_raster(path, shade, transform=(a, b, c, d, e, f), crs=crs)
 
 
 def _default_max_error(z: np.ndarray) -> float:

@@ -65,6 +65,7 @@ def fractal_transform(
     return_fit: bool = False,
     dilations: int = 2,
     anisotropy: bool = False,
+    scale: Optional[str] = None,
 ):
     """Map of local fractal dimension over a moving window.
 
@@ -205,6 +206,21 @@ def fractal_transform(
         on numpy's BLAS threads, which this does not limit (set
         ``OPENBLAS_NUM_THREADS`` before starting Python, e.g. in Dask
         workers).
+    scale : {None, "db", "linear", "amplitude"}, default None
+        Radiometric scale of a SAR image. The maps depend on it: the
+        estimators see the heights of the image surface, and linear
+        intensity (a heavy right tail of speckle) gives other maps than dB
+        (on linear intensity most windows fall below D = 2 and the
+        urban/non-urban ordering can flip). The defaults and the worked
+        examples were validated on dB (Sentinel-1 sigma0 in dB).
+        ``"linear"`` (intensity, sigma0) is converted to
+        ``10 log10(image)``, ``"amplitude"`` to ``20 log10(image)``
+        (non-positive values become NaN); ``"db"`` and ``None`` use the
+        image as it is. With ``None`` an image that looks like linear
+        intensity (non-negative, heavy right tail: 99th percentile above 5
+        times the median and mean above 1.2 times the median) gets a
+        warning naming ``scale="linear"``. Not for DEMs or optical images
+        (leave ``None``).
     return_fit : bool, default False
         Also return the map of r² of the log-log fit (1 with two lags); for
         ``"whittle"`` and ``"gls"``, the map of the standard error of ``D``.
@@ -286,6 +302,12 @@ def fractal_transform(
 
     arr, image = _select_band(image, band)
     w = check_window(window_size, shape=arr.shape)
+    check_choice(scale, "scale", (None, "db", "linear", "amplitude"))
+    if scale in ("linear", "amplitude"):
+        arr, image = _to_db(arr, image, nodata, 10.0 if scale == "linear" else 20.0)
+        nodata = None  # now NaN
+    elif scale is None and array_kind(arr) == "numpy":
+        warn_if_linear(arr, nodata)
     z_used: Optional[float] = None  # the height unit of the box and mass methods
     if spec.uses_z_scale:
         z_used = resolve_z_scale(z_scale, arr, nodata)
@@ -325,6 +347,61 @@ def fractal_transform(
     if return_fit:
         return TransformFit(out, flag_map(out[0], method), params)
     return out if len(out) > 1 else out[0]
+
+
+def looks_linear(arr: np.ndarray, nodata=None) -> bool:
+    """True for an image that looks like linear SAR intensity: the finite
+    samples (nodata excluded) are non-negative with a heavy right tail (99th
+    percentile above 5 times the median, mean above 1.2 times the median;
+    single-look speckle has 6.6 and 1.44, dB images have negative values,
+    DEMs and optical images have neither tail)."""
+    a = np.asarray(arr)
+    if a.dtype.kind not in "iuf" or a.size == 0:
+        return False
+    if a.size > 1_000_000:  # a regular sample is enough for the quantiles
+        k = int(np.ceil(np.sqrt(a.size / 1_000_000)))
+        a = a[::k, ::k] if a.ndim == 2 else a.ravel()[:: k * k]
+    v = a[np.isfinite(a)] if a.dtype.kind == "f" else a.ravel()
+    if nodata is not None and not np.isnan(nodata):
+        v = v[v != nodata]
+    if v.size < 100 or v.min() < 0:
+        return False
+    med = float(np.median(v))
+    if not med > 0:
+        return False
+    return float(np.percentile(v, 99)) > 5.0 * med and float(v.mean()) > 1.2 * med
+
+
+def warn_if_linear(arr: np.ndarray, nodata=None) -> None:
+    """Warn when ``arr`` looks like linear intensity (:func:`looks_linear`)."""
+    if looks_linear(arr, nodata):
+        import warnings
+
+        from fractalgeo_rs._warn import user_stacklevel
+
+        warnings.warn("image: looks like linear SAR intensity or amplitude (non-negative with a heavy right tail); "
+                      "the maps were validated on dB: pass scale='linear' (CLI: --scale linear) to convert "
+                      "intensity to 10 log10, scale='amplitude' (--scale amplitude) for amplitudes, or scale='db' "
+                      "(--scale db) if the image is on a log scale already", UserWarning,
+                      stacklevel=user_stacklevel())
+
+
+def _to_db(arr, image, nodata, factor: float):
+    """``factor * log10`` of the image (numpy, Dask or xarray), NaN at
+    nodata and at non-positive values."""
+    def conv(a):
+        a = a.astype(np.float64)
+        bad = ~(a > 0)
+        if nodata is not None:
+            bad = bad | _nodata_mask(a, nodata)
+        return factor * np.log10(np.where(bad, np.nan, np.where(bad, 1.0, a)))
+
+    kind = array_kind(image)
+    if kind == "xarray":
+        image = image.copy(data=conv(image.data))
+        return image.data, image
+    out = conv(arr)
+    return out, out
 
 
 def _select_band(image, band):

@@ -2,8 +2,13 @@
 from __future__ import annotations
 
 import argparse
+import sys
 
-from fractalgeo_rs._cli_common import HelpFormatter, add_band, add_n_threads, add_progress, add_raster_io
+from fractalgeo_rs._cli_common import (HelpFormatter, LazyChoices, add_band, add_cell_size, add_n_threads, add_progress,
+                                        add_raster_io, input_georef)
+
+#: Where the flags are explained in what the wheel ships (it has no docs/ folder).
+FLAGS_HELP = "python -m pydoc fractalgeo_rs.transform.TransformFit"
 
 
 def add_parsers(sub) -> None:
@@ -17,25 +22,36 @@ def add_parsers(sub) -> None:
                     "progress bar is drawn when stderr is a terminal (--progress / --no-progress).",
     )
     add_raster_io(p, output_help="output map (.tif or .npy)", band=False)
-    p.add_argument("--window", type=int, default=33, help="odd window side in pixels (default 33)")
-    from fractalgeo_rs.transform._methods import METHODS
-
-    p.add_argument("--method", default="mass", choices=list(METHODS),
-                   help="estimator (default mass: Voss's P(m, L), the paper's method)")
+    p.add_argument("--window", type=int, default=33, help="odd window side in pixels")
+    p.add_argument("--method", default="mass", choices=LazyChoices(_method_names), metavar="METHOD",
+                   help="estimator, one of %(choices)s (default mass: Voss's P(m, L), the paper's method)")
     p.add_argument("--z-scale", type=_z_scale, default="auto",
                    help="mass, dbc, blanket: height units per pixel (e.g. 1 dB or 1 grey level); default auto: "
                         "1.4826 x median |lag-1 increment| of the whole image, printed; 'range': (max - min) / "
                         "max(rows, cols); 'cell': the file's cell size (cubic boxes for a DEM whose heights and "
-                        "cells share a unit); pass a fixed value to compare maps across scenes")
+                        "cells share a unit; in metres on a DEM in metres); pass a fixed value to compare maps across "
+                        "scenes")
+    p.add_argument("--scale", choices=("db", "linear", "amplitude"), default=None,
+                   help="radiometric scale of a SAR input: linear intensity is converted to 10 log10, amplitude "
+                        "to 20 log10 (the maps were validated on dB); db: used as it is (None: used as it is, "
+                        "with a warning when the input looks like linear intensity)")
     p.add_argument("--step", type=int, default=1,
                    help="compute every STEP-th row and column only (output cells STEP pixels wide, "
-                        "centred on the input pixels they sample; default 1)")
+                        "centred on the input pixels they sample)")
     add_band(p)
+    add_cell_size(p)
     p.add_argument("--chunks", type=int, default=None,
-                   help="process with Dask in chunks of this side, with a progress bar (needs the dask extra)")
+                   help="process with Dask in chunks of this side, with a progress bar (needs the dask extra; "
+                        "None: in memory)")
     add_n_threads(p)
     add_progress(p)
     p.set_defaults(func=_run)
+
+
+def _method_names():
+    from fractalgeo_rs.transform._methods import METHODS
+
+    return list(METHODS)
 
 
 def map_tags(params: dict, input_units=None, input_cell_size=None) -> dict:
@@ -71,16 +87,21 @@ def _run(args: argparse.Namespace) -> int:
     if args.chunks is not None and args.chunks < 1:
         raise ValueError(f"--chunks: expected a positive chunk side in pixels, got {args.chunks}")
     data, profile = read_raster(args.input, band=args.band)
-    nodata = (profile or {}).get("nodata")
-    geo = (profile or {}).get("transform")
-    cell = abs(geo.a) if geo is not None else None
+    to_tif = args.output.lower().endswith((".tif", ".tiff"))
+    g = input_georef(args, profile, data.shape, announce=to_tif and args.z_scale != "cell")
+    nodata = g["nodata"]
+    cell = g["cell"][0]  # the x pixel size, sqrt(a^2 + d^2) on rotated grids
     if args.z_scale == "cell":
-        if cell is None:
-            raise ValueError("--z-scale: 'cell' needs a georeferenced input (a cell size in its transform)")
+        if g["assumed"]:
+            raise ValueError("--z-scale: 'cell' needs the input's cell size: the input has no georeferencing, "
+                             "give --cell-size")
         args.z_scale = cell
+        print(f"fractalgeo transform: note: --z-scale cell: {cell:.6g} height units per box step (cubic boxes), "
+              f"right only when heights and cells share a unit; on a DEM whose relief is small against its "
+              f"cells the map is then near 2 (use 'auto' to compare textures)", file=sys.stderr)
     show = _progress.resolve(args.progress, cli=True)
     opts = dict(method=args.method, nodata=nodata, n_threads=args.n_threads, z_scale=args.z_scale,
-                step=args.step, return_fit=True)
+                step=args.step, return_fit=True, scale=args.scale)
     if args.chunks is not None:
         import dask.array as da  # the CLI turns a missing module into one line naming the extra
 
@@ -92,9 +113,11 @@ def _run(args: argparse.Namespace) -> int:
         fit = fractal_transform(data, args.window, progress=show, **opts)
         dmap, flags = fit[0], fit.flags
     dmap = np.asarray(dmap, dtype=np.float32)
-    tags = map_tags(fit.params, (profile or {}).get("units"), cell)
+    tags = map_tags(fit.params, "dB" if args.scale else (profile or {}).get("units"), cell)
+    if args.scale:
+        tags["INPUT_SCALE"] = args.scale
     if args.output.lower().endswith((".tif", ".tiff")):
-        transform = (profile or {}).get("transform")
+        transform = g["transform"]
         if transform is not None and args.step > 1:
             # output cell (k, l) is centred on input pixel (k step, l step)
             from rasterio import Affine
@@ -104,12 +127,13 @@ def _run(args: argparse.Namespace) -> int:
             # pixels wide with its corner shifted by (1 - step) / 2 pixels
             step_cell = Affine(args.step, 0.0, shift, 0.0, args.step, shift)
             transform = transform @ step_cell if hasattr(transform, "__matmul__") else transform * step_cell
-        write_raster(args.output, dmap, crs=(profile or {}).get("crs"), transform=transform, nodata=float("nan"),
+        write_raster(args.output, dmap, crs=g["crs"], transform=transform, nodata=float("nan"),
                      tags=tags)
     else:
         write_raster(args.output, dmap)
     finite = dmap[np.isfinite(dmap)]
-    print(f"{args.input}: {data.shape}, window {args.window}, method {args.method}")
+    scale = f", {args.scale} input converted to dB" if args.scale in ("linear", "amplitude") else ""
+    print(f"{args.input}: {data.shape}, window {args.window}, method {args.method}{scale}")
     if fit.params["z_scale"] is not None:
         print(f"z_scale: {fit.params['z_scale']:.6g} data units per box step")
     if finite.size:
@@ -119,6 +143,6 @@ def _run(args: argparse.Namespace) -> int:
         out = [f"{100 * np.mean(flags & bit > 0):.1f} % {name}" for name, bit in FLAGS.items()
                if name != "too_few_valid" and np.any(flags & bit)]
         if out:
-            print("outside the valid domain: " + ", ".join(out) + " (see docs/transform.md)")
+            print("outside the valid domain: " + ", ".join(out) + f" (flags: {FLAGS_HELP})")
     print(f"map: {args.output}")
     return 0

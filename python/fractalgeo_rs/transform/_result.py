@@ -101,7 +101,7 @@ def warn_out_of_range(dmap: np.ndarray, method: str) -> None:
     else:
         return
     warnings.warn(f"{method}: {what}, so those values are not dimensions of a surface; return_fit=True "
-                  f"gives their flag layer (docs/transform.md)", FractalRangeWarning, stacklevel=user_stacklevel())
+                  f"gives their flag layer (help(fractalgeo_rs.transform.TransformFit))", FractalRangeWarning, stacklevel=user_stacklevel())
 
 
 class TransformFit(tuple):

@@ -91,6 +91,10 @@ def segment(
     v = X[ok]
     sd = v.std(axis=0)
     v = (v - v.mean(axis=0)) / np.where(sd > 0, sd, 1.0)
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer))):
+        raise TypeError(f"seed: expected a non-negative int or None, got {seed!r}")
+    if seed is not None and seed < 0:
+        raise ValueError(f"seed: expected a non-negative int or None, got {seed}")
     rng = np.random.default_rng(seed)
     centres = [v[rng.integers(len(v))]]
     for _ in range(1, k):
