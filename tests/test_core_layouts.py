@@ -146,6 +146,10 @@ def _same(x, y, where):
         assert len(x) == len(y), where
         for k, (u, v) in enumerate(zip(x, y)):
             _same(u, v, f"{where}[{k}]")
+    elif isinstance(x, dict):
+        assert x.keys() == y.keys(), where
+        for k in x:
+            _same(x[k], y[k], f"{where}[{k!r}]")
     elif isinstance(x, np.ndarray):
         np.testing.assert_array_equal(x, y, err_msg=where)
     else:

@@ -38,11 +38,12 @@ def test_geogrid_affine_centres_and_transform_round_trip():
     g = GeoGrid((500000.0, 4000000.0), (30.0, 25.0), crs="EPSG:32633")
     assert g.affine == (30.0, 0.0, 500000.0, 0.0, -25.0, 4000000.0)
     assert g.center(2, 3) == (500000.0 + 3.5 * 30.0, 4000000.0 - 2.5 * 25.0)
-    assert GeoGrid.from_transform(g.affine, crs="EPSG:32633") == g
-    gdal = (500000.0, 30.0, 0.0, 4000000.0, 0.0, -25.0)
-    assert GeoGrid.from_transform(gdal) == GeoGrid((500000.0, 4000000.0), (30.0, 25.0))
+    assert g.gdal == (500000.0, 30.0, 0.0, 4000000.0, 0.0, -25.0)
+    assert GeoGrid.from_transform(g.gdal, crs="EPSG:32633") == g
+    affine = pytest.importorskip("affine")
+    assert GeoGrid.from_transform(affine.Affine(*g.affine)) == GeoGrid((500000.0, 4000000.0), (30.0, 25.0))
     r = GeoGrid((10.0, 20.0), (2.0, 3.0), rotation=30.0)
-    back = GeoGrid.from_transform(r.affine)
+    back = GeoGrid.from_transform(r.gdal)
     assert back.cell_size == pytest.approx((2.0, 3.0), abs=1e-12)
     assert back.rotation == pytest.approx(30.0, abs=1e-9)
     y, x = g.coords((3, 2))
@@ -64,9 +65,9 @@ def test_geogrid_bad_origin_rotation_and_transform():
     with pytest.raises(TypeError, match="^origin:"):
         GeoGrid(5.0, 1.0)
     with pytest.raises(ValueError, match="^transform:.*row 0 north"):
-        GeoGrid.from_transform((1.0, 0.0, 0.0, 0.0, 1.0, 0.0))  # south up
+        GeoGrid.from_transform((0.0, 1.0, 0.0, 0.0, 0.0, 1.0))  # GDAL order, south up
     with pytest.raises(ValueError, match="^transform:"):
-        GeoGrid.from_transform((1.0, 0.5, 0.0, 0.0, -1.0, 0.0))  # sheared
+        GeoGrid.from_transform((0.0, 1.0, 0.5, 0.0, 0.0, -1.0))  # sheared
 
 
 def test_geogrid_geographic_and_mismatched_crs():
@@ -89,7 +90,7 @@ def test_geogrid_of_reads_one_source():
     assert GeoGrid.of(z) is None
     assert GeoGrid.of(z, cell_size=2.0) == GeoGrid((0.0, 8.0), 2.0)
     with pytest.raises(ValueError, match="only one"):
-        GeoGrid.of(z, cell_size=2.0, transform=(1.0, 0.0, 0.0, 0.0, -1.0, 0.0))
+        GeoGrid.of(z, cell_size=2.0, transform=(0.0, 1.0, 0.0, 0.0, 0.0, -1.0))
     with pytest.raises(ValueError, match="^grid:.*EPSG:32612.*EPSG:32611"):
         GeoGrid.of(da, grid=GeoGrid((0.0, 0.0), 30.0, crs="EPSG:32612"))
     with pytest.raises(ValueError, match="^crs:"):
@@ -115,7 +116,7 @@ def test_tin_from_xarray_has_vertices_in_metres(crop):
     np.testing.assert_array_equal(t.vertices[:, 2], crop[row, col])
     assert t.crs == "EPSG:32611"
     # the same mesh as the numpy DEM with the equivalent transform
-    ref = tin_from_dem(crop, max_error=5.0, transform=(30.0, 0.0, 500000.0, 0.0, -30.0, 4000000.0))
+    ref = tin_from_dem(crop, max_error=5.0, transform=(500000.0, 30.0, 0.0, 4000000.0, 0.0, -30.0))
     np.testing.assert_array_equal(t.triangles, ref.triangles)
     np.testing.assert_allclose(t.vertices, ref.vertices, rtol=0, atol=1e-9)
     # and the same as an explicit GeoGrid on the numpy array
@@ -164,7 +165,7 @@ def _numpy_tin_mesh(t):
 
 
 def test_tin_mesh_in_rust_is_the_numpy_one_bit_for_bit(crop, tmp_path):
-    t = tin_from_dem(crop, max_error=3.0, transform=(30.0, 0.0, 386000.0, 0.0, -30.0, 3795000.0))
+    t = tin_from_dem(crop, max_error=3.0, transform=(386000.0, 30.0, 0.0, 3795000.0, 0.0, -30.0))
     m = t.to_mesh()
     verts, normals, uvs, lo = _numpy_tin_mesh(t)
     np.testing.assert_array_equal(m.vertices, verts)
@@ -212,7 +213,7 @@ def test_closed_mesh_is_watertight_and_agrees_with_trimesh():
     f = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
     m = Mesh.from_triangles(v, f)
     assert m.is_watertight()
-    trimesh = pytest.importorskip("trimesh")
+    pytest.importorskip("trimesh")
     tm = m.to_trimesh()
     assert tm.is_watertight and tm.is_winding_consistent
     assert tm.volume == pytest.approx(1 / 6, rel=1e-12)  # positive: normals out
@@ -272,7 +273,8 @@ def test_grid_mesh_nodata_and_dask():
 # ---------------------------------------------------------------- files and trimesh
 
 def _read_ply(path):
-    data = open(path, "rb").read()
+    with open(path, "rb") as fh:
+        data = fh.read()
     head, body = data.split(b"end_header\n", 1)
     lines = head.decode().splitlines()
     nv = int(next(ln for ln in lines if ln.startswith("element vertex")).split()[-1])
@@ -288,7 +290,9 @@ def _read_ply(path):
 
 def _read_obj(path):
     v, f = [], []
-    for ln in open(path):
+    with open(path) as fh:
+        lines = fh.readlines()
+    for ln in lines:
         if ln.startswith("v "):
             v.append([np.float32(s) for s in ln.split()[1:]])
         elif ln.startswith("f "):

@@ -132,7 +132,9 @@ class GeoGrid:
     >>> g = GeoGrid((500000.0, 4000000.0), 30.0, crs="EPSG:32633")
     >>> g.center(0, 0), g.affine
     ((500015.0, 3999985.0), (30.0, 0.0, 500000.0, 0.0, -30.0, 4000000.0))
-    >>> GeoGrid.from_transform(g.affine) == GeoGrid((500000.0, 4000000.0), (30.0, 30.0))
+    >>> g.gdal
+    (500000.0, 30.0, 0.0, 4000000.0, 0.0, -30.0)
+    >>> GeoGrid.from_transform(g.gdal, crs="EPSG:32633") == g
     True
     """
 
@@ -180,8 +182,9 @@ class GeoGrid:
     # ------------------------------------------------------------ builders
     @classmethod
     def from_transform(cls, transform, crs=None) -> "GeoGrid":
-        """The grid of an affine transform (rasterio ``Affine`` or a GDAL
-        6-tuple). Only row-0-north grids with square-angled cells are
+        """The grid of an affine transform: a rasterio ``Affine`` (or any
+        object with attributes ``a`` to ``f``) or a GDAL 6-tuple ``(c, a, b,
+        f, d, e)`` (see :attr:`gdal`), as ``tin_from_dem(transform=)``. Only row-0-north grids with square-angled cells are
         grids: a south-up or sheared transform is a ``ValueError`` naming
         ``transform``."""
         a, b, c, d, e, f = _six(transform)
@@ -290,6 +293,13 @@ class GeoGrid:
             return (self.dx, 0.0, self.x0, 0.0, -self.dy, self.y0)
         s, c = math.sin(math.radians(self.rotation)), math.cos(math.radians(self.rotation))
         return (self.dx * c, self.dy * s, self.x0, self.dx * s, -self.dy * c, self.y0)
+
+    @property
+    def gdal(self) -> Tuple[float, float, float, float, float, float]:
+        """The GDAL geotransform ``(c, a, b, f, d, e)`` (what
+        :meth:`from_transform` takes as a 6-tuple)."""
+        a, b, c, d, e, f = self.affine
+        return (c, a, b, f, d, e)
 
     @property
     def is_geographic(self) -> bool:

@@ -186,17 +186,18 @@ class Mesh:
             if f.name == "origin":
                 continue
             a = np.asarray(getattr(self, f.name))
-            if a.dtype != _DTYPES[f.name]:
-                if a.dtype.kind == "f" and _DTYPES[f.name] != np.float32:
+            want = np.dtype(_DTYPES[f.name])
+            if a.dtype != want:
+                if a.dtype.kind == "f" and want.kind != "f":
                     raise TypeError(f"{f.name}: expected integers, got dtype {a.dtype}")
-                if a.dtype.kind in "iu" and a.size and (a.min() < 0 or a.max() > np.iinfo(_DTYPES[f.name]).max):
-                    raise ValueError(f"{f.name}: values out of range of {np.dtype(_DTYPES[f.name]).name}")
-                a = a.astype(_DTYPES[f.name])
+                if a.dtype.kind in "iu" and a.size and (a.min() < 0 or a.max() > np.iinfo(want.name).max):
+                    raise ValueError(f"{f.name}: values out of range of {want.name}")
+                a = a.astype(want)
             conv[f.name] = a
         origin = np.asarray(self.origin, dtype=np.float64)
         if origin.shape != (3,):
             raise ValueError(f"origin: expected 3 numbers, got shape {origin.shape}")
-        return Mesh(**conv, origin=tuple(float(v) for v in origin))
+        return Mesh(**conv, origin=(float(origin[0]), float(origin[1]), float(origin[2])))
 
     def validate(self) -> "Mesh":
         """Check the mesh and return it: one normal and uv per vertex, one
