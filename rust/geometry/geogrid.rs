@@ -57,9 +57,7 @@ impl GeoGrid {
     /// Check every field; errors name `cell_size`, `origin` or `rotation`.
     pub fn checked(self) -> CoreResult<Self> {
         for (v, what) in [(self.dx, "dx"), (self.dy, "dy")] {
-            // NaN fails the comparison: `!(v > 0.0)` is deliberate
-            #[allow(clippy::neg_cmp_op_on_partial_ord)]
-            if !(v > 0.0) || !v.is_finite() {
+            if !v.is_finite() || v <= 0.0 {
                 return Err(CoreError::invalid(
                     "cell_size",
                     format!("{what} must be a finite number > 0, got {v}"),
@@ -113,7 +111,8 @@ impl GeoGrid {
         // columns along (a, d), rows along (b, e) = (dy sin r, -dy cos r):
         // perpendicular, and clockwise of the columns (row 0 north)
         let ortho = (a * b + d * e).abs() <= 1e-12 * dx * dy;
-        if !(det < 0.0) || !ortho {
+        // finite inputs: det is a number, so `det >= 0.0` is the negation of `det < 0.0`
+        if det >= 0.0 || !ortho {
             return Err(CoreError::invalid(
                 "transform",
                 format!(
