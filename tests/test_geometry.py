@@ -40,6 +40,7 @@ def test_geogrid_affine_centres_and_transform_round_trip():
     assert g.center(2, 3) == (500000.0 + 3.5 * 30.0, 4000000.0 - 2.5 * 25.0)
     assert g.gdal == (500000.0, 30.0, 0.0, 4000000.0, 0.0, -25.0)
     assert GeoGrid.from_transform(g.gdal, crs="EPSG:32633") == g
+    assert GeoGrid.from_affine(g.affine, crs="EPSG:32633") == g
     affine = pytest.importorskip("affine")
     assert GeoGrid.from_transform(affine.Affine(*g.affine)) == GeoGrid((500000.0, 4000000.0), (30.0, 25.0))
     r = GeoGrid((10.0, 20.0), (2.0, 3.0), rotation=30.0)
@@ -106,6 +107,23 @@ def test_geogrid_of_reads_one_source():
 
 
 # ---------------------------------------------------------------- TINs in map units
+
+def test_bundled_geographic_dem_is_refused_and_meshes_on_a_metric_grid():
+    dem, info = fg.data.srtm_alps()
+    g = GeoGrid.from_affine(info["transform"], crs=info["crs"])
+    assert g.is_geographic and g.cell_size == pytest.approx((1 / 1200, 1 / 1200))
+    with pytest.raises(ValueError, match="^grid:.*geographic"):
+        tin_from_dem(dem, max_error=5.0, grid=g)
+    dx, dy = (float(v) for v in info["cell_size"])  # metres east-west, north-south
+    local = GeoGrid((0.0, dem.shape[0] * dy), (dx, dy))
+    t = tin_from_dem(dem, max_error=5.0, grid=local)
+    col, row = t.grid[:, 0], t.grid[:, 1]
+    np.testing.assert_allclose(t.vertices[:, 0], (col + 0.5) * dx, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(t.vertices[:, 1], (dem.shape[0] - row - 0.5) * dy, rtol=0, atol=1e-9)
+    m = t.to_mesh()
+    assert m.edges()["boundary"] == _rim_vertices(m)
+    assert m.edges()["inconsistent"] == 0 and np.all(m.normals[:, 2] > 0)
+
 
 def test_tin_from_xarray_has_vertices_in_metres(crop):
     da, x, y = _xr_dem(crop, crs="EPSG:32611")

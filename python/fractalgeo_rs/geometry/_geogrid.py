@@ -199,6 +199,18 @@ class GeoGrid:
         return cls((c, f), (dx, dy), rotation, crs)
 
     @classmethod
+    def from_affine(cls, coefficients, crs=None) -> "GeoGrid":
+        """The grid of the six affine coefficients in rasterio's order
+        ``(a, b, c, d, e, f)`` (``x = a col + b row + c``, ``y = d col + e
+        row + f``), e.g. the ``transform`` of the bundled data's info dict
+        (:attr:`affine` is the inverse)."""
+        try:
+            a, b, c, d, e, f = (float(v) for v in coefficients)
+        except (TypeError, ValueError):
+            raise TypeError(f"transform: expected 6 numbers (a, b, c, d, e, f), got {coefficients!r}") from None
+        return cls.from_transform((c, a, b, f, d, e), crs)
+
+    @classmethod
     def from_cell_size(cls, rows: int, cell_size, crs=None) -> "GeoGrid":
         """The grid used when a raster has no georeference: square cells of
         ``cell_size``, north up, the lower-left corner of ``rows`` rows at
@@ -335,8 +347,8 @@ class GeoGrid:
         (degrees): a mesh or a slope needs the same unit in x, y and z."""
         if self.is_geographic:
             raise ValueError(f"{param}: the grid's CRS {self.crs!r} is geographic (degrees); reproject it "
-                             f"to a projected CRS in metres (e.g. UTM, rioxarray's .rio.reproject) or pass "
-                             f"cell_size= with the ground spacing in metres")
+                             f"to a projected CRS in metres (e.g. UTM, rioxarray's .rio.reproject), or give the ground "
+                             f"spacing in metres (cell_size=, or a GeoGrid without a geographic CRS)")
 
 
 def _rio(da):
