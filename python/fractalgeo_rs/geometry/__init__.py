@@ -1,7 +1,9 @@
-"""Geometry shared by every domain: the triangle :class:`Mesh` (plants,
-TINs, DEM grids; OBJ/PLY, trimesh, PyVista) and the raster georeference
-:class:`GeoGrid` (origin, cell size, rotation, CRS; row 0 north). Both
-mirror ``rust/geometry/``.
+"""Geometry shared by every domain: one triangle mesh and one raster georeference.
+
+:class:`~fractalgeo_rs.geometry.Mesh` holds plants, TINs and DEM grids
+(OBJ/PLY, trimesh, PyVista); :class:`~fractalgeo_rs.geometry.GeoGrid` the
+origin, cell size, rotation and CRS of a raster (row 0 north). Both mirror
+``rust/geometry/``. See the user guide page on geometry.
 
 Examples
 --------

@@ -150,7 +150,8 @@ class Mesh:
         dem : array_like or xarray.DataArray, shape (rows, cols)
             Heights (map units of the grid). Not modified.
         grid, transform, cell_size
-            The georeference (at most one; see :meth:`GeoGrid.of`); a
+            The georeference (at most one; see
+            :meth:`~fractalgeo_rs.geometry.GeoGrid.of`); a
             DataArray's own coordinates otherwise; pixel units (cell size
             1, origin at the lower-left corner) for a bare array.
         split : {"ne-sw", "nw-se", "alternating"}
