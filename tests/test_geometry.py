@@ -114,6 +114,8 @@ def test_bundled_geographic_dem_is_refused_and_meshes_on_a_metric_grid():
     assert g.is_geographic and g.cell_size == pytest.approx((1 / 1200, 1 / 1200))
     with pytest.raises(ValueError, match="^grid:.*geographic"):
         tin_from_dem(dem, max_error=5.0, grid=g)
+    with pytest.raises(ValueError, match="^grid:.*geographic"):
+        Mesh.from_grid(dem, grid=g)
     dx, dy = (float(v) for v in info["cell_size"])  # metres east-west, north-south
     local = GeoGrid((0.0, dem.shape[0] * dy), (dx, dy))
     t = tin_from_dem(dem, max_error=5.0, grid=local)

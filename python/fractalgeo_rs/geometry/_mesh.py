@@ -153,7 +153,8 @@ class Mesh:
             The georeference (at most one; see
             :meth:`~fractalgeo_rs.geometry.GeoGrid.of`); a
             DataArray's own coordinates otherwise; pixel units (cell size
-            1, origin at the lower-left corner) for a bare array.
+            1, origin at the lower-left corner) for a bare array. A
+            geographic grid (degrees) is refused: x, y and z need one unit.
         split : {"ne-sw", "nw-se", "alternating"}
         nodata : float, optional
             Height meaning "no data" (NaN always is).
@@ -167,6 +168,8 @@ class Mesh:
                 type(dem).__module__.startswith("dask"):
             raise TypeError("dem: a Dask array is not meshed lazily; call .compute() (or .load()) first")
         g = GeoGrid.of(dem, grid=grid, transform=transform, cell_size=cell_size, param="dem")
+        if g is not None:
+            g.require_projected("grid" if grid is not None else "dem")
         z = np.array(getattr(dem, "values", dem), dtype=np.float64, order="C", copy=True)
         if z.ndim != 2:
             raise ValueError(f"dem: expected a 2D array, got shape {z.shape}")
