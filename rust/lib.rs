@@ -9,7 +9,8 @@
 //! | module | what |
 //! |---|---|
 //! | [`dimension`] | fractal dimension estimators (box counting, DBC, self-affine boxes) |
-//! | [`io`] | raster readers and writers that the bindings expose |
+//! | [`geometry`] | the shared triangle `Mesh` and raster georeference `GeoGrid` (below every domain) |
+//! | [`io`] | raster readers and writers that the bindings expose, mesh files |
 //! | [`synth`] | fBm and surface synthesis |
 //! | [`dem`] | DEM work: shaded relief, lakes, resampling |
 //! | [`lsystem`] | L-systems, turtle geometry and IFS |
@@ -33,6 +34,7 @@ pub mod checks;
 pub mod dem;
 pub mod dimension;
 pub mod error;
+pub mod geometry;
 pub mod io;
 pub mod lsystem;
 pub mod parallel;

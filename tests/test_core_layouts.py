@@ -50,9 +50,13 @@ def _mesh(a):
     n = a.shape[0]
     with tempfile.TemporaryDirectory() as d:
         p = os.path.join(d, "m.ply")
-        _core.write_mesh(p, "ply", a, a, a[:, :2], np.array([[0, 1, 2]], np.uint32),
-                         np.zeros(1, np.uint32), np.zeros(1, np.uint8), np.zeros(1, np.uint32),
-                         np.zeros(1, np.uint32))
+        from types import SimpleNamespace
+
+        mesh = SimpleNamespace(origin=(0.0, 0.0, 0.0), vertices=a, normals=a, uvs=a[:, :2],
+                               faces=np.array([[0, 1, 2]], np.uint32), part_ids=np.zeros(1, np.uint32),
+                               kinds=np.zeros(1, np.uint8), colors=np.zeros(1, np.uint32),
+                               instances=np.zeros(1, np.uint32))
+        _core.write_mesh(p, "ply", mesh)
         del n
         return pathlib.Path(p).read_bytes()
 
@@ -94,6 +98,10 @@ CASES = {
     "shade_to_byte": (np.abs(np.sin(IMG)).astype(np.float32), lambda a: _core.shade_to_byte(a)),
     "write_exr": (IMG.astype(np.float32), lambda a: _file_bytes(_core.write_exr, a, ".exr")),
     "write_mesh": (rng.random((3, 3)).astype(np.float32), _mesh),
+    "mesh_from_grid": (IMG, lambda a: _core.mesh_from_grid(a, __import__("types").SimpleNamespace(
+        origin=(0.0, 37.0), cell_size=(1.0, 1.0), rotation=0.0, crs=None), "alternating")),
+    "mesh_from_tin": (np.array([[0.0, 0.0, 1.0], [7.0, 0.5, 2.0], [0.5, 6.0, 3.0], [7.0, 6.0, 4.0]]),
+                      lambda a: _core.mesh_from_tin(a, np.array([[0, 1, 2], [1, 3, 2]], np.int64))),
     "ifs_check": (np.array([[0.5, 0, 0, 0.5, 0, 0], [0.5, 0, 0, 0.5, 0.5, 0], [0.5, 0, 0, 0.5, 0.25, 0.5]]),
                   lambda a: _core.ifs_check(a)),
     "ifs_chaos_game": (np.array([[0.5, 0, 0, 0.5, 0, 0], [0.5, 0, 0, 0.5, 0.5, 0], [0.5, 0, 0, 0.5, 0.25, 0.5]]),
@@ -138,6 +146,10 @@ def _same(x, y, where):
         assert len(x) == len(y), where
         for k, (u, v) in enumerate(zip(x, y)):
             _same(u, v, f"{where}[{k}]")
+    elif isinstance(x, dict):
+        assert x.keys() == y.keys(), where
+        for k in x:
+            _same(x[k], y[k], f"{where}[{k!r}]")
     elif isinstance(x, np.ndarray):
         np.testing.assert_array_equal(x, y, err_msg=where)
     else:

@@ -28,7 +28,8 @@ import numpy as np
 
 __all__ = ["run_raster", "halo_blocks", "array_kind", "require"]
 
-_EXTRAS = {"dask": "dask", "xarray": "dask", "rasterio": "geo", "matplotlib": "plot", "tqdm": "progress"}
+_EXTRAS = {"dask": "dask", "xarray": "dask", "rasterio": "geo", "matplotlib": "plot", "tqdm": "progress",
+           "trimesh": "mesh", "pyvista": "pyvista"}
 
 
 def require(module: str):
@@ -190,6 +191,24 @@ def _run_dask(kernel, arr, *, depth: int, step: int, n_out: int, dtype, boundary
 _RUNNERS: Dict[str, Callable] = {"numpy": _run_numpy, "dask": _run_dask}
 
 
+def _georeferenced(image, xr_obj, grid):
+    """The DataArray whose coords and attrs the outputs take: the input's
+    (its CRS checked against the grid's) or one built from the grid."""
+    crs = getattr(grid, "crs", None)
+    if xr_obj is not None:
+        own = xr_obj.attrs.get("crs")
+        if own is not None and crs is not None and str(own) != crs:
+            raise ValueError(f"grid: CRS {crs!r} does not match the image's CRS {str(own)!r}")
+        if crs is not None and own is None:
+            xr_obj = xr_obj.copy(deep=False)
+            xr_obj.attrs = {**xr_obj.attrs, "crs": crs}
+        return xr_obj
+    xr = require("xarray")
+    y, x = grid.coords(image.shape)
+    attrs = {"crs": crs} if crs is not None else {}
+    return xr.DataArray(image, dims=("y", "x"), coords={"y": y, "x": x}, attrs=attrs)
+
+
 def run_raster(
     kernel: Callable[[np.ndarray], np.ndarray],
     image,
@@ -206,6 +225,7 @@ def run_raster(
     locate: bool = False,
     progress: bool = False,
     desc: str = "",
+    grid=None,
 ):
     """Run ``kernel`` on ``image`` of any array type; returns ``k`` outputs.
 
@@ -246,6 +266,14 @@ def run_raster(
         is lazy: wrap its ``compute`` in ``_progress.dask_bar``.
     desc : str
         The bar's label.
+    grid : fractalgeo_rs.geometry.GeoGrid, optional
+        The input's georeference, read once by the caller
+        (``GeoGrid.of``). A DataArray input keeps its coords and gets a
+        ``crs`` attribute from the grid when it has none (a different CRS
+        is a ``ValueError`` naming ``grid``); a numpy or Dask input gives
+        ``xarray.DataArray`` outputs with the grid's cell-centre ``y, x``
+        coordinates (every ``step``-th) and ``crs``. Without ``grid`` the
+        outputs are as before.
 
     Returns
     -------
@@ -265,6 +293,8 @@ def run_raster(
                               boundary=boundary, locate=locate, progress=progress, desc=desc)
     if stack_dim is not None:
         stacked = _stacked(stacked)
+    if grid is not None:
+        xr_obj = _georeferenced(image, xr_obj, grid)
     if xr_obj is None:
         return stacked if stack_dim is not None else [stacked[k] for k in range(n_out)]
     dims = xr_obj.dims

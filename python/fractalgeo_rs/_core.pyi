@@ -2,7 +2,7 @@
 # Each domain keeps its own section; the public, documented API is in the
 # Python modules that wrap these functions.
 from os import PathLike
-from typing import List, Optional, Sequence, Tuple, final
+from typing import Any, Dict, List, Optional, Protocol, Sequence, Tuple, final
 
 import numpy as np
 import numpy.typing as npt
@@ -40,6 +40,10 @@ __all__ = [
     "lsystem_parse_text",
     "mass_curve_image",
     "mass_transform_map",
+    "mesh_edges",
+    "mesh_from_grid",
+    "mesh_from_tin",
+    "mesh_validate",
     "midpoint_refine_1d",
     "midpoint_refine_2d",
     "moran_dimension",
@@ -64,6 +68,44 @@ __all__ = [
     "tin_grid",
     "tin_rasterize",
 ]
+
+# ---- geometry ----
+class _MeshLike(Protocol):  # read by attribute (geometry.Mesh), exact dtypes, any strides
+    @property
+    def origin(self) -> Tuple[float, float, float]: ...
+    @property
+    def vertices(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def normals(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def uvs(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def faces(self) -> npt.NDArray[np.uint32]: ...
+    @property
+    def part_ids(self) -> npt.NDArray[np.uint32]: ...
+    @property
+    def kinds(self) -> npt.NDArray[np.uint8]: ...
+    @property
+    def colors(self) -> npt.NDArray[np.uint32]: ...
+    @property
+    def instances(self) -> npt.NDArray[np.uint32]: ...
+
+class _GeoGridLike(Protocol):  # read by attribute (geometry.GeoGrid)
+    @property
+    def origin(self) -> Tuple[float, float]: ...
+    @property
+    def cell_size(self) -> Tuple[float, float]: ...
+    @property
+    def rotation(self) -> float: ...
+    @property
+    def crs(self) -> Optional[str]: ...
+
+def mesh_from_grid(
+    dem: npt.NDArray[np.float64], grid: _GeoGridLike, split: str, n_threads: Optional[int] = None
+) -> Dict[str, Any]: ...
+def mesh_from_tin(vertices: npt.NDArray[np.float64], triangles: npt.NDArray[np.int64]) -> Dict[str, Any]: ...
+def mesh_validate(mesh: _MeshLike) -> None: ...
+def mesh_edges(mesh: _MeshLike) -> Tuple[int, int, int]: ...
 
 # ---- dimension ----
 def box_count_binary(
@@ -204,16 +246,30 @@ def read_exr(path: str | PathLike[str]) -> npt.NDArray[np.float32]: ...
 def write_exr(path: str | PathLike[str], image: npt.NDArray[np.float32]) -> None: ...
 
 # ---- lsystem ----
-_TurtleArgs = Tuple[
-    float, float, float, float,
-    Tuple[float, float, float], float,
-    Tuple[float, float, float], Tuple[float, float, float],
-    str, str,
-]  # angle, step, width, width_factor, tropism, elasticity, heading, left, draw, move
-_MeshArrays = Tuple[
-    npt.NDArray[np.float32], npt.NDArray[np.float32], npt.NDArray[np.float32], npt.NDArray[np.uint32],
-    npt.NDArray[np.uint32], npt.NDArray[np.uint8], npt.NDArray[np.uint32], npt.NDArray[np.uint32],
-]  # vertices, normals, uvs, faces, part_ids, kinds, colors, instances
+class _TurtleArgs(Protocol):  # read by attribute (lsystem.geometry.TurtleArgs)
+    @property
+    def angle(self) -> float: ...
+    @property
+    def step(self) -> float: ...
+    @property
+    def width(self) -> float: ...
+    @property
+    def width_factor(self) -> float: ...
+    @property
+    def tropism(self) -> Tuple[float, float, float]: ...
+    @property
+    def elasticity(self) -> float: ...
+    @property
+    def heading(self) -> Tuple[float, float, float]: ...
+    @property
+    def left(self) -> Tuple[float, float, float]: ...
+    @property
+    def draw(self) -> str: ...
+    @property
+    def moves(self) -> str: ...
+
+# a mesh from Rust: {"origin", "vertices", "normals", "uvs", "faces", "part_ids", "kinds", "colors", "instances"}
+_MeshDict = Dict[str, Any]
 
 @final
 class ModuleString:
@@ -247,19 +303,8 @@ def turtle_segments(
     npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.uint32],
     npt.NDArray[np.float64], npt.NDArray[np.uint64],
 ]: ...
-def turtle_mesh(lstring: ModuleString, turtle: _TurtleArgs, sides: int, n_threads: Optional[int] = None) -> _MeshArrays: ...
-def write_mesh(
-    path: str | PathLike[str],
-    format: str,
-    vertices: npt.NDArray[np.float32],
-    normals: npt.NDArray[np.float32],
-    uvs: npt.NDArray[np.float32],
-    faces: npt.NDArray[np.uint32],
-    part_ids: npt.NDArray[np.uint32],
-    kinds: npt.NDArray[np.uint8],
-    colors: npt.NDArray[np.uint32],
-    instances: npt.NDArray[np.uint32],
-) -> None: ...
+def turtle_mesh(lstring: ModuleString, turtle: _TurtleArgs, sides: int, n_threads: Optional[int] = None) -> _MeshDict: ...
+def write_mesh(path: str | PathLike[str], format: str, mesh: _MeshLike) -> None: ...
 def plants_on_terrain(
     lsystem: LSystemCore,
     n: int,
@@ -272,7 +317,7 @@ def plants_on_terrain(
     turtle: _TurtleArgs,
     sides: int,
     n_threads: Optional[int] = None,
-) -> Tuple[_MeshArrays, npt.NDArray[np.float64]]: ...
+) -> Tuple[_MeshDict, npt.NDArray[np.float64]]: ...
 def ifs_check(
     maps: npt.NDArray[np.float64], probabilities: Optional[Sequence[float]] = None
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], Optional[float]]: ...

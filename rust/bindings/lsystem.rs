@@ -3,48 +3,50 @@
 //! Every kernel runs through `run_in_pool`, so even a bug (a panic) comes
 //! back as RuntimeError, never as a PanicException.
 use super::convert::{array2, rows_in, run, run_on_grid};
+use super::geometry::{MeshIn, MeshOut};
 use crate::lsystem::derive::LSystem;
 use crate::lsystem::grammar::{parse_module_string, parse_rule_text, ModString};
-use crate::lsystem::mesh::{build_mesh, Mesh};
+use crate::lsystem::mesh::build_mesh;
 use crate::lsystem::terrain::{plants_on_terrain as scene_kernel, SceneParams};
 use crate::lsystem::turtle::{polylines, segments, TurtleParams};
 use crate::lsystem::{export, ifs};
 use crate::parallel::run_in_pool;
 use glam::DVec3;
 use numpy::ndarray::{Array1, Array2};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-/// Turtle options as passed from Python:
-/// (angle, step, width, width_factor, tropism, elasticity, heading, left, draw, moves).
-type TurtleArgs = (
-    f64,
-    f64,
-    f64,
-    f64,
-    [f64; 3],
-    f64,
-    [f64; 3],
-    [f64; 3],
-    String,
-    String,
-);
+/// Turtle options as passed from Python: any object with these attributes
+/// (`fractalgeo_rs.lsystem.geometry.TurtleArgs`, a named tuple).
+#[derive(FromPyObject)]
+struct TurtleArgs {
+    angle: f64,
+    step: f64,
+    width: f64,
+    width_factor: f64,
+    tropism: [f64; 3],
+    elasticity: f64,
+    heading: [f64; 3],
+    left: [f64; 3],
+    draw: String,
+    moves: String,
+}
 
 fn turtle_params(t: TurtleArgs) -> TurtleParams {
     TurtleParams {
-        angle: t.0,
-        step: t.1,
-        width: t.2,
-        width_factor: t.3,
-        tropism: DVec3::from_array(t.4),
-        elasticity: t.5,
-        heading: DVec3::from_array(t.6),
-        left: DVec3::from_array(t.7),
-        draw: t.8.chars().collect(),
-        moves: t.9.chars().collect(),
+        angle: t.angle,
+        step: t.step,
+        width: t.width,
+        width_factor: t.width_factor,
+        tropism: DVec3::from_array(t.tropism),
+        elasticity: t.elasticity,
+        heading: DVec3::from_array(t.heading),
+        left: DVec3::from_array(t.left),
+        draw: t.draw.chars().collect(),
+        moves: t.moves.chars().collect(),
     }
 }
 
@@ -249,31 +251,7 @@ fn turtle_segments<'py>(
     ))
 }
 
-type MeshArrays<'py> = (
-    Bound<'py, PyArray2<f32>>,
-    Bound<'py, PyArray2<f32>>,
-    Bound<'py, PyArray2<f32>>,
-    Bound<'py, PyArray2<u32>>,
-    Bound<'py, PyArray1<u32>>,
-    Bound<'py, PyArray1<u8>>,
-    Bound<'py, PyArray1<u32>>,
-    Bound<'py, PyArray1<u32>>,
-);
-
-fn mesh_arrays(py: Python<'_>, m: Mesh) -> MeshArrays<'_> {
-    (
-        rows(m.vertices).into_pyarray(py),
-        rows(m.normals).into_pyarray(py),
-        rows(m.uvs).into_pyarray(py),
-        rows(m.faces).into_pyarray(py),
-        m.part_ids.into_pyarray(py),
-        m.kinds.into_pyarray(py),
-        m.colors.into_pyarray(py),
-        m.instances.into_pyarray(py),
-    )
-}
-
-/// Mesh of a module string: (vertices, normals, uvs, faces, part_ids, kinds, colors, instances).
+/// Mesh of a module string (a dict of the mesh's fields, see `MeshOut`).
 #[pyfunction]
 #[pyo3(signature = (lstring, turtle, sides, n_threads=None))]
 fn turtle_mesh<'py>(
@@ -282,56 +260,18 @@ fn turtle_mesh<'py>(
     turtle: TurtleArgs,
     sides: usize,
     n_threads: Option<usize>,
-) -> PyResult<MeshArrays<'py>> {
+) -> PyResult<MeshOut> {
     let s = lstring.inner.clone();
     let p = turtle_params(turtle);
     let m = run(py, n_threads, || build_mesh(&s, &p, sides))?;
-    Ok(mesh_arrays(py, m))
-}
-
-#[allow(clippy::too_many_arguments)]
-fn mesh_from_arrays(
-    vertices: PyReadonlyArray2<'_, f32>,
-    normals: PyReadonlyArray2<'_, f32>,
-    uvs: PyReadonlyArray2<'_, f32>,
-    faces: PyReadonlyArray2<'_, u32>,
-    part_ids: PyReadonlyArray1<'_, u32>,
-    kinds: PyReadonlyArray1<'_, u8>,
-    colors: PyReadonlyArray1<'_, u32>,
-    instances: PyReadonlyArray1<'_, u32>,
-) -> PyResult<Mesh> {
-    Ok(Mesh {
-        vertices: rows_in(&vertices, "vertices")?,
-        normals: rows_in(&normals, "normals")?,
-        uvs: rows_in(&uvs, "uvs")?,
-        faces: rows_in(&faces, "faces")?,
-        part_ids: part_ids.as_array().to_vec(),
-        kinds: kinds.as_array().to_vec(),
-        colors: colors.as_array().to_vec(),
-        instances: instances.as_array().to_vec(),
-    })
+    Ok(MeshOut(m))
 }
 
 /// Write a mesh as OBJ (`format="obj"`) or binary PLY (`format="ply"`), atomically.
 #[pyfunction]
-#[pyo3(signature = (path, format, vertices, normals, uvs, faces, part_ids, kinds, colors, instances))]
-#[allow(clippy::too_many_arguments)]
-fn write_mesh(
-    py: Python<'_>,
-    path: PathBuf,
-    format: &str,
-    vertices: PyReadonlyArray2<'_, f32>,
-    normals: PyReadonlyArray2<'_, f32>,
-    uvs: PyReadonlyArray2<'_, f32>,
-    faces: PyReadonlyArray2<'_, u32>,
-    part_ids: PyReadonlyArray1<'_, u32>,
-    kinds: PyReadonlyArray1<'_, u8>,
-    colors: PyReadonlyArray1<'_, u32>,
-    instances: PyReadonlyArray1<'_, u32>,
-) -> PyResult<()> {
-    let m = mesh_from_arrays(
-        vertices, normals, uvs, faces, part_ids, kinds, colors, instances,
-    )?;
+#[pyo3(signature = (path, format, mesh))]
+fn write_mesh(py: Python<'_>, path: PathBuf, format: &str, mesh: MeshIn<'_>) -> PyResult<()> {
+    let m = mesh.into_mesh()?;
     match format {
         "obj" => run(py, Some(1), || export::write_obj(&m, &path))?,
         "ply" => run(py, Some(1), || export::write_ply(&m, &path))?,
@@ -361,7 +301,7 @@ fn plants_on_terrain<'py>(
     turtle: TurtleArgs,
     sides: usize,
     n_threads: Option<usize>,
-) -> PyResult<(MeshArrays<'py>, Bound<'py, PyArray2<f64>>)> {
+) -> PyResult<(MeshOut, Bound<'py, PyArray2<f64>>)> {
     let l = lsystem.inner.clone();
     let p = SceneParams {
         n,
@@ -375,7 +315,7 @@ fn plants_on_terrain<'py>(
     };
     let ((m, bases), _) =
         run_on_grid(py, &dem, n_threads, |z, r, c| scene_kernel(&l, z, r, c, &p))?;
-    Ok((mesh_arrays(py, m), rows(bases).into_pyarray(py)))
+    Ok((MeshOut(m), rows(bases).into_pyarray(py)))
 }
 
 fn ifs_from(

@@ -11,6 +11,7 @@ use pyo3::prelude::*;
 pub mod convert;
 mod dem;
 mod dimension;
+pub mod geometry;
 mod io;
 mod lsystem;
 mod progress;
@@ -35,6 +36,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     dem::register(m)?;
     dimension::register(m)?;
+    geometry::register(m)?;
     io::register(m)?;
     synth::register(m)?;
     lsystem::register(m)?;

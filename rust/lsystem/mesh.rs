@@ -14,6 +14,7 @@
 use super::grammar::ModString;
 use super::turtle::{interpret, Sink, State, TurtleParams, NO_TAG};
 use crate::error::{CoreError, CoreResult};
+pub use crate::geometry::Mesh;
 use glam::{DQuat, DVec3};
 use rayon::prelude::*;
 
@@ -24,63 +25,6 @@ pub const MAX_TRIANGLES: usize = 1 << 28;
 pub const KIND_BRANCH: u8 = 0;
 /// Leaf polygons.
 pub const KIND_LEAF: u8 = 1;
-
-/// An indexed triangle mesh with per-triangle attributes.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Mesh {
-    pub vertices: Vec<[f32; 3]>,
-    pub normals: Vec<[f32; 3]>,
-    pub uvs: Vec<[f32; 2]>,
-    pub faces: Vec<[u32; 3]>,
-    /// Turtle element of each triangle: segment number for branches, polygon
-    /// number for leaves.
-    pub part_ids: Vec<u32>,
-    /// [`KIND_BRANCH`] or [`KIND_LEAF`].
-    pub kinds: Vec<u8>,
-    /// Colour index (`'`) of each triangle.
-    pub colors: Vec<u32>,
-    /// Instance number of each triangle (0 for one plant; see [`super::terrain`]).
-    pub instances: Vec<u32>,
-}
-
-impl Mesh {
-    /// Append `other` moved by `f` (applied to points) and `g` (to normals).
-    pub fn append_transformed(
-        &mut self,
-        other: &Mesh,
-        instance: u32,
-        f: impl Fn(DVec3) -> DVec3,
-        g: impl Fn(DVec3) -> DVec3,
-    ) -> CoreResult<()> {
-        let base = self.vertices.len();
-        if base + other.vertices.len() > u32::MAX as usize {
-            return Err(CoreError::invalid(
-                "n_plants",
-                "the scene has more than 2^32 vertices",
-            ));
-        }
-        let b = base as u32;
-        self.vertices.extend(other.vertices.iter().map(|v| {
-            f(DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64))
-                .as_vec3()
-                .to_array()
-        }));
-        self.normals.extend(other.normals.iter().map(|v| {
-            g(DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64))
-                .as_vec3()
-                .to_array()
-        }));
-        self.uvs.extend_from_slice(&other.uvs);
-        self.faces
-            .extend(other.faces.iter().map(|t| [t[0] + b, t[1] + b, t[2] + b]));
-        self.part_ids.extend_from_slice(&other.part_ids);
-        self.kinds.extend_from_slice(&other.kinds);
-        self.colors.extend_from_slice(&other.colors);
-        self.instances
-            .extend(std::iter::repeat_n(instance, other.faces.len()));
-        Ok(())
-    }
-}
 
 /// A ring of a tube, before its vertices are made.
 struct Ring {
@@ -365,6 +309,42 @@ mod tests {
         let vs: Vec<f32> = m.uvs.iter().map(|t| t[1]).collect();
         assert_eq!(vs[0], 0.0);
         assert_eq!(vs[13], 2.0);
+    }
+
+    #[test]
+    fn a_tube_welded_at_its_seam_is_open_only_at_its_ends() {
+        use crate::geometry::EdgeReport;
+        let s = parse_module_string("F+F", "axiom").unwrap();
+        let sides = 7;
+        let m = build_mesh(&s, &TurtleParams::spatial(30.0, 1.0), sides).unwrap();
+        assert_eq!(m.vertices.len(), 3 * (sides + 1));
+        // the seam vertex (j = sides) repeats j = 0 up to rounding only:
+        // cos(2 pi) and sin(2 pi) are not exactly 1 and 0
+        let close = |a: [f32; 3], b: [f32; 3]| (0..3).all(|k| (a[k] - b[k]).abs() < 1e-6);
+        let weld: Vec<u32> = (0..m.vertices.len())
+            .map(|i| {
+                (0..=i)
+                    .find(|&k| close(m.vertices[k], m.vertices[i]))
+                    .unwrap() as u32
+            })
+            .collect();
+        for r in 0..3 {
+            assert_eq!(weld[r * (sides + 1) + sides] as usize, r * (sides + 1));
+        }
+        let mut w = m.clone();
+        for f in &mut w.faces {
+            *f = f.map(|i| weld[i as usize]);
+        }
+        // open at the two end rings only, consistently oriented
+        assert_eq!(
+            w.edges(),
+            EdgeReport {
+                boundary: 2 * sides,
+                non_manifold: 0,
+                inconsistent: 0
+            }
+        );
+        m.validate().unwrap();
     }
 
     #[test]

@@ -7,7 +7,7 @@
 //! | [`derive`] | parallel (stochastic, context-sensitive, parametric) rewriting |
 //! | [`turtle`] | 2D and 3D turtle interpretation |
 //! | [`mesh`] | generalised cylinders and leaf polygons |
-//! | [`export`] | OBJ and PLY files |
+//! | [`export`] | OBJ and PLY files (moved to [`crate::io::mesh`]; re-exported) |
 //! | [`ifs`] | iterated function systems, presets, Moran's equation |
 //! | [`terrain`] | stochastic plants placed on a DEM, one scene mesh |
 //!
@@ -19,7 +19,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod derive;
-pub mod export;
+pub use crate::io::mesh as export;
 pub mod expr;
 pub mod grammar;
 pub mod ifs;

@@ -23,6 +23,7 @@
 //! parallel, each with its seams simplified in 1D like shared edges, and the
 //! tiles' meshes are merged (see [`greedy_tin`]).
 use crate::error::{CoreError, CoreResult};
+use crate::geometry::{GeoGrid, Mesh};
 use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
 use spade::{DelaunayTriangulation, HasPosition, Point2, Triangulation};
 
@@ -37,6 +38,38 @@ pub struct GreedyTin {
     pub triangles: Vec<[i64; 3]>,
     /// Largest `|z - mesh|` over the valid samples covered by the result.
     pub max_error: f64,
+}
+
+impl GreedyTin {
+    /// Map coordinates `(x, y, z)` of the vertices: the centre of each
+    /// vertex's sample on `grid`.
+    pub fn map_vertices(&self, grid: &GeoGrid) -> Vec<[f64; 3]> {
+        self.grid
+            .iter()
+            .zip(&self.z)
+            .map(|(g, &z)| {
+                let [x, y] = grid.center(g[1] as f64, g[0] as f64);
+                [x, y, z]
+            })
+            .collect()
+    }
+
+    /// Triangles counter-clockwise seen from +z in map axes: the grid's
+    /// `(col, row)` axes are mirrored on a row-0-north [`GeoGrid`], so every
+    /// triangle's last two corners are swapped.
+    pub fn map_triangles(&self) -> Vec<[u32; 3]> {
+        self.triangles
+            .iter()
+            .map(|t| [t[0] as u32, t[2] as u32, t[1] as u32])
+            .collect()
+    }
+
+    /// The TIN as a [`Mesh`] in map coordinates of `grid` (see
+    /// [`Mesh::from_tin`]), built in Rust from the kernel's result.
+    pub fn to_mesh(&self, grid: &GeoGrid) -> CoreResult<Mesh> {
+        let grid = grid.clone().checked()?;
+        Mesh::from_tin(&self.map_vertices(&grid), &self.map_triangles())
+    }
 }
 
 #[derive(Clone, Copy)]
@@ -897,6 +930,53 @@ mod tests {
             // the tiled mesh is not far from the single-tile one
             let one = greedy_tin(&z, rows, cols, 2.0, Some(usize::MAX), shared).unwrap();
             assert!(t.grid.len() as f64 <= 1.05 * one.grid.len() as f64);
+        }
+    }
+
+    #[test]
+    fn tiled_tin_mesh_is_crack_free_with_its_rim_on_the_raster_edge() {
+        let (rows, cols) = (2 * TILE + 40, TILE + 90);
+        let z = field(rows, cols, 11);
+        let grid = GeoGrid::new(500_000.0, 4_000_000.0, 30.0, 30.0).unwrap();
+        for shared in [false, true] {
+            let t = greedy_tin(&z, rows, cols, 2.0, None, shared).unwrap();
+            let m = t.to_mesh(&grid).unwrap();
+            m.validate().unwrap();
+            let e = m.edges();
+            assert_eq!((e.non_manifold, e.inconsistent), (0, 0));
+            // every open edge runs along the raster's outer edge, and they
+            // add up to its perimeter: no crack inside
+            let (lo, hi) = m.bounds().unwrap();
+            let rim = m.boundary_edges();
+            assert_eq!(rim.len(), e.boundary);
+            let mut length = 0.0;
+            for [a, b] in rim {
+                let (p, q) = (m.vertices[a as usize], m.vertices[b as usize]);
+                let on = |k: usize, v: f64| {
+                    (p[k] as f64 + m.origin[k] - v).abs() < 1e-6
+                        && (q[k] as f64 + m.origin[k] - v).abs() < 1e-6
+                };
+                assert!(
+                    on(0, lo[0]) || on(0, hi[0]) || on(1, lo[1]) || on(1, hi[1]),
+                    "open edge {p:?}-{q:?} inside the raster"
+                );
+                length += ((p[0] - q[0]) as f64).hypot((p[1] - q[1]) as f64);
+            }
+            let perimeter = 2.0 * 30.0 * ((rows - 1) + (cols - 1)) as f64;
+            assert!(
+                (length - perimeter).abs() < 1e-6 * perimeter,
+                "{length} {perimeter}"
+            );
+            // counter-clockwise from above: every normal points up
+            assert!(m.normals.iter().all(|n| n[2] > 0.0));
+            // vertices at the sample centres, in metres
+            for (k, g) in t.grid.iter().enumerate() {
+                let x = 500_015.0 + 30.0 * g[0] as f64;
+                let y = 4_000_000.0 - 15.0 - 30.0 * g[1] as f64;
+                let v = m.vertices[k];
+                assert!((v[0] as f64 + m.origin[0] - x).abs() < 1e-3);
+                assert!((v[1] as f64 + m.origin[1] - y).abs() < 1e-3);
+            }
         }
     }
 

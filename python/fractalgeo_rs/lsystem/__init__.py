@@ -26,7 +26,9 @@ J. E. Hutchinson, Fractals and self-similarity, *Indiana Univ. Math. J.* 30
 """
 from fractalgeo_rs.lsystem.core import DEFAULT_MAX_LENGTH, LString, LSystem
 from fractalgeo_rs.lsystem.export import write_obj, write_ply, write_png, write_svg
-from fractalgeo_rs.lsystem.geometry import TURTLE_SYMBOLS, Mesh, Polylines, Segments, plant_mesh, turtle_2d, turtle_3d
+from fractalgeo_rs.lsystem.geometry import TURTLE_SYMBOLS, Polylines, Segments, plant_mesh, turtle_2d, turtle_3d
+# the mesh type is fractalgeo_rs.geometry.Mesh (documented there); kept importable from here
+from fractalgeo_rs.lsystem.geometry import Mesh as Mesh
 from fractalgeo_rs.lsystem.ifs import IFS, IFS_PRESETS, ifs_preset, moran_dimension, rasterize_points
 from fractalgeo_rs.lsystem.terrain import plants_on_terrain
 
@@ -36,7 +38,6 @@ __all__ = [
     "IFS_PRESETS",
     "LString",
     "LSystem",
-    "Mesh",
     "Polylines",
     "Segments",
     "TURTLE_SYMBOLS",

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numbers
 from dataclasses import dataclass
-from typing import Optional, Sequence, Union
+from typing import NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -52,21 +52,37 @@ def _symbols(v, name):
     return v
 
 
+class TurtleArgs(NamedTuple):
+    """Validated turtle options, read by name by the Rust binding
+    (``TurtleArgs`` in ``rust/bindings/lsystem.rs``)."""
+
+    angle: float
+    step: float
+    width: float
+    width_factor: float
+    tropism: Tuple[float, float, float]
+    elasticity: float
+    heading: Tuple[float, float, float]
+    left: Tuple[float, float, float]
+    draw: str
+    moves: str
+
+
 def turtle_args(*, angle=90.0, step=1.0, width=1.0, width_factor=0.7, tropism=(0.0, 0.0, 0.0), elasticity=0.0,
-                draw="FG", move="fg", planar=False) -> tuple:
-    """Validated turtle options in the order ``_core`` expects."""
+                draw="FG", move="fg", planar=False) -> TurtleArgs:
+    """Validated turtle options, as the named structure ``_core`` reads."""
     h, l = _PLANAR if planar else _SPATIAL
-    return (
-        _real(angle, "angle"),
-        _real(step, "step"),
-        _real(width, "width"),
-        _real(width_factor, "width_factor"),
-        _vec3(tropism, "tropism"),
-        _real(elasticity, "elasticity"),
-        h,
-        l,
-        _symbols(draw, "draw"),
-        _symbols(move, "move"),
+    return TurtleArgs(
+        angle=_real(angle, "angle"),
+        step=_real(step, "step"),
+        width=_real(width, "width"),
+        width_factor=_real(width_factor, "width_factor"),
+        tropism=_vec3(tropism, "tropism"),
+        elasticity=_real(elasticity, "elasticity"),
+        heading=h,
+        left=l,
+        draw=_symbols(draw, "draw"),
+        moves=_symbols(move, "move"),
     )
 
 

@@ -99,4 +99,4 @@ def plants_on_terrain(
         check_seed(seed), check_positive_float(scale, "scale"), int(max_plants), args, int(sides),
         check_n_threads(n_threads),
     )
-    return Mesh(*arrays), bases
+    return Mesh._from_core(arrays), bases

@@ -3,11 +3,13 @@ from __future__ import annotations
 
 import numbers
 from dataclasses import dataclass
-from typing import Tuple
+from typing import Optional, Tuple
 
 import numpy as np
 
 from fractalgeo_rs import _core
+from fractalgeo_rs._backend import array_kind
+from fractalgeo_rs.geometry import GeoGrid, Mesh
 from fractalgeo_rs._validation import (
     as_array,
     check_memory,
@@ -150,6 +152,9 @@ class TIN:
     transform : tuple of float
         ``(a, b, c, d, e, f)``: pixel corner ``(col, row)`` maps to
         ``(a col + b row + c, d col + e row + f)`` (rasterio's ``Affine``).
+    crs : str or None
+        The DEM's coordinate reference system when it had one (a DataArray's
+        or ``grid``'s), else None.
 
     References
     ----------
@@ -174,6 +179,7 @@ class TIN:
     grid: np.ndarray
     shape: Tuple[int, int]
     transform: Tuple[float, float, float, float, float, float]
+    crs: Optional[str] = None
 
     def __len__(self) -> int:
         return len(self.triangles)
@@ -213,31 +219,15 @@ class TIN:
         length = np.linalg.norm(n, axis=1, keepdims=True)
         return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
 
-    def to_mesh(self):
-        """The TIN as a :class:`~fractalgeo_rs.lsystem.Mesh` for the
-        OBJ/PLY writers: float32 vertices (map coordinates relative to the
-        lower-left vertex, so that float32 keeps centimetres in UTM),
-        per-vertex normals, UVs = map ``x, y`` scaled to [0, 1] over the
-        mesh's bounding box."""
-        from fractalgeo_rs.lsystem.geometry import Mesh
-
-        v = self.vertices
-        lo = v[:, :2].min(axis=0)
-        span = np.maximum(v[:, :2].max(axis=0) - lo, np.finfo(float).tiny)
-        rel = v.copy()
-        rel[:, :2] -= lo
-        m = len(self.triangles)
-        zeros = np.zeros(m, dtype=np.uint32)
-        return Mesh(
-            vertices=rel.astype(np.float32),
-            normals=self.normals().astype(np.float32),
-            uvs=((v[:, :2] - lo) / span).astype(np.float32),
-            faces=self.triangles.astype(np.uint32),
-            part_ids=np.arange(m, dtype=np.uint32),
-            kinds=np.zeros(m, dtype=np.uint8),
-            colors=zeros,
-            instances=zeros.copy(),
-        )
+    def to_mesh(self) -> Mesh:
+        """The TIN as a :class:`~fractalgeo_rs.geometry.Mesh`, built in
+        Rust: float32 vertices relative to ``origin`` = the lower-left
+        vertex (map ``x, y`` minima, z = 0), so that float32 keeps
+        millimetres in UTM; per-vertex area-weighted normals (:meth:`normals`);
+        UVs = map ``x, y`` scaled to [0, 1] over the mesh's bounding box;
+        ``part_ids`` = triangle number."""
+        return Mesh._from_core(_core.mesh_from_tin(np.ascontiguousarray(self.vertices, dtype=np.float64),
+                                                   np.ascontiguousarray(self.triangles, dtype=np.int64)))
 
     def write_obj(self, path, *, coordinates: str = "local", crs=None) -> None:
         """Write the mesh as Wavefront OBJ, georeferenced.
@@ -252,7 +242,7 @@ class TIN:
         """
         from fractalgeo_rs.tin._export import write_tin
 
-        write_tin(self, path, coordinates=coordinates, crs=crs)
+        write_tin(self, path, coordinates=coordinates, crs=crs if crs is not None else self.crs)
 
     def write_ply(self, path, *, coordinates: str = "local", crs=None) -> None:
         """Write the mesh as binary little-endian PLY, georeferenced:
@@ -260,13 +250,13 @@ class TIN:
         ``comment offset X Y Z`` and the sidecars of :meth:`write_obj`."""
         from fractalgeo_rs.tin._export import write_tin
 
-        write_tin(self, path, coordinates=coordinates, crs=crs)
+        write_tin(self, path, coordinates=coordinates, crs=crs if crs is not None else self.crs)
 
     def write_png(self, path, *, azimuth: float = 315.0, altitude: float = 45.0, crs=None) -> None:
         """Write a shaded-relief PNG preview of the mesh: :meth:`to_grid`
         shaded by :func:`fractalgeo_rs.hillshade` (0 = no triangle), on the
         DEM's grid: georeferenced by a world file (``.pgw``) and, with a
-        ``crs``, its WKT in ``.prj``."""
+        ``crs`` (default: the TIN's own ``crs``), its WKT in ``.prj``."""
         from fractalgeo_rs.dem import hillshade
         from fractalgeo_rs.io import write_raster
 
@@ -285,7 +275,7 @@ def _default_max_error(z: np.ndarray) -> float:
 
 
 def tin_from_dem(dem, *, max_error=None, max_triangles=None, transform=None, cell_size=None,
-                 nodata=None, tile_edges="shared", n_threads=None) -> TIN:
+                 nodata=None, tile_edges="shared", grid=None, n_threads=None) -> TIN:
     r"""Error-bounded triangulated irregular network of a DEM.
 
     Greedy insertion (Garland and Heckbert 1995, the scheme of Delatin):
@@ -309,12 +299,22 @@ def tin_from_dem(dem, *, max_error=None, max_triangles=None, transform=None, cel
     the triangles concatenated in tile order, so the result is the same for
     any ``n_threads``.
 
+    Vertices are in the DEM's map units: a ``xarray.DataArray`` brings its
+    georeference (coordinates or rioxarray transform and CRS, read by
+    :meth:`fractalgeo_rs.geometry.GeoGrid.of`), a numpy array takes
+    ``transform``, ``cell_size`` or ``grid``. A grid in degrees (a
+    geographic CRS) is refused unless ``cell_size`` gives the ground
+    spacing in metres (the mesh is then in a local metric frame with its
+    origin at the lower-left corner): a mesh needs one unit for x, y and z.
+
     Parameters
     ----------
-    dem : array_like, shape (rows, cols)
+    dem : array_like or xarray.DataArray, shape (rows, cols)
         Heights; any real dtype. NaN (and ``nodata``) samples are left out:
         triangles covering them are dropped, so nodata areas become holes.
-        Not modified.
+        Not modified. A Dask array (or a DataArray backed by one) is refused
+        with a ``TypeError``: the greedy insertion needs the whole raster,
+        so call ``.compute()`` first.
     max_error : float, optional
         Largest allowed vertical error (DEM units), >= 0. Default: 0.5 % of
         the robust relief (98th minus 2nd percentile of the valid heights);
@@ -333,6 +333,10 @@ def tin_from_dem(dem, *, max_error=None, max_triangles=None, transform=None, cel
         Sample spacing when there is no ``transform`` (default 1).
     nodata : float, optional
         Height value meaning "no data" (NaN always is).
+    grid : GeoGrid, optional
+        The georeference as a :class:`~fractalgeo_rs.geometry.GeoGrid`
+        (instead of ``transform`` or ``cell_size``); its CRS must match a
+        DataArray's.
     tile_edges : {"shared", "free"}
         ``"shared"``: the vertices on the four raster edges are chosen from
         the edge samples alone (Douglas-Peucker within ``max_error`` on each
@@ -369,7 +373,17 @@ def tin_from_dem(dem, *, max_error=None, max_triangles=None, transform=None, cel
     >>> bool(np.allclose(t.to_grid(), dem))
     True
     """
-    a = as_array(dem, "dem")
+    kind = array_kind(dem)
+    if array_kind(dem.data if kind == "xarray" else dem) == "dask":
+        raise TypeError("dem: a Dask array is not meshed lazily (the greedy insertion needs the whole raster); "
+                        "pass dem.compute() (or dem.load() for a DataArray)")
+    geo = None
+    if kind == "xarray" or grid is not None:
+        geo = GeoGrid.of(dem, grid=grid, transform=transform, cell_size=cell_size, param="dem",
+                         rows=int(np.shape(dem)[0]) if np.ndim(dem) == 2 else None)
+        if geo is not None:
+            geo.require_projected("grid" if grid is not None else "dem")
+    a = as_array(dem.values if kind == "xarray" else dem, "dem")
     if a.ndim != 2:
         raise ValueError(f"dem: expected a 2D array, got shape {a.shape}")
     if a.dtype.kind not in "fiu":
@@ -390,16 +404,17 @@ def tin_from_dem(dem, *, max_error=None, max_triangles=None, transform=None, cel
         max_triangles = check_positive_int(max_triangles, "max_triangles")
     check_choice(tile_edges, "tile_edges", ("shared", "free"))
     n_threads = check_n_threads(n_threads)
-    t = _affine(transform, cell_size, z.shape[0])
-    grid, zs, tris, achieved = _core.tin_greedy(z, max_error, max_triangles, tile_edges == "shared", n_threads)
+    t = geo.affine if geo is not None else _affine(transform, cell_size, z.shape[0])
+    cells, zs, tris, achieved = _core.tin_greedy(z, max_error, max_triangles, tile_edges == "shared", n_threads)
     ta, tb, tc, td, te, tf = t
-    cc = grid[:, 0] + 0.5
-    rr = grid[:, 1] + 0.5
+    cc = cells[:, 0] + 0.5
+    rr = cells[:, 1] + 0.5
     verts = np.column_stack([ta * cc + tb * rr + tc, td * cc + te * rr + tf, zs])
     if ta * te - tb * td < 0:
         tris = tris[:, [0, 2, 1]]
     return TIN(vertices=verts, triangles=np.ascontiguousarray(tris), max_error=float(achieved),
-               grid=grid, shape=(int(z.shape[0]), int(z.shape[1])), transform=t)
+               grid=cells, shape=(int(z.shape[0]), int(z.shape[1])), transform=t,
+               crs=geo.crs if geo is not None else None)
 
 
 def grid_from_points(points, values, shape, transform=None, *, cell_size=None, method="natural",

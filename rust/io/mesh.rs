@@ -3,8 +3,8 @@
 //! `part_id`, `kind`, `color`, `instance`). Both are written to a temporary
 //! file beside the target and renamed over it, so a file appears whole or
 //! not at all.
-use super::mesh::Mesh;
 use crate::error::{CoreError, CoreResult};
+use crate::geometry::Mesh;
 use crate::io::image_io::temp_path;
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -48,7 +48,7 @@ fn atomic<F: FnOnce(&mut BufWriter<File>) -> std::io::Result<()>>(
 /// Write `mesh` as Wavefront OBJ (1-based `f v/vt/vn` faces; branches and
 /// leaves in groups `branches` and `leaves`).
 pub fn write_obj(mesh: &Mesh, path: &Path) -> CoreResult<()> {
-    check(mesh)?;
+    mesh.check_layout()?;
     atomic(path, |w| {
         writeln!(
             w,
@@ -86,7 +86,7 @@ pub fn write_obj(mesh: &Mesh, path: &Path) -> CoreResult<()> {
 
 /// Write `mesh` as binary little-endian PLY.
 pub fn write_ply(mesh: &Mesh, path: &Path) -> CoreResult<()> {
-    check(mesh)?;
+    mesh.check_layout()?;
     atomic(path, |w| {
         write!(
             w,
@@ -124,33 +124,6 @@ pub fn write_ply(mesh: &Mesh, path: &Path) -> CoreResult<()> {
         }
         Ok(())
     })
-}
-
-fn check(mesh: &Mesh) -> CoreResult<()> {
-    let (nv, nf) = (mesh.vertices.len(), mesh.faces.len());
-    if mesh.normals.len() != nv || mesh.uvs.len() != nv {
-        return Err(CoreError::invalid(
-            "mesh",
-            "normals and uvs must have one row per vertex",
-        ));
-    }
-    if mesh.part_ids.len() != nf
-        || mesh.kinds.len() != nf
-        || mesh.colors.len() != nf
-        || mesh.instances.len() != nf
-    {
-        return Err(CoreError::invalid(
-            "mesh",
-            "part_ids, kinds, colors and instances must have one entry per face",
-        ));
-    }
-    if mesh.faces.iter().flatten().any(|&i| i as usize >= nv) {
-        return Err(CoreError::invalid(
-            "mesh",
-            "a face refers to a vertex that does not exist",
-        ));
-    }
-    Ok(())
 }
 
 #[cfg(test)]
