@@ -98,7 +98,7 @@ METHODS: Dict[str, Callable[..., DimensionFit]] = {
 
 # methods defined for one dimensionality of a profile or surface only, and
 # what to use on the other
-_GRAPH_ONLY = {
+GRAPH_ONLY = {
     "dbc": (2, "variogram', 'madogram', 'variation', 'higuchi', 'spectral' or 'whittle"),
     "blanket": (2, "variogram', 'madogram', 'variation', 'higuchi', 'spectral' or 'whittle"),
     "surface_variation": (2, "variation', 'variogram' or 'madogram"),
@@ -146,8 +146,8 @@ def dimension(data, method: str = "box", **options) -> DimensionFit:
     """
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"method: expected one of {', '.join(map(repr, METHODS))}, got {method!r}")
-    if method in _GRAPH_ONLY:
-        nd, other = _GRAPH_ONLY[method]
+    if method in GRAPH_ONLY:
+        nd, other = GRAPH_ONLY[method]
         have = np.ndim(data)
         if have in (1, 2) and have != nd:
             kind = {1: "1D profiles", 2: "2D surfaces"}[have]

@@ -144,13 +144,13 @@ def _run_dimension(args: argparse.Namespace) -> int:
     nodata = (profile or {}).get("nodata")
     if nodata is not None and not np.isnan(nodata):
         data = np.where(data == nodata, np.nan, data.astype(np.float64))
-    from fractalgeo_rs.dimension import _GRAPH_ONLY
+    from fractalgeo_rs.dimension import GRAPH_ONLY
 
     kind = input_kind(data, args.threshold)
     method = args.method or DEFAULT_METHOD[kind]
     defaults = {} if args.method else dict(DEFAULTS[kind][1])
-    if method in _GRAPH_ONLY and kind != "set":
-        ndim, others = _GRAPH_ONLY[method]
+    if method in GRAPH_ONLY and kind != "set":
+        ndim, others = GRAPH_ONLY[method]
         if (kind == "profile") != (ndim == 1):
             need = "profile" if ndim == 1 else "surface"
             raise ValueError(f"--method {method}: estimates the dimension of a {need} and the input is a {kind}; "
