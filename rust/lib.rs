@@ -14,6 +14,7 @@
 //! | [`dem`] | DEM work: shaded relief, lakes, resampling |
 //! | [`lsystem`] | L-systems, turtle geometry and IFS |
 //! | [`transform`] | moving-window maps of local dimension |
+//! | [`radar`] | speckle and side-looking SAR geometry |
 //! | [`progress`] | a work counter kernels tick for progress bars |
 
 #![warn(clippy::undocumented_unsafe_blocks)]
@@ -27,6 +28,7 @@ pub mod io;
 pub mod lsystem;
 pub mod parallel;
 pub mod progress;
+pub mod radar;
 pub mod synth;
 pub mod tin;
 pub mod transform;

@@ -10,7 +10,7 @@ The package mirrors the Rust crate's domains: :mod:`fractalgeo_rs.dimension`
 :mod:`fractalgeo_rs.lsystem`.
 """
 from fractalgeo_rs._core import __version__
-from fractalgeo_rs import data, io, tin
+from fractalgeo_rs import data, io, radar, tin
 from fractalgeo_rs.fit import DimensionFit, FractalRangeWarning
 from fractalgeo_rs.dimension import (
     Lacunarity,

@@ -63,6 +63,9 @@ __all__ = [
     "tin_greedy",
     "tin_grid",
     "tin_rasterize",
+    "radar_geometry",
+    "radar_project",
+    "speckle_f64",
 ]
 
 # ---- dimension ----
@@ -430,3 +433,29 @@ def tin_rasterize(
     cols: int,
     n_threads: Optional[int] = None,
 ) -> npt.NDArray[np.float64]: ...
+
+# ---- radar ----
+def speckle_f64(
+    intensity: npt.NDArray[np.float64],
+    looks: int,
+    seed: int,
+    origin: Tuple[int, int] = (0, 0),
+    global_cols: int = 0,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...
+def radar_geometry(
+    dem: npt.NDArray[np.float64],
+    dx: float,
+    dy: float,
+    incidence: float,
+    n_threads: Optional[int] = None,
+) -> Tuple[
+    npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.uint8], int
+]: ...
+def radar_project(
+    power: npt.NDArray[np.float64],
+    position: npt.NDArray[np.float64],
+    lit: npt.NDArray[np.uint8],
+    n_bins: int,
+    n_threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32], npt.NDArray[np.uint32]]: ...
