@@ -239,7 +239,7 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
     power[~np.isfinite(cos_l)] = np.nan
     slant, count, nlit = _core.radar_project(np.ascontiguousarray(power), pos, lit.astype(np.uint8), n_bins,
                                             n_threads)
-    bins_covered = count > 0
+    bins_covered = (count > 0) | (slant > 0)  # a footprint's end may reach a bin without covering its centre
     slant = np.where(bins_covered, slant, np.nan)
     speckled = slant if looks is None else _core.speckle_f64(slant, looks, seed, (0, 0), 0, n_threads)
     spacing = d_range * math.sin(math.radians(inc))
