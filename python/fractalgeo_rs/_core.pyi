@@ -63,6 +63,7 @@ __all__ = [
     "tin_greedy",
     "tin_grid",
     "tin_rasterize",
+    "radar_geocode",
     "radar_geometry",
     "radar_project",
     "speckle_f64",
@@ -448,6 +449,8 @@ def radar_geometry(
     dx: float,
     dy: float,
     incidence: float,
+    table: Sequence[float],
+    table_step: float,
     n_threads: Optional[int] = None,
 ) -> Tuple[
     npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.uint8], int
@@ -455,7 +458,15 @@ def radar_geometry(
 def radar_project(
     power: npt.NDArray[np.float64],
     position: npt.NDArray[np.float64],
-    lit: npt.NDArray[np.uint8],
+    flags: npt.NDArray[np.uint8],
     n_bins: int,
     n_threads: Optional[int] = None,
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32], npt.NDArray[np.uint32]]: ...
+def radar_geocode(
+    slant_a: npt.NDArray[np.float64],
+    slant_b: npt.NDArray[np.float64],
+    count: npt.NDArray[np.uint32],
+    position: npt.NDArray[np.float64],
+    flags: npt.NDArray[np.uint8],
+    n_threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...

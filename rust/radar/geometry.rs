@@ -25,19 +25,42 @@
 use crate::error::{CoreError, CoreResult};
 use rayon::prelude::*;
 
+/// Bit of [`Geometry::flags`]: the pixel is in radar shadow (cast, or its
+/// facet faces away beyond grazing).
+pub const SHADOW: u8 = 1;
+/// Bit of [`Geometry::flags`]: the facet faces the radar more steeply than
+/// the incidence (active layover: slant range decreases with ground range).
+pub const ACTIVE_LAYOVER: u8 = 2;
+
 /// Per-pixel geometry of a scene (row-major, same shape as the DEM).
 #[derive(Debug, Clone)]
 pub struct Geometry {
-    /// Cosine of the local incidence angle (NaN where a height is missing).
-    pub cos_local: Vec<f64>,
-    /// Facet area over ground area, `sqrt(1 + z_x^2 + z_y^2)`.
-    pub area_factor: Vec<f64>,
+    /// Local incidence angle in degrees (NaN where a height is missing;
+    /// above 90 for facets facing away beyond grazing).
+    pub theta_local: Vec<f64>,
+    /// Backscattered power in units of a flat cell's: sigma0 at the local
+    /// incidence (linear interpolation in the table) times the facet's area
+    /// over the cell's, 0 in shadow, NaN where a height is missing.
+    pub power: Vec<f64>,
     /// Slant-range position in bins of `dx sin theta`, from 0.
     pub position: Vec<f64>,
-    /// 1 where the pixel is in radar shadow (cast or facing away).
-    pub shadow: Vec<u8>,
+    /// [`SHADOW`] and [`ACTIVE_LAYOVER`] bits.
+    pub flags: Vec<u8>,
     /// Number of slant-range bins that hold the scene.
     pub n_bins: usize,
+}
+
+/// sigma0 at `angle` degrees from a table sampled every `step` degrees from 0
+/// (linear interpolation, clamped at the table's ends).
+#[inline]
+fn lookup(table: &[f64], step: f64, angle: f64) -> f64 {
+    let x = (angle / step).max(0.0);
+    let i = x.floor() as usize;
+    if i + 1 >= table.len() {
+        return table[table.len() - 1];
+    }
+    let f = x - i as f64;
+    table[i] * (1.0 - f) + table[i + 1] * f
 }
 
 fn check(z: &[f64], rows: usize, cols: usize, dx: f64, dy: f64, incidence: f64) -> CoreResult<()> {
@@ -77,7 +100,9 @@ fn deriv(v: impl Fn(usize) -> f64, i: usize, n: usize, h: f64) -> f64 {
 }
 
 /// The geometry of the DEM `z` (`rows` x `cols`, NaN = missing) seen at
-/// `incidence` degrees from the vertical.
+/// `incidence` degrees from the vertical, with the facet backscatter
+/// `table[i]` = sigma0 at `i * table_step` degrees.
+#[allow(clippy::too_many_arguments)]
 pub fn geometry(
     z: &[f64],
     rows: usize,
@@ -85,37 +110,56 @@ pub fn geometry(
     dx: f64,
     dy: f64,
     incidence: f64,
+    table: &[f64],
+    table_step: f64,
 ) -> CoreResult<Geometry> {
     check(z, rows, cols, dx, dy, incidence)?;
+    if table.is_empty() || !(table_step.is_finite() && table_step > 0.0) {
+        return Err(CoreError::invalid(
+            "table",
+            "expected a non-empty sigma0 table and a positive step",
+        ));
+    }
     let t = incidence.to_radians();
     let (st, ct) = t.sin_cos();
     let cot = ct / st;
+    let tan_t = st / ct;
     let n = rows * cols;
-    let mut cos_local = vec![0.0; n];
-    let mut area = vec![0.0; n];
+    let mut theta = vec![0.0; n];
+    let mut power = vec![0.0; n];
     let mut pos = vec![0.0; n];
-    let mut shadow = vec![0u8; n];
-    cos_local
+    let mut flags = vec![0u8; n];
+    theta
         .par_chunks_mut(cols)
-        .zip(area.par_chunks_mut(cols))
+        .zip(power.par_chunks_mut(cols))
         .zip(pos.par_chunks_mut(cols))
-        .zip(shadow.par_chunks_mut(cols))
+        .zip(flags.par_chunks_mut(cols))
         .enumerate()
-        .for_each(|(r, (((cl, ar), ps), sh))| {
+        .for_each(|(r, (((th, pw), ps), fl))| {
             let line = &z[r * cols..(r + 1) * cols];
             let mut umax = f64::NEG_INFINITY;
             for j in 0..cols {
                 let zx = deriv(|i| line[i], j, cols, dx);
                 let zy = deriv(|i| z[i * cols + j], r, rows, dy);
                 let norm = (1.0 + zx * zx + zy * zy).sqrt();
-                cl[j] = (ct + st * zx) / norm;
-                ar[j] = norm;
+                let c = ((ct + st * zx) / norm).clamp(-1.0, 1.0);
+                let angle = c.acos().to_degrees();
+                th[j] = if c.is_nan() { f64::NAN } else { angle };
                 ps[j] = j as f64 - line[j] * cot / dx;
                 let u = line[j] + j as f64 * dx * cot;
                 // relative tolerance: a plane exactly at grazing slope is lit
                 let tol = 1e-12 * (u.abs() + umax.abs().min(f64::MAX));
                 let cast = u.is_finite() && umax > u + tol;
-                sh[j] = u8::from(cast || cl[j] <= 0.0);
+                let shadow = cast || c <= 0.0;
+                fl[j] =
+                    if shadow { SHADOW } else { 0 } | if zx > tan_t { ACTIVE_LAYOVER } else { 0 };
+                pw[j] = if !u.is_finite() || c.is_nan() {
+                    f64::NAN
+                } else if shadow {
+                    0.0
+                } else {
+                    lookup(table, table_step, angle) * norm
+                };
                 if u > umax {
                     umax = u;
                 }
@@ -139,10 +183,10 @@ pub fn geometry(
     }
     pos.par_iter_mut().for_each(|p| *p -= lo);
     Ok(Geometry {
-        cos_local,
-        area_factor: area,
+        theta_local: theta,
+        power,
         position: pos,
-        shadow,
+        flags,
         n_bins: span.ceil() as usize + 1,
     })
 }
@@ -183,18 +227,19 @@ fn footprint(p: &[f64], j: usize) -> (f64, f64) {
 }
 
 /// Project per-pixel `power` at slant `position` (from [`geometry`]) onto
-/// `n_bins` slant-range bins per row. `lit` marks the pixels that count as
-/// illuminated. Non-finite power or position contributes nothing.
+/// `n_bins` slant-range bins per row. A pixel without the [`SHADOW`] bit of
+/// `flags` counts as lit. Non-finite power or position contributes nothing.
+/// Bins that no footprint reaches are NaN.
 pub fn project(
     power: &[f64],
     position: &[f64],
-    lit_pixel: &[u8],
+    flags: &[u8],
     rows: usize,
     cols: usize,
     n_bins: usize,
 ) -> CoreResult<Slant> {
     let n = rows * cols;
-    if power.len() != n || position.len() != n || lit_pixel.len() != n {
+    if power.len() != n || position.len() != n || flags.len() != n {
         return Err(CoreError::invalid(
             "power",
             "shapes of power, position and lit differ",
@@ -218,7 +263,7 @@ pub fn project(
         .for_each(|(r, ((img, cnt), lt))| {
             let p = &position[r * cols..(r + 1) * cols];
             let w = &power[r * cols..(r + 1) * cols];
-            let l = &lit_pixel[r * cols..(r + 1) * cols];
+            let l = &flags[r * cols..(r + 1) * cols];
             for j in 0..cols {
                 if !p[j].is_finite() {
                     continue;
@@ -233,7 +278,7 @@ pub fn project(
                 let mut k = k0;
                 while (k as f64) < b && k < n_bins {
                     cnt[k] += 1;
-                    lt[k] += u32::from(l[j] != 0);
+                    lt[k] += u32::from(l[j] & SHADOW == 0);
                     k += 1;
                 }
                 let v = w[j];
@@ -257,8 +302,66 @@ pub fn project(
                     k += 1;
                 }
             }
+            for (v, &c) in img.iter_mut().zip(cnt.iter()) {
+                if c == 0 && *v == 0.0 {
+                    *v = f64::NAN;
+                }
+            }
         });
     Ok(Slant { image, count, lit })
+}
+
+/// Terrain geocoding: each pixel takes the value of the slant bin nearest to
+/// its `position` in each image of `slants` (`rows * n_bins` each); returns
+/// those images on the DEM's grid (NaN where the position is) and the
+/// layover mask (the bin is covered by more than one footprint, or the
+/// pixel has the [`ACTIVE_LAYOVER`] bit).
+pub fn geocode(
+    slants: &[&[f64]],
+    count: &[u32],
+    position: &[f64],
+    flags: &[u8],
+    rows: usize,
+    cols: usize,
+    n_bins: usize,
+) -> CoreResult<(Vec<Vec<f64>>, Vec<u8>)> {
+    let n = rows * cols;
+    if position.len() != n || flags.len() != n || count.len() != rows * n_bins {
+        return Err(CoreError::invalid(
+            "position",
+            "shapes of the inputs differ",
+        ));
+    }
+    if slants.iter().any(|s| s.len() != rows * n_bins) || n_bins == 0 {
+        return Err(CoreError::invalid("slant", "expected rows x n_bins images"));
+    }
+    let bin = |p: f64| ((p + 0.5).floor().max(0.0) as usize).min(n_bins - 1);
+    let mut outs: Vec<Vec<f64>> = Vec::with_capacity(slants.len());
+    for s in slants {
+        let mut o = vec![0.0; n];
+        o.par_chunks_mut(cols).enumerate().for_each(|(r, o)| {
+            let p = &position[r * cols..(r + 1) * cols];
+            let line = &s[r * n_bins..(r + 1) * n_bins];
+            for (o, &p) in o.iter_mut().zip(p) {
+                *o = if p.is_finite() {
+                    line[bin(p)]
+                } else {
+                    f64::NAN
+                };
+            }
+        });
+        outs.push(o);
+    }
+    let mut lay = vec![0u8; n];
+    lay.par_chunks_mut(cols).enumerate().for_each(|(r, o)| {
+        let p = &position[r * cols..(r + 1) * cols];
+        let f = &flags[r * cols..(r + 1) * cols];
+        let c = &count[r * n_bins..(r + 1) * n_bins];
+        for j in 0..cols {
+            o[j] = u8::from(p[j].is_finite() && (c[bin(p[j])] > 1 || f[j] & ACTIVE_LAYOVER != 0));
+        }
+    });
+    Ok((outs, lay))
 }
 
 #[cfg(test)]
@@ -276,12 +379,13 @@ mod tests {
     fn local_incidence_of_a_plane() {
         for s in [-40.0f64, -10.0, 0.0, 12.0, 30.0] {
             let z = plane(3, 6, 2.0, s);
-            let g = geometry(&z, 3, 6, 2.0, 2.0, 35.0).unwrap();
-            for c in &g.cos_local {
-                assert!(
-                    (c - (35.0 - s).to_radians().cos()).abs() < 1e-12,
-                    "slope {s}: {c}"
-                );
+            let g = geometry(&z, 3, 6, 2.0, 2.0, 35.0, &[1.0, 1.0], 90.0).unwrap();
+            for t in &g.theta_local {
+                assert!((t - (35.0 - s).abs()).abs() < 1e-9, "slope {s}: {t}");
+            }
+            // flat table: power = facet area / cell area = 1 / cos(s)
+            for p in &g.power {
+                assert!((p - 1.0 / s.to_radians().cos()).abs() < 1e-12);
             }
         }
     }
@@ -291,12 +395,8 @@ mod tests {
         let theta = 35.0;
         for (s, want) in [(-54.9, 0u8), (-55.1, 1u8)] {
             let z = plane(2, 8, 1.0, s);
-            let g = geometry(&z, 2, 8, 1.0, 1.0, theta).unwrap();
-            assert!(
-                g.shadow.iter().all(|&v| v == want),
-                "slope {s}: {:?}",
-                g.shadow
-            );
+            let g = geometry(&z, 2, 8, 1.0, 1.0, theta, &[1.0], 1.0).unwrap();
+            assert!(g.flags.iter().all(|&v| v & SHADOW == want), "slope {s}");
         }
     }
 
@@ -306,30 +406,30 @@ mod tests {
         // shadow covers the 10 m behind it (columns 4..=12 strictly below the ray)
         let cols = 20;
         let z: Vec<f64> = (0..cols).map(|j| if j == 3 { 10.0 } else { 0.0 }).collect();
-        let g = geometry(&z, 1, cols, 1.0, 1.0, 45.0).unwrap();
+        let g = geometry(&z, 1, cols, 1.0, 1.0, 45.0, &[1.0], 1.0).unwrap();
         for j in 5..13 {
-            assert_eq!(g.shadow[j], 1, "column {j}");
+            assert_eq!(g.flags[j] & SHADOW, 1, "column {j}");
         }
-        assert_eq!(g.shadow[14], 0);
+        assert_eq!(g.flags[14] & SHADOW, 0);
     }
 
     #[test]
     fn flat_ground_projects_one_to_one_and_layover_counts() {
         let z = vec![0.0; 2 * 5];
-        let g = geometry(&z, 2, 5, 1.0, 1.0, 30.0).unwrap();
-        let lit = vec![1u8; 10];
-        let s = project(&[1.0; 10], &g.position, &lit, 2, 5, g.n_bins).unwrap();
+        let g = geometry(&z, 2, 5, 1.0, 1.0, 30.0, &[1.0], 1.0).unwrap();
+        let s = project(&[1.0; 10], &g.position, &g.flags, 2, 5, g.n_bins).unwrap();
         assert_eq!(g.n_bins, 5);
         assert!(s.image.iter().all(|v| (v - 1.0).abs() < 1e-12));
         assert!(s.count.iter().all(|&c| c == 1));
         // a plane steeper than the incidence: every bin in layover-free order
         // reversed (count 1), a ridge: forward then reversed -> count 2 at least
         let z = plane(1, 8, 1.0, 40.0);
-        let g = geometry(&z, 1, 8, 1.0, 1.0, 30.0).unwrap();
+        let g = geometry(&z, 1, 8, 1.0, 1.0, 30.0, &[1.0], 1.0).unwrap();
         assert!(g.position.windows(2).all(|w| w[1] < w[0]));
+        assert!(g.flags.iter().all(|&f| f == ACTIVE_LAYOVER));
         let power = vec![1.0; 8];
-        let s = project(&power, &g.position, &[1u8; 8], 1, 8, g.n_bins).unwrap();
-        let total: f64 = s.image.iter().sum();
+        let s = project(&power, &g.position, &g.flags, 1, 8, g.n_bins).unwrap();
+        let total: f64 = s.image.iter().filter(|v| v.is_finite()).sum();
         assert!((total - 8.0).abs() < 1e-9, "power conserved: {total}");
     }
 }

@@ -223,42 +223,26 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
     seed = resolve_seed(seed)
     n_threads = check_n_threads(n_threads)
     # facet backscatter on a table of local incidence (validates the surface)
-    table_deg = np.linspace(0.0, 89.9, 900)
+    step = 0.1
+    table_deg = np.arange(900) * step
     table = np.asarray(backscatter(table_deg, model=model, wavelength=wavelength, permittivity=permittivity,
                                    rms_height=rms_height, correlation_length=correlation_length,
                                    correlation=correlation, hurst=hurst, topothesy=topothesy,
                                    polarization=polarization), dtype=np.float64)
     zr = np.ascontiguousarray(_TO_RANGE[look](np.asarray(z, dtype=np.float64)))
     d_range, d_az = (dx, dy) if look in (90, 270) else (dy, dx)
-    cos_l, area, pos, shadow, n_bins = _core.radar_geometry(zr, d_range, d_az, inc, n_threads)
-    theta_l = np.degrees(np.arccos(np.clip(cos_l, -1.0, 1.0)))
-    lit = (shadow == 0) & np.isfinite(cos_l)
-    with np.errstate(invalid="ignore"):
-        s0 = np.interp(np.minimum(theta_l, 89.9), table_deg, table)
-    power = np.where(lit, s0 * area, 0.0)
-    power[~np.isfinite(cos_l)] = np.nan
-    slant, count, nlit = _core.radar_project(np.ascontiguousarray(power), pos, lit.astype(np.uint8), n_bins,
-                                            n_threads)
-    bins_covered = (count > 0) | (slant > 0)  # a footprint's end may reach a bin without covering its centre
-    slant = np.where(bins_covered, slant, np.nan)
+    theta_l, power, pos, flags, n_bins = _core.radar_geometry(zr, d_range, d_az, inc, table.tolist(), step,
+                                                              n_threads)
+    slant, count, nlit = _core.radar_project(power, pos, flags, n_bins, n_threads)
     speckled = slant if looks is None else _core.speckle_f64(slant, looks, seed, (0, 0), 0, n_threads)
     spacing = d_range * math.sin(math.radians(inc))
     if not ground_range:
-        return SARScene(speckled, slant, count > 1, bins_covered & (nlit == 0), theta_l, spacing, "slant")
-    rows = np.arange(zr.shape[0])[:, None]
-    b = np.clip(np.floor(pos + 0.5), 0, n_bins - 1)
-    b = np.where(np.isfinite(b), b, 0).astype(np.intp)
-    missing = ~np.isfinite(zr)
-    g_img = np.where(missing, np.nan, speckled[rows, b])
-    g_s0 = np.where(missing, np.nan, slant[rows, b])
-    # layover: the bin is shared by several footprints (passive), or the
-    # slope faces the radar more steeply than the incidence (active)
-    active = np.gradient(zr, d_range, axis=1) > math.tan(math.radians(inc))
-    g_lay = ((count[rows, b] > 1) | active) & ~missing
+        return SARScene(speckled, slant, count > 1, (count > 0) & (nlit == 0), theta_l, spacing, "slant")
+    g_img, g_s0, g_lay = _core.radar_geocode(speckled, slant, count, pos, flags, n_threads)
     back = _FROM_RANGE[look]
-    out_img, out_s0 = (np.ascontiguousarray(back(a)) for a in (g_img, g_s0))
-    lay, shd = (np.ascontiguousarray(back(a)) for a in (g_lay, shadow.astype(bool) & ~missing))
-    inc_map = np.ascontiguousarray(back(theta_l))
+    out_img, out_s0, inc_map = (np.ascontiguousarray(back(a)) for a in (g_img, g_s0, theta_l))
+    lay = np.ascontiguousarray(back(g_lay.view(bool)))
+    shd = np.ascontiguousarray(back((flags & 1).view(bool)))
     if kind == "xarray":
         out_img = dem.copy(data=out_img).rename("sar_intensity")
         out_s0 = dem.copy(data=out_s0).rename("sigma0")
