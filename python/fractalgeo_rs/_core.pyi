@@ -440,7 +440,7 @@ def speckle_f64(
     intensity: npt.NDArray[np.float64],
     looks: int,
     seed: int,
-    origin: Tuple[int, int] = (0, 0),
+    origin: Tuple[int, int] = ...,
     global_cols: int = 0,
     n_threads: Optional[int] = None,
 ) -> npt.NDArray[np.float64]: ...
