@@ -17,9 +17,11 @@
 //!   piecewise-linear profile through the samples, whose maximum is at a
 //!   sample), or when its facet faces away (`cos theta_loc <= 0`, slopes
 //!   facing away steeper than `90 - theta`).
-//! * **Projection**: a pixel's footprint on the slant-range axis runs between
-//!   the midpoints to its neighbours; its power is spread over the bins the
-//!   footprint overlaps, in proportion to the overlap (power is conserved).
+//! * **Projection**: each half of a pixel (from its centre to the midpoint to
+//!   a neighbour) lands on the slant-range axis between the slant ranges of
+//!   those two points, with half the pixel's power spread over the bins it
+//!   overlaps in proportion to the overlap (power is conserved; at a fold,
+//!   a crest in layover, both halves land on the same side).
 //!   A bin is in layover when the footprints of more than one pixel of the
 //!   line cover its centre.
 use crate::error::{CoreError, CoreResult};
@@ -202,7 +204,8 @@ pub struct Slant {
     pub lit: Vec<u32>,
 }
 
-/// Footprint `[a, b]` (sorted) of pixel `j` of a line of slant positions.
+/// Edges `(left, right)` of the footprint of pixel `j` of a line of slant
+/// positions: the midpoints to its neighbours (extrapolated at the ends).
 #[inline]
 fn footprint(p: &[f64], j: usize) -> (f64, f64) {
     let n = p.len();
@@ -219,10 +222,45 @@ fn footprint(p: &[f64], j: usize) -> (f64, f64) {
         (None, Some(r)) => (2.0 * pj - r, r),
         (None, None) => (pj - 0.5, pj + 0.5),
     };
-    if l <= r {
-        (l, r)
-    } else {
-        (r, l)
+    (l, r)
+}
+
+/// Add `v` spread uniformly over the half-open slant interval between `e0`
+/// and `e1` (either order) to `img`, and count the bins whose centre it
+/// covers in `cnt` (and in `lt` when `lit`).
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn deposit(img: &mut [f64], cnt: &mut [u32], lt: &mut [u32], e0: f64, e1: f64, v: f64, lit: bool) {
+    let n_bins = img.len();
+    let (a, b) = if e0 <= e1 { (e0, e1) } else { (e1, e0) };
+    let (a, b) = (a.max(-0.5), b.min(n_bins as f64 - 0.5));
+    if b < a {
+        return;
+    }
+    // bins whose centre k lies in [a, b)
+    let mut k = a.ceil().max(0.0) as usize;
+    while (k as f64) < b && k < n_bins {
+        cnt[k] += 1;
+        lt[k] += u32::from(lit);
+        k += 1;
+    }
+    if !(v.is_finite() && v != 0.0) {
+        return;
+    }
+    let len = b - a;
+    if len < 1e-12 {
+        let k = (a + 0.5).floor().clamp(0.0, n_bins as f64 - 1.0) as usize;
+        img[k] += v;
+        return;
+    }
+    let mut k = (a + 0.5).floor().max(0.0) as usize;
+    while k < n_bins && (k as f64 - 0.5) < b {
+        let lo = (k as f64 - 0.5).max(a);
+        let hi = (k as f64 + 0.5).min(b);
+        if hi > lo {
+            img[k] += v * (hi - lo) / len;
+        }
+        k += 1;
     }
 }
 
@@ -254,7 +292,6 @@ pub fn project(
     let mut image = vec![0.0; rows * n_bins];
     let mut count = vec![0u32; rows * n_bins];
     let mut lit = vec![0u32; rows * n_bins];
-    let last = n_bins as f64 - 0.5;
     image
         .par_chunks_mut(n_bins)
         .zip(count.par_chunks_mut(n_bins))
@@ -268,39 +305,14 @@ pub fn project(
                 if !p[j].is_finite() {
                     continue;
                 }
-                let (a, b) = footprint(p, j);
-                let (a, b) = (a.max(-0.5), b.min(last));
-                if b < a {
-                    continue;
-                }
-                // bins whose centre k lies in [a, b)
-                let k0 = a.ceil().max(0.0) as usize;
-                let mut k = k0;
-                while (k as f64) < b && k < n_bins {
-                    cnt[k] += 1;
-                    lt[k] += u32::from(l[j] & SHADOW == 0);
-                    k += 1;
-                }
-                let v = w[j];
-                if !(v.is_finite() && v != 0.0) {
-                    continue;
-                }
-                let len = b - a;
-                if len < 1e-12 {
-                    let k = (a + 0.5).floor().clamp(0.0, n_bins as f64 - 1.0) as usize;
-                    img[k] += v;
-                    continue;
-                }
-                let first = (a + 0.5).floor().max(0.0) as usize;
-                let mut k = first;
-                while k < n_bins && (k as f64 - 0.5) < b {
-                    let lo = (k as f64 - 0.5).max(a);
-                    let hi = (k as f64 + 0.5).min(b);
-                    if hi > lo {
-                        img[k] += v * (hi - lo) / len;
-                    }
-                    k += 1;
-                }
+                // the two halves of the cell, from its centre to the
+                // midpoints to its neighbours, each with half the power: at a
+                // fold (a crest seen in layover) both land on one side
+                let (e0, e1) = footprint(p, j);
+                let lit = l[j] & SHADOW == 0;
+                let v = 0.5 * w[j];
+                deposit(img, cnt, lt, e0, p[j], v, lit);
+                deposit(img, cnt, lt, p[j], e1, v, lit);
             }
             for (v, &c) in img.iter_mut().zip(cnt.iter()) {
                 if c == 0 && *v == 0.0 {
@@ -431,5 +443,32 @@ mod tests {
         let s = project(&power, &g.position, &g.flags, 1, 8, g.n_bins).unwrap();
         let total: f64 = s.image.iter().filter(|v| v.is_finite()).sum();
         assert!((total - 8.0).abs() < 1e-9, "power conserved: {total}");
+    }
+
+    #[test]
+    fn every_pixel_covers_its_own_bin_at_a_fold() {
+        // a ridge whose front slope (50 deg) is steeper than the incidence:
+        // the crest is a fold of the slant-range map
+        let cols = 40;
+        let z: Vec<f64> = (0..cols)
+            .map(|j| {
+                let x = j as f64;
+                if x < 10.0 {
+                    0.0
+                } else if x < 20.0 {
+                    (x - 10.0) * 50f64.to_radians().tan()
+                } else {
+                    (30.0 - x).max(0.0) * 50f64.to_radians().tan()
+                }
+            })
+            .collect();
+        let g = geometry(&z, 1, cols, 1.0, 1.0, 30.0, &[1.0], 1.0).unwrap();
+        let s = project(&vec![1.0; cols], &g.position, &g.flags, 1, cols, g.n_bins).unwrap();
+        for j in 0..cols {
+            let k = ((g.position[j] + 0.5).floor() as usize).min(g.n_bins - 1);
+            assert!(s.count[k] >= 1, "pixel {j} bin {k}");
+        }
+        let total: f64 = s.image.iter().filter(|v| v.is_finite()).sum();
+        assert!((total - cols as f64).abs() < 1e-9);
     }
 }
