@@ -4,7 +4,7 @@ numpy/scipy, not Rust: each call evaluates a closed form, a short series or a
 one-dimensional Hankel transform per incidence angle (microseconds to
 milliseconds), vectorised over angles; there is no per-pixel work to move
 into a kernel. The scene simulator evaluates these models on a table of
-local incidence angles and interpolates (see :func:`simulate`).
+local incidence angles and interpolates (see :func:`~fractalgeo_rs.radar.simulate`).
 """
 from __future__ import annotations
 
@@ -37,7 +37,7 @@ class RadarValidityWarning(UserWarning):
 
     The message gives the numbers (k*sigma, k*l, rms slope, radius of
     curvature, wavelength) and the criterion that failed; see
-    :func:`validity`.
+    :func:`~fractalgeo_rs.radar.validity`.
 
     Attributes
     ----------
@@ -393,7 +393,7 @@ def validity(*, wavelength, rms_height=None, correlation_length=None, correlatio
     wavelength : float
         Radar wavelength in metres.
     rms_height, correlation_length, correlation, hurst, topothesy
-        The surface, as in :func:`backscatter`.
+        The surface, as in :func:`~fractalgeo_rs.radar.backscatter`.
     incidence : float or array_like
         Incidence angle(s) in degrees (the largest sets the GO criterion).
 
@@ -593,7 +593,7 @@ def backscatter(incidence, *, model="kirchhoff", wavelength, permittivity, rms_h
     r"""Backscatter coefficient sigma0 of a rough surface (linear, m^2/m^2).
 
     ``k = 2 pi / wavelength``, ``theta`` the incidence, ``R(0)`` the Fresnel
-    coefficient at normal incidence (:func:`fresnel`), ``W`` the roughness
+    coefficient at normal incidence (:func:`~fractalgeo_rs.radar.fresnel`), ``W`` the roughness
     spectrum normalised so that :math:`\sigma^2 W(K) = \int_0^\infty C(\tau)
     J_0(K\tau)\tau\,d\tau` and ``D(tau) = E[(z(x + tau) - z(x))^2]`` the
     structure function.
@@ -633,7 +633,7 @@ def backscatter(incidence, *, model="kirchhoff", wavelength, permittivity, rms_h
     ``"exponential"`` :math:`\rho = e^{-\tau/l}`, ``"fbm"``
     :math:`D(\tau) = T^{2-2H}\tau^{2H}` (``topothesy`` ``T`` in metres: the
     lag at which the rms height difference equals the lag). Outside a
-    model's validity range (:func:`validity`) a :class:`RadarValidityWarning`
+    model's validity range (:func:`~fractalgeo_rs.radar.validity`) a :class:`~fractalgeo_rs.radar.RadarValidityWarning`
     gives the numbers.
 
     Parameters
@@ -646,7 +646,7 @@ def backscatter(incidence, *, model="kirchhoff", wavelength, permittivity, rms_h
         Radar wavelength in metres (C band: 0.056).
     permittivity : complex
         Relative permittivity of the ground, ``Im >= 0`` (time convention
-        ``exp(-i omega t)``, see :func:`fresnel`).
+        ``exp(-i omega t)``, see :func:`~fractalgeo_rs.radar.fresnel`).
     rms_height, correlation_length : float
         ``sigma`` and ``l`` in metres (Gaussian and exponential correlations).
     correlation : {"gaussian", "exponential", "fbm"}
@@ -657,7 +657,7 @@ def backscatter(incidence, *, model="kirchhoff", wavelength, permittivity, rms_h
         Only SPM distinguishes HH from VV; cross-polarised backscatter is 0
         in all three models.
     return_validity : bool
-        Also return the :class:`BackscatterValidity`.
+        Also return the :class:`~fractalgeo_rs.radar.BackscatterValidity`.
 
     Returns
     -------

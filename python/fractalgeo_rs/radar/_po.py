@@ -18,7 +18,7 @@ _STREAM_GAUSSIAN = 0x7ad0_0001
 
 @dataclass(frozen=True)
 class PhysicalOptics:
-    """Result of :func:`physical_optics`.
+    """Result of :func:`~fractalgeo_rs.radar.physical_optics`.
 
     Attributes
     ----------
@@ -57,7 +57,7 @@ class PhysicalOptics:
 
 def surface_realisation(shape, cell_size, *, correlation, rms_height=None, correlation_length=None, hurst=None,
                         topothesy=None, seed=0, n_threads=None):
-    r"""One periodic random surface with the statistics of :func:`backscatter`.
+    r"""One periodic random surface with the statistics of :func:`~fractalgeo_rs.radar.backscatter`.
 
     ``"gaussian"``: spectral synthesis on the torus, the FFT of white noise
     (drawn by the package's counter-based generator, as
@@ -75,7 +75,7 @@ def surface_realisation(shape, cell_size, *, correlation, rms_height=None, corre
     cell_size : float
         Grid spacing, metres.
     correlation, rms_height, correlation_length, hurst, topothesy
-        The surface, as in :func:`backscatter` (``"gaussian"`` or ``"fbm"``).
+        The surface, as in :func:`~fractalgeo_rs.radar.backscatter` (``"gaussian"`` or ``"fbm"``).
     seed : int
         Seed in ``[0, 2**64)``.
     n_threads : int or None
@@ -139,11 +139,11 @@ def physical_optics(incidence, *, wavelength, permittivity, rms_height=None, cor
               \qquad |\mathbf{q}| = 2k\sin\theta,\ q_z = 2k\cos\theta,
 
     so each angle costs one FFT of ``exp(i q_z z)`` per periodic synthetic
-    surface (:func:`surface_realisation`). The FFT bins whose ``|q|`` lies
+    surface (:func:`~fractalgeo_rs.radar.surface_realisation`). The FFT bins whose ``|q|`` lies
     within half a bin of ``2 k sin theta`` (a ring: the surfaces are
     isotropic) are averaged, then the realisations; the spread over
     realisations gives the standard error. Its expectation is the Kirchhoff
-    integral of :func:`backscatter` (``model="kirchhoff"``) up to the
+    integral of :func:`~fractalgeo_rs.radar.backscatter` (``model="kirchhoff"``) up to the
     discretisation of the surface; it checks that integral and gives
     sigma0 for surfaces without a closed form.
 
@@ -153,7 +153,7 @@ def physical_optics(incidence, *, wavelength, permittivity, rms_height=None, cor
         Incidence angles in degrees; ``2 k sin theta`` must lie between two
         Fourier bins ``2 pi / (shape cell_size)`` and the Nyquist frequency.
     wavelength, permittivity, rms_height, correlation_length, correlation, hurst, topothesy
-        As in :func:`backscatter` (``correlation`` ``"gaussian"`` or ``"fbm"``).
+        As in :func:`~fractalgeo_rs.radar.backscatter` (``correlation`` ``"gaussian"`` or ``"fbm"``).
     shape : int
         Side of the periodic grid, ``>= 16``.
     cell_size : float or None

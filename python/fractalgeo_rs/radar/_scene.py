@@ -1,6 +1,6 @@
 """Synthetic SAR scenes from DEMs: geometry and projection in Rust
 (``_core.radar_geometry``, ``_core.radar_project``, ``_core.speckle_f64``),
-sigma0 from a table of :func:`backscatter` over the local incidence."""
+sigma0 from a table of :func:`~fractalgeo_rs.radar.backscatter` over the local incidence."""
 from __future__ import annotations
 
 import math
@@ -37,7 +37,7 @@ _FROM_RANGE = {
 
 @dataclass(frozen=True)
 class SARScene:
-    """A simulated SAR scene (the output of :func:`simulate`).
+    """A simulated SAR scene (the output of :func:`~fractalgeo_rs.radar.simulate`).
 
     Attributes
     ----------
@@ -128,7 +128,7 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
     2. radar shadow: a cell is hidden when a cell nearer the radar rises
        above the ray (a running maximum of ``z + x cot theta`` along each
        range line, exact for the heightfield) or faces away beyond grazing;
-    3. sigma0 per facet from :func:`backscatter` at the local incidence
+    3. sigma0 per facet from :func:`~fractalgeo_rs.radar.backscatter` at the local incidence
        (the microscale roughness given by the keywords), times the facet's
        area over the ground cell's;
     4. slant-range projection: each cell's footprint between the midpoints to
@@ -136,7 +136,7 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
        z cos theta``) with its power split by overlap; a bin covered by more
        than one footprint is layover (slopes facing the radar steeper than
        ``theta``);
-    5. speckle on the slant-range image (:func:`speckle`, ``looks``-look
+    5. speckle on the slant-range image (:func:`~fractalgeo_rs.radar.speckle`, ``looks``-look
        Gamma intensity; ``looks=None`` for none);
     6. ``ground_range=True``: each DEM cell takes the value of the slant bin
        it falls in (terrain-geocoded, so cells in layover share the summed
@@ -159,7 +159,7 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
     wavelength : float
         Metres (C band 0.056).
     model, permittivity, rms_height, correlation_length, correlation, hurst, topothesy, polarization
-        The facet backscatter, as in :func:`backscatter`.
+        The facet backscatter, as in :func:`~fractalgeo_rs.radar.backscatter`.
     looks : int or None
         Looks of the speckle (1: single look); ``None``: no speckle.
     seed : int or None
