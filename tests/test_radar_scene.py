@@ -158,3 +158,20 @@ def test_bundled_real_dem():
         assert np.isfinite(s.image).all() and (s.image >= 0).all()
         lay.append(s.layover.mean())
     assert lay[0] > lay[1] > lay[2] >= 0 and lay[0] > 0.01
+
+
+def test_validity_judged_at_the_scene_incidence():
+    """Geometric optics is valid at 20 degrees for this surface (not at the
+    89.9 degrees of the sigma0 table): no warning; SPM is not: one warning
+    pointing at this file."""
+    kw = dict(wavelength=WL, permittivity=5 + 0.5j, rms_height=0.05, correlation_length=0.5)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fg.radar.simulate(np.zeros((6, 6)), 1.0, look_azimuth=90, incidence=20, model="geometric_optics",
+                          correlation="gaussian", looks=None, **kw)
+    with pytest.warns(fg.radar.RadarValidityWarning, match="simulate: model='spm'") as rec:
+        fg.radar.simulate(np.zeros((6, 6)), 1.0, look_azimuth=90, incidence=20, model="spm",
+                          correlation="gaussian", looks=None, **kw)
+    assert rec[0].filename == __file__

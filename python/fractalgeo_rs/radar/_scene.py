@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -13,7 +14,8 @@ import numpy as np
 from fractalgeo_rs import _core
 from fractalgeo_rs._backend import array_kind
 from fractalgeo_rs._validation import check_n_threads, check_real_array
-from fractalgeo_rs.radar._backscatter import MODELS, _positive, backscatter
+from fractalgeo_rs._warn import user_stacklevel
+from fractalgeo_rs.radar._backscatter import MODELS, RadarValidityWarning, _positive, backscatter, validity
 from fractalgeo_rs.radar._speckle import check_looks
 from fractalgeo_rs.synth._common import resolve_seed
 
@@ -225,10 +227,19 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
     # facet backscatter on a table of local incidence (validates the surface)
     step = 0.1
     table_deg = np.arange(900) * step
-    table = np.asarray(backscatter(table_deg, model=model, wavelength=wavelength, permittivity=permittivity,
-                                   rms_height=rms_height, correlation_length=correlation_length,
-                                   correlation=correlation, hurst=hurst, topothesy=topothesy,
-                                   polarization=polarization), dtype=np.float64)
+    with warnings.catch_warnings():
+        # judged below at the scene's incidence, not at the table's 89.9 degrees
+        warnings.simplefilter("ignore", RadarValidityWarning)
+        table = np.asarray(backscatter(table_deg, model=model, wavelength=wavelength, permittivity=permittivity,
+                                       rms_height=rms_height, correlation_length=correlation_length,
+                                       correlation=correlation, hurst=hurst, topothesy=topothesy,
+                                       polarization=polarization), dtype=np.float64)
+    val = validity(wavelength=wavelength, rms_height=rms_height, correlation_length=correlation_length,
+                   correlation=correlation, hurst=hurst, topothesy=topothesy, incidence=inc)
+    if not val.valid[model]:
+        warnings.warn(f"simulate: model={model!r} is outside its range of validity at incidence {inc:g}: "
+                      f"{val.ranges[model]}; here k*sigma = {val.k_sigma:.3g}, k*l = {val.k_l:.3g}, "
+                      f"rms slope = {val.rms_slope:.3g}", RadarValidityWarning, stacklevel=user_stacklevel())
     zr = np.ascontiguousarray(_TO_RANGE[look](np.asarray(z, dtype=np.float64)))
     d_range, d_az = (dx, dy) if look in (90, 270) else (dy, dx)
     theta_l, power, pos, flags, n_bins = _core.radar_geometry(zr, d_range, d_az, inc, table.tolist(), step,
