@@ -15,6 +15,7 @@
 //! | [`dem`] | DEM work: shaded relief, lakes, resampling |
 //! | [`lsystem`] | L-systems, turtle geometry and IFS |
 //! | [`transform`] | moving-window maps of local dimension |
+//! | [`radar`] | speckle and side-looking SAR geometry |
 //!
 //! Crate-level services that every domain may use (and that use no domain):
 //!
@@ -41,6 +42,7 @@ pub mod parallel;
 pub mod progress;
 pub mod rng;
 pub mod sample;
+pub mod radar;
 pub mod synth;
 pub mod tin;
 pub mod transform;

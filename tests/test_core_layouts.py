@@ -118,6 +118,13 @@ CASES = {
     "blanket_areas_image": (IMG, lambda a: _core.blanket_areas_image(a, 4, 1.0)),
     "lacunarity_transform_map": (np.abs(IMG), lambda a: _core.lacunarity_transform_map(a, 9, [1, 2, 4], 0.5)),
     "mass_curve_image": (IMG, lambda a: _core.mass_curve_image(a, [3, 5, 7], 1.0)),
+    "speckle_f64": (np.abs(IMG), lambda a: _core.speckle_f64(a, 3, 11)),
+    "radar_geometry": (IMG, lambda a: _core.radar_geometry(a, 2.0, 1.5, 35.0, [1.0, 0.5, 0.2], 45.0)),
+    "radar_project": (np.abs(IMG), lambda a: _core.radar_project(
+        a, np.tile(np.arange(a.shape[1], dtype=np.float64), (a.shape[0], 1)) + 0.3 * np.sin(a),
+        (a > 1).astype(np.uint8), a.shape[1] + 2)),
+    "radar_geocode": (np.abs(IMG), lambda a: _core.radar_geocode(
+        a, a + 1, (a > 1).astype(np.uint32) + 1, np.abs(IMG[:, :20]), (IMG[:, :20] > 0).astype(np.uint8) * 2)),
 }
 # functions whose array arguments are not data laid out by the caller
 NOT_LAYOUT = {

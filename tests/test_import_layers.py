@@ -30,7 +30,7 @@ FOUNDATION = {"_core", "_warn", "_compat"}
 SERVICES = {"_validation", "_progress", "_backend", "_scales", "_zscale", "fit", "io", "plotting", "data",
             "_cli_common"}
 GEOMETRY = {"geometry"}
-DOMAINS = {"dimension", "synth", "transform", "dem", "lsystem", "tin"}
+DOMAINS = {"dimension", "synth", "transform", "dem", "lsystem", "tin", "radar"}
 TOP = {"__init__", "cli", "demo"}
 
 # The domains a domain may import (downward edges only).
@@ -41,6 +41,7 @@ DOMAIN_DEPS = {
     "transform": {"dimension"},
     "dem": {"synth"},  # synth._common.resolve_seed: _validation.check_seed is the same function
     "tin": {"dem"},
+    "radar": {"synth"},  # fBm surfaces for physical optics
 }
 
 # Edges that break the layers today and are being removed by the work of

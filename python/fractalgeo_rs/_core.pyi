@@ -67,6 +67,10 @@ __all__ = [
     "tin_greedy",
     "tin_grid",
     "tin_rasterize",
+    "radar_geocode",
+    "radar_geometry",
+    "radar_project",
+    "speckle_f64",
 ]
 
 # ---- geometry ----
@@ -475,3 +479,39 @@ def tin_rasterize(
     cols: int,
     n_threads: Optional[int] = None,
 ) -> npt.NDArray[np.float64]: ...
+
+# ---- radar ----
+def speckle_f64(
+    intensity: npt.NDArray[np.float64],
+    looks: int,
+    seed: int,
+    origin: Tuple[int, int] = ...,
+    global_cols: int = 0,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...
+def radar_geometry(
+    dem: npt.NDArray[np.float64],
+    dx: float,
+    dy: float,
+    incidence: float,
+    table: Sequence[float],
+    table_step: float,
+    n_threads: Optional[int] = None,
+) -> Tuple[
+    npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.uint8], int
+]: ...
+def radar_project(
+    power: npt.NDArray[np.float64],
+    position: npt.NDArray[np.float64],
+    flags: npt.NDArray[np.uint8],
+    n_bins: int,
+    n_threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32], npt.NDArray[np.uint32]]: ...
+def radar_geocode(
+    slant_a: npt.NDArray[np.float64],
+    slant_b: npt.NDArray[np.float64],
+    count: npt.NDArray[np.uint32],
+    position: npt.NDArray[np.float64],
+    flags: npt.NDArray[np.uint8],
+    n_threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...

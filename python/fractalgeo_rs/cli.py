@@ -26,6 +26,7 @@ _DOMAIN_CLIS = (
     "fractalgeo_rs.dimension._cli",
     "fractalgeo_rs.demo",
     "fractalgeo_rs.lsystem._cli",
+    "fractalgeo_rs.radar._cli",
     "fractalgeo_rs.synth._cli",
     "fractalgeo_rs.transform._cli",
     "fractalgeo_rs.tin._cli",

@@ -15,6 +15,7 @@ pub mod geometry;
 mod io;
 mod lsystem;
 mod progress;
+mod radar;
 mod synth;
 mod tin;
 mod transform;
@@ -43,5 +44,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     progress::register(m)?;
     transform::register(m)?;
     tin::register(m)?;
+    radar::register(m)?;
     Ok(())
 }

@@ -437,7 +437,7 @@ def _spectral_amplitude(n0, n1, h):
     return amp
 
 
-def _white_noise_rfft2(n0, n1, seed, stream, n_threads, steps=None):
+def white_noise_rfft2(n0, n1, seed, stream, n_threads, steps=None):
     """A random matrix with the distribution of ``rfft2`` of an (n0, n1) white
     noise matrix (unit variance), drawn directly in the frequency domain.
 
@@ -463,7 +463,7 @@ def _white_noise_rfft2(n0, n1, seed, stream, n_threads, steps=None):
 
 def _surface_spectral(rows, cols, h, seed, periodic, n_threads, steps=None):
     n0, n1 = _spectral_grid(rows, cols, periodic)
-    spec = _white_noise_rfft2(n0, n1, seed, c.STREAM_SPECTRAL_2D, n_threads, steps)
+    spec = white_noise_rfft2(n0, n1, seed, c.STREAM_SPECTRAL_2D, n_threads, steps)
     spec *= _spectral_amplitude(n0, n1, h)
     z = sfft.irfft2(spec, s=(n0, n1), workers=_workers(n_threads), overwrite_x=True)
     if steps is not None:
