@@ -15,6 +15,7 @@
 //! | [`lsystem`] | L-systems, turtle geometry and IFS |
 //! | [`transform`] | moving-window maps of local dimension |
 //! | [`progress`] | a work counter kernels tick for progress bars |
+//! | [`radiometry`] | the virtual radiometric experiment: BRF, albedo and images of rough surfaces |
 
 #![warn(clippy::undocumented_unsafe_blocks)]
 
@@ -27,6 +28,7 @@ pub mod io;
 pub mod lsystem;
 pub mod parallel;
 pub mod progress;
+pub mod radiometry;
 pub mod synth;
 pub mod tin;
 pub mod transform;

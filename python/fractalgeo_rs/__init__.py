@@ -10,7 +10,7 @@ The package mirrors the Rust crate's domains: :mod:`fractalgeo_rs.dimension`
 :mod:`fractalgeo_rs.lsystem`.
 """
 from fractalgeo_rs._core import __version__
-from fractalgeo_rs import data, io, tin
+from fractalgeo_rs import data, io, radiometry, tin
 from fractalgeo_rs.fit import DimensionFit, FractalRangeWarning
 from fractalgeo_rs.dimension import (
     Lacunarity,
@@ -46,7 +46,7 @@ from fractalgeo_rs.tin import TIN, delaunay, grid_from_points, tin_from_dem
 def _exports():
     """The imports above are the one list of the top-level API: ``__all__`` is
     every public name they bind (classes and functions of this package, and
-    the subpackages ``data``, ``io`` and ``tin``), in the order imported."""
+    the subpackages ``data``, ``io``, ``radiometry`` and ``tin``), in the order imported."""
     import types
 
     names = ["__version__"]
@@ -54,7 +54,7 @@ def _exports():
         if name.startswith("_"):
             continue
         if isinstance(obj, types.ModuleType):
-            if name in ("data", "io", "tin"):
+            if name in ("data", "io", "radiometry", "tin"):
                 names.append(name)
         elif getattr(obj, "__module__", "").startswith("fractalgeo_rs."):
             names.append(name)

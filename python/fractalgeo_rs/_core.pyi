@@ -63,6 +63,9 @@ __all__ = [
     "tin_greedy",
     "tin_grid",
     "tin_rasterize",
+    "radiometry_albedo",
+    "radiometry_brf",
+    "radiometry_render",
 ]
 
 # ---- dimension ----
@@ -430,3 +433,47 @@ def tin_rasterize(
     cols: int,
     n_threads: Optional[int] = None,
 ) -> npt.NDArray[np.float64]: ...
+
+# ---- radiometry ----
+def radiometry_brf(
+    dem: npt.NDArray[np.float64],
+    cell_size: float,
+    periodic: bool,
+    split: str,
+    material: str,
+    params: Sequence[float],
+    sun: Tuple[float, float],
+    view: Tuple[float, float],
+    spp: int,
+    max_depth: int,
+    seed: int,
+    n_threads: Optional[int] = None,
+) -> Tuple[float, float, int]: ...
+def radiometry_albedo(
+    dem: npt.NDArray[np.float64],
+    cell_size: float,
+    periodic: bool,
+    split: str,
+    material: str,
+    params: Sequence[float],
+    sun: Tuple[float, float],
+    spp: int,
+    max_depth: int,
+    seed: int,
+    n_threads: Optional[int] = None,
+) -> Tuple[float, float, int]: ...
+def radiometry_render(
+    dem: npt.NDArray[np.float64],
+    cell_size: float,
+    periodic: bool,
+    split: str,
+    material: str,
+    params: Sequence[float],
+    sun: Tuple[float, float],
+    view: Tuple[float, float],
+    shape: Tuple[int, int],
+    spp: int,
+    max_depth: int,
+    seed: int,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float32]: ...

@@ -13,6 +13,7 @@ mod dem;
 mod dimension;
 mod io;
 mod lsystem;
+mod radiometry;
 mod synth;
 mod tin;
 mod transform;
@@ -39,5 +40,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     lsystem::register(m)?;
     transform::register(m)?;
     tin::register(m)?;
+    radiometry::register(m)?;
     Ok(())
 }
