@@ -184,8 +184,8 @@ impl Heightfield {
 
     #[inline(always)]
     fn inside(&self, tri: u8, fx: f64, fy: f64) -> bool {
-        let box_ok =
-            fx >= -EDGE_EPS && fx <= 1.0 + EDGE_EPS && fy >= -EDGE_EPS && fy <= 1.0 + EDGE_EPS;
+        let r = -EDGE_EPS..=1.0 + EDGE_EPS;
+        let box_ok = r.contains(&fx) && r.contains(&fy);
         box_ok
             && match (self.split, tri) {
                 (Split::NeSw, 0) => fx + fy <= 1.0 + EDGE_EPS,

@@ -6,7 +6,7 @@ import math
 import numbers
 import warnings
 from dataclasses import dataclass
-from typing import Optional, Tuple, Union
+from typing import List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -62,7 +62,7 @@ class Lambertian:
     def __post_init__(self):
         object.__setattr__(self, "rho", _reflectance(self.rho, "rho"))
 
-    def _spec(self):
+    def _spec(self) -> Tuple[str, List[float]]:
         return "lambertian", [self.rho]
 
 
@@ -107,7 +107,7 @@ class OrenNayar:
             raise ValueError(f"sigma: expected a slope standard deviation >= 0 in radians, got {s}")
         object.__setattr__(self, "sigma", float(s))
 
-    def _spec(self):
+    def _spec(self) -> Tuple[str, List[float]]:
         return "oren-nayar", [self.rho, self.sigma]
 
 
@@ -157,7 +157,7 @@ class Phong:
         object.__setattr__(self, "ks", ks)
         object.__setattr__(self, "exponent", float(n))
 
-    def _spec(self):
+    def _spec(self) -> Tuple[str, List[float]]:
         return "phong", [self.kd, self.ks, self.exponent]
 
 
@@ -221,7 +221,7 @@ def _depth(value) -> int:
 
 
 def _seed(value) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not 0 <= value < 2**64:
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not 0 <= int(value) < 2**64:
         raise ValueError(f"seed: expected an int in [0, 2**64), got {value!r}")
     return int(value)
 
@@ -379,7 +379,7 @@ class Scene:
         z.setflags(write=False)
         return cls(z, cell_size, periodic, material, split)
 
-    def _args(self):
+    def _args(self) -> Tuple[np.ndarray, float, bool, str, str, List[float]]:
         name, params = self.material._spec()
         return (self.dem, self.cell_size, self.periodic, self.split, name, params)
 
