@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import fractalgeo_rs as fg
-from fractalgeo_rs.radiometry import Estimate, Lambertian, OrenNayar, Scene
+from fractalgeo_rs.radiometry import Estimate, Lambertian, OrenNayar, Phong, Scene
 
 
 def periodic_surface(n=16, amp=4.0, seed=0, modes=3):
@@ -101,7 +101,7 @@ def test_white_periodic_surface_reflects_everything(zenith):
     assert s.albedo(sun=(60.0, zenith), spp=20_000, max_depth=1, seed=5).value < 1.0
 
 
-@pytest.mark.parametrize("material", [Lambertian(0.6), OrenNayar(0.6, 0.5)])
+@pytest.mark.parametrize("material", [Lambertian(0.6), OrenNayar(0.6, 0.5), Phong(0.3, 0.4, 10.0)])
 def test_brf_is_reciprocal(material):
     z = fg.fbm_surface((16, 16), 0.7, method="spectral", periodic=True, seed=6, sigma=2.0)
     s = Scene.from_dem(z, material=material)
@@ -169,6 +169,10 @@ def test_bad_input_is_a_clear_error():
         OrenNayar(-0.1, 0.2)
     with pytest.raises(ValueError, match="^sigma"):
         OrenNayar(0.5, float("nan"))
+    with pytest.raises(ValueError, match=r"^ks: expected kd \+ ks <= 1"):
+        Phong(0.6, 0.6, 5.0)
+    with pytest.raises(ValueError, match="^exponent"):
+        Phong(0.2, 0.2, -1.0)
     bad = z.copy()
     bad[2, 1] = np.nan
     with pytest.raises(ValueError, match="^dem: expected finite heights.*row 2, column 1"):
@@ -224,3 +228,30 @@ def test_inputs_are_not_modified_and_any_layout_works():
     np.testing.assert_array_equal(z, before)
     assert a == b and isinstance(a, Estimate)
     assert not Scene.from_dem(z).dem.flags.writeable
+
+
+def _unit(az, zen):
+    a, z = np.radians(az), np.radians(zen)
+    return np.array([np.sin(a) * np.sin(z), np.cos(a) * np.sin(z), np.cos(z)])
+
+
+def test_a_flat_plane_returns_pi_times_the_facet_brdf():
+    """On a flat plane every path sees one facet, lit: BRF = pi f(sun, view)
+    exactly, for any model (closed forms of Oren-Nayar 1994 and
+    Lafortune-Willems 1994 written here in angles)."""
+    kd, ks, n = 0.2, 0.5, 8.0
+    rho, sigma = 0.6, 0.4
+    glossy = Scene.from_dem(np.zeros((4, 4)), material=Phong(kd, ks, n))
+    rough = Scene.from_dem(np.zeros((4, 4)), material=OrenNayar(rho, sigma))
+    a = 1 - 0.5 * sigma**2 / (sigma**2 + 0.33)
+    b = 0.45 * sigma**2 / (sigma**2 + 0.09)
+    for sun, view in [((0, 30), (180, 30)), ((0, 30), (150, 40)), ((90, 60), (0, 10)), ((10, 50), (20, 70))]:
+        si, vo = _unit(*sun), _unit(*view)
+        ca = max(0.0, float(si @ np.array([-vo[0], -vo[1], vo[2]])))
+        phong = np.pi * (kd / np.pi + ks * (n + 2) / (2 * np.pi) * ca**n)
+        alpha, beta = np.radians(max(sun[1], view[1])), np.radians(min(sun[1], view[1]))
+        cdphi = np.cos(np.radians(sun[0] - view[0]))
+        oren = rho * (a + b * max(0.0, cdphi) * np.sin(alpha) * np.tan(beta))
+        for depth in (1, 3):
+            assert abs(glossy.brf(sun=sun, view=view, spp=300, max_depth=depth).value - phong) < 1e-9
+            assert abs(rough.brf(sun=sun, view=view, spp=300, max_depth=depth).value - oren) < 1e-9

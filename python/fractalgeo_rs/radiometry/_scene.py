@@ -250,7 +250,7 @@ class Scene:
     """A triangulated surface with a reflectance model, lit by a
     directional sun and seen by an orthographic sensor.
 
-    Build one with :meth:`from_dem`. Directions are ``(azimuth, zenith)`` in
+    Build one with ``from_dem``. Directions are ``(azimuth, zenith)`` in
     degrees: azimuth clockwise from north, zenith from the vertical, both
     pointing away from the surface (towards the sun or the sensor); the
     string ``"nadir"`` is ``(0, 0)``. The sun's irradiance is 1 on a plane
@@ -345,7 +345,7 @@ class Scene:
 
         References
         ----------
-        M. Datcu and K. Seidel, 1995 (see :class:`Scene`).
+        M. Datcu and K. Seidel, 1995 (see ``Scene``).
         """
         z = as_array(dem, "dem")
         if z.ndim != 2:
@@ -493,7 +493,7 @@ class Scene:
         The tile's horizontal extent is divided into ``shape`` pixels; pixel
         ``(i, j)`` (row 0 north) averages ``spp`` paths through uniform
         points of its box footprint on the reference plane (the DEM's mean
-        height), traced as in :meth:`brf`. Values are radiances for unit sun
+        height), traced as in ``brf``. Values are radiances for unit sun
         irradiance normal to the beam: ``pi * image.mean() / cos(sun
         zenith)`` estimates the BRF.
 
