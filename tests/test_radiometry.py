@@ -292,8 +292,9 @@ def test_v_grooves_oblique_sun_and_view_match_the_interval_geometry():
     sc = Scene.from_dem(grooves(s_deg), material=Lambertian(rho))
     # nadir check of the reference itself: rho cos(s)
     assert abs(vgroove_single_brf(rho, s_deg, (90, 50), (0, 0)) - rho * np.cos(np.radians(s_deg))) < 1e-5
-    for sun, view in [((90, 50), (270, 40)), ((90, 70), (90, 30)), ((270, 65), (90, 60)),
-                      ((90, 45), (90, 45)), ((90, 80), (270, 75))]:
+    for sun, view in [((90, 50), (270, 40)), ((90, 70), (90, 30)), ((270, 40), (90, 20)),
+                      ((90, 45), (90, 45)), ((90, 80), (90, 60)), ((90, 80), (270, 20))]:
         expect = vgroove_single_brf(rho, s_deg, sun, view)
+        assert expect > 0.05
         e = sc.brf(sun=sun, view=view, spp=200_000, max_depth=1, seed=4)
         assert abs(e.value - expect) < 3 * e.se + 1e-5, (sun, view, e, expect)
