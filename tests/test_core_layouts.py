@@ -111,11 +111,11 @@ CASES = {
     "lacunarity_transform_map": (np.abs(IMG), lambda a: _core.lacunarity_transform_map(a, 9, [1, 2, 4], 0.5)),
     "mass_curve_image": (IMG, lambda a: _core.mass_curve_image(a, [3, 5, 7], 1.0)),
     "radiometry_brf": (IMG[:9, :7], lambda a: _core.radiometry_brf(
-        a, 1.0, False, "ne-sw", "lambertian", [0.5], (30.0, 40.0), (200.0, 20.0), 500, 3, 1)),
+        a, (1.0, 2.0), False, "ne-sw", "lambertian", [0.5], (30.0, 40.0), (200.0, 20.0), 500, 3, 1)),
     "radiometry_albedo": (IMG[:9, :7], lambda a: _core.radiometry_albedo(
-        a, 1.0, False, "ne-sw", "lambertian", [0.5], (30.0, 40.0), 500, 3, 1)),
+        a, (1.0, 2.0), False, "ne-sw", "lambertian", [0.5], (30.0, 40.0), 500, 3, 1)),
     "radiometry_render": (IMG[:9, :7], lambda a: _core.radiometry_render(
-        a, 1.0, False, "nw-se", "lambertian", [0.5], (30.0, 40.0), (0.0, 0.0), (5, 4), 4, 3, 1)),
+        a, (1.0, 2.0), False, "nw-se", "lambertian", [0.5], (30.0, 40.0), (0.0, 0.0), (5, 4), 4, 3, 1)),
 }
 # functions whose array arguments are not data laid out by the caller
 NOT_LAYOUT = {

@@ -32,8 +32,10 @@ def grooves(slope_deg, n=8, cell=1.0):
     return np.where(np.arange(n) % 2 == 1, h, 0.0)[None, :].repeat(n, 0)
 
 
-def facet_sums(z, cell=1.0):
-    """sum(A nz^2), sum(A nz) over the NE-SW facets of a periodic DEM."""
+def facet_sums(z, cell=1.0, cell_y=None):
+    """sum(A nz^2), sum(A nz) over the NE-SW facets of a periodic DEM with
+    cells ``cell`` (east-west) by ``cell_y`` (north-south, default ``cell``)."""
+    cy = cell if cell_y is None else cell_y
     zp = np.pad(z, ((0, 1), (0, 1)), mode="wrap")
     # corner: (east, north) offset in cells, heights of that corner of every cell
     corner = {"nw": ((0, 0), zp[:-1, :-1]), "ne": ((1, 0), zp[:-1, 1:]),
@@ -43,7 +45,7 @@ def facet_sums(z, cell=1.0):
         (pa, a), (pb, b), (pc, c) = (corner[k] for k in tri)
 
         def edge(p, h):
-            return np.stack([np.full_like(a, (p[0] - pa[0]) * cell), np.full_like(a, (p[1] - pa[1]) * cell), h - a], -1)
+            return np.stack([np.full_like(a, (p[0] - pa[0]) * cell), np.full_like(a, (p[1] - pa[1]) * cy), h - a], -1)
 
         cr = np.cross(edge(pb, b), edge(pc, c))
         length = np.linalg.norm(cr, axis=-1)
@@ -80,6 +82,11 @@ def test_nadir_single_scattering_is_the_facet_mean_of_nz():
     e = s.brf(sun=(0, 0), view=(0, 0), spp=200_000, max_depth=1, seed=1)
     assert close(e, rho * num / den), (e, rho * num / den)
     assert rho * num / den < 0.97 * rho
+    # rectangular cells (a geographic DEM's metres east-west and north-south)
+    num, den = facet_sums(z, cell=1.5, cell_y=3.0)
+    s = Scene.from_dem(z, cell_size=(1.5, 3.0), material=Lambertian(rho))
+    e = s.brf(sun=(0, 0), view=(0, 0), spp=200_000, max_depth=1, seed=1)
+    assert close(e, rho * num / den), (e, rho * num / den)
 
 
 def test_v_grooves_nadir_single_scattering_is_rho_cos_s():
@@ -189,6 +196,10 @@ def test_bad_input_is_a_clear_error():
         Scene.from_dem(z, material=0.5)
     with pytest.raises(ValueError, match="^cell_size"):
         Scene.from_dem(z, cell_size=0)
+    with pytest.raises(ValueError, match="^cell_size"):
+        Scene.from_dem(z, cell_size=(1.0, -2.0))
+    with pytest.raises(TypeError, match="^cell_size"):
+        Scene.from_dem(z, cell_size="30 m")
     with pytest.raises(ValueError, match="^seed"):
         s.brf(sun=(0, 0), seed=-1)
     with pytest.raises(MemoryError, match="^shape"):
@@ -202,13 +213,13 @@ def test_the_kernel_checks_too():
 
     z = np.zeros((3, 3))
     with pytest.raises(ValueError, match="^sun: zenith"):
-        _core.radiometry_brf(z, 1.0, True, "ne-sw", "lambertian", [0.5], (0, 91), (0, 0), 10, 1, 0)
+        _core.radiometry_brf(z, (1.0, 1.0), True, "ne-sw", "lambertian", [0.5], (0, 91), (0, 0), 10, 1, 0)
     with pytest.raises(ValueError, match="^rho"):
-        _core.radiometry_albedo(z, 1.0, True, "ne-sw", "lambertian", [2.0], (0, 0), 10, 1, 0)
+        _core.radiometry_albedo(z, (1.0, 1.0), True, "ne-sw", "lambertian", [2.0], (0, 0), 10, 1, 0)
     with pytest.raises(ValueError, match="^material"):
-        _core.radiometry_albedo(z, 1.0, True, "ne-sw", "hapke", [0.5], (0, 0), 10, 1, 0)
+        _core.radiometry_albedo(z, (1.0, 1.0), True, "ne-sw", "hapke", [0.5], (0, 0), 10, 1, 0)
     with pytest.raises(MemoryError, match="^shape"):
-        _core.radiometry_render(z, 1.0, True, "ne-sw", "lambertian", [0.5], (0, 0), (0, 0), (10**5, 10**5), 1, 1, 0)
+        _core.radiometry_render(z, (1.0, 1.0), True, "ne-sw", "lambertian", [0.5], (0, 0), (0, 0), (10**5, 10**5), 1, 1, 0)
 
 
 def test_mismatched_periodic_edges_warn_and_mirroring_fixes_them():

@@ -437,7 +437,7 @@ def tin_rasterize(
 # ---- radiometry ----
 def radiometry_brf(
     dem: npt.NDArray[np.float64],
-    cell_size: float,
+    cell_size: Tuple[float, float],
     periodic: bool,
     split: str,
     material: str,
@@ -451,7 +451,7 @@ def radiometry_brf(
 ) -> Tuple[float, float, int]: ...
 def radiometry_albedo(
     dem: npt.NDArray[np.float64],
-    cell_size: float,
+    cell_size: Tuple[float, float],
     periodic: bool,
     split: str,
     material: str,
@@ -464,7 +464,7 @@ def radiometry_albedo(
 ) -> Tuple[float, float, int]: ...
 def radiometry_render(
     dem: npt.NDArray[np.float64],
-    cell_size: float,
+    cell_size: Tuple[float, float],
     periodic: bool,
     split: str,
     material: str,

@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 fn build(
     z: &[f64],
     (rows, cols): (usize, usize),
-    cell_size: f64,
+    cell_size: (f64, f64),
     periodic: bool,
     split: &str,
     material_name: &str,
@@ -40,7 +40,7 @@ fn build(
 fn radiometry_brf(
     py: Python<'_>,
     dem: PyReadonlyArray2<'_, f64>,
-    cell_size: f64,
+    cell_size: (f64, f64),
     periodic: bool,
     split: &str,
     material: &str,
@@ -81,7 +81,7 @@ fn radiometry_brf(
 fn radiometry_albedo(
     py: Python<'_>,
     dem: PyReadonlyArray2<'_, f64>,
-    cell_size: f64,
+    cell_size: (f64, f64),
     periodic: bool,
     split: &str,
     material: &str,
@@ -115,7 +115,7 @@ fn radiometry_albedo(
 fn radiometry_render<'py>(
     py: Python<'py>,
     dem: PyReadonlyArray2<'py, f64>,
-    cell_size: f64,
+    cell_size: (f64, f64),
     periodic: bool,
     split: &str,
     material: &str,

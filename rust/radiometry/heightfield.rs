@@ -8,10 +8,11 @@
 //! one side re-enters the opposite one with no special case. Non-periodic
 //! rays are clipped to the patch and escape when they leave it.
 //!
-//! Everything here is in *grid units*: `X` = column, `Y` = row (row 0 north,
-//! so `Y` points south), `Z` = height / cell size. That frame is a mirror
-//! image of (east, north, up) scaled uniformly, which keeps every angle and
-//! dot product, so isotropic reflectance models can work in it directly.
+//! Rays, points and normals are in the world frame (`x` east, `y` north,
+//! `z` up, metres): vertex `(r, c)` sits at `(c dx, -r dy, z[r, c])`. Inside
+//! [`Heightfield::intersect`] the ray is mapped linearly to grid coordinates
+//! (`X = x / dx` = column, `Y = -y / dy` = row, `z` kept), which leaves the
+//! ray parameter `t` unchanged, so cells may be rectangular.
 use glam::DVec3;
 
 use crate::error::{CoreError, CoreResult};
@@ -64,11 +65,15 @@ pub struct Heightfield {
     pub periodic: bool,
     /// The diagonal split.
     pub split: Split,
-    /// Lowest and highest height (grid units).
+    /// Cell size east-west (metres).
+    pub dx: f64,
+    /// Cell size north-south (metres).
+    pub dy: f64,
+    /// Lowest height (metres).
     pub zmin: f64,
-    /// Highest height (grid units).
+    /// Highest height (metres).
     pub zmax: f64,
-    /// Mean vertex height (grid units): the reference plane of the sensor.
+    /// Mean vertex height (metres): the reference plane of the sensor.
     pub zmean: f64,
 }
 
@@ -81,8 +86,8 @@ const MAX_STEPS: usize = 1 << 22;
 const EDGE_EPS: f64 = 1e-12;
 
 impl Heightfield {
-    /// Build from heights `z` (row-major, `rows x cols`, metres) with square
-    /// cells of `cell_size` metres.
+    /// Build from heights `z` (row-major, `rows x cols`, metres) with cells
+    /// of `cell_size = (dx, dy)` metres (east-west, north-south).
     ///
     /// Periodic: the grid is one period, `rows x cols` cells, and the
     /// sample after the last column (row) is the first column (row).
@@ -91,11 +96,13 @@ impl Heightfield {
         z: &[f64],
         rows: usize,
         cols: usize,
-        cell_size: f64,
+        cell_size: (f64, f64),
         periodic: bool,
         split: Split,
     ) -> CoreResult<Heightfield> {
-        crate::checks::positive_finite(cell_size, "cell_size")?;
+        let (dx, dy) = cell_size;
+        crate::checks::positive_finite(dx, "cell_size")?;
+        crate::checks::positive_finite(dy, "cell_size")?;
         if z.len() != rows * cols {
             return Err(CoreError::Internal(format!(
                 "heightfield: {} heights for a {rows} x {cols} grid",
@@ -132,7 +139,7 @@ impl Heightfield {
         } else {
             (rows - 1, cols - 1)
         };
-        let h = |r: usize, c: usize| z[(r % rows) * cols + (c % cols)] / cell_size;
+        let h = |r: usize, c: usize| z[(r % rows) * cols + (c % cols)];
         let mut cells: Vec<CellData> = crate::buffers::try_with_capacity(ncr * ncc, "dem")?;
         let (mut zmin, mut zmax) = (f64::INFINITY, f64::NEG_INFINITY);
         for r in 0..ncr {
@@ -145,13 +152,15 @@ impl Heightfield {
                 cells.push([nw, ne, sw, se, lo, hi]);
             }
         }
-        let zmean = z.iter().sum::<f64>() / (z.len() as f64 * cell_size);
+        let zmean = z.iter().sum::<f64>() / z.len() as f64;
         Ok(Heightfield {
             cells,
             ncr,
             ncc,
             periodic,
             split,
+            dx,
+            dy,
             zmin,
             zmax,
             zmean,
@@ -195,32 +204,40 @@ impl Heightfield {
             }
     }
 
-    /// Unit upward normal of a facet (grid frame).
-    pub fn facet_normal(&self, f: FacetId) -> DVec3 {
-        let (_, b, c) = self.plane(self.cell(f.ix, f.iy), f.tri);
-        DVec3::new(-b, -c, 1.0).normalize()
+    /// Upward normal (not unit) of the plane `z = a + b fx + c fy` in the
+    /// world frame: `dz/dx = b / dx`, `dz/dy = -c / dy`.
+    #[inline(always)]
+    fn normal_of(&self, b: f64, c: f64) -> DVec3 {
+        DVec3::new(-b / self.dx, c / self.dy, 1.0)
     }
 
-    /// Area (grid units squared) and unit normal of every facet of one tile,
-    /// in the order (row, column, facet).
+    /// Unit upward normal of a facet (world frame).
+    pub fn facet_normal(&self, f: FacetId) -> DVec3 {
+        let (_, b, c) = self.plane(self.cell(f.ix, f.iy), f.tri);
+        self.normal_of(b, c).normalize()
+    }
+
+    /// Area (square metres) and unit normal of every facet of one tile, in
+    /// the order (row, column, facet).
     pub fn facets(&self) -> Vec<(f64, DVec3)> {
         let mut out = Vec::with_capacity(2 * self.ncr * self.ncc);
         for iy in 0..self.ncr as i64 {
             for ix in 0..self.ncc as i64 {
                 for tri in 0..2u8 {
                     let (_, b, c) = self.plane(self.cell(ix, iy), tri);
-                    let n = DVec3::new(-b, -c, 1.0);
-                    // a facet projects onto half a cell: area = 0.5 |n'| / 1
-                    out.push((0.5 * n.length(), n.normalize()));
+                    let n = self.normal_of(b, c);
+                    // a facet projects onto half a cell: area = 0.5 dx dy / nz
+                    out.push((0.5 * self.dx * self.dy * n.length(), n.normalize()));
                 }
             }
         }
         out
     }
 
-    /// Tile size in grid units (columns, rows).
+    /// Tile size in metres (east-west, north-south); the tile covers
+    /// `x` in [0, W] and `y` in [-H, 0].
     pub fn extent(&self) -> (f64, f64) {
-        (self.ncc as f64, self.ncr as f64)
+        (self.ncc as f64 * self.dx, self.ncr as f64 * self.dy)
     }
 
     /// Move a point of a periodic surface (and the facet it lies on) into
@@ -233,8 +250,8 @@ impl Heightfield {
         let ky = f.iy.div_euclid(self.ncr as i64);
         (
             DVec3::new(
-                p.x - (kx * self.ncc as i64) as f64,
-                p.y - (ky * self.ncr as i64) as f64,
+                p.x - (kx * self.ncc as i64) as f64 * self.dx,
+                p.y + (ky * self.ncr as i64) as f64 * self.dy,
                 p.z,
             ),
             FacetId {
@@ -245,13 +262,16 @@ impl Heightfield {
         )
     }
 
-    /// The first facet hit by the ray `o + t d` (`d` a unit vector) with
-    /// `t > 0`, ignoring facet `skip` (the one the ray starts on).
+    /// The first facet hit by the ray `o + t d` (world frame, `d` a unit
+    /// vector) with `t > 0`, ignoring facet `skip` (the one the ray starts on).
     pub fn intersect(&self, o: DVec3, d: DVec3, skip: Option<FacetId>) -> Option<Hit> {
+        // grid coordinates: the same t
+        let o = DVec3::new(o.x / self.dx, -o.y / self.dy, o.z);
+        let d = DVec3::new(d.x / self.dx, -d.y / self.dy, d.z);
         let mut t_start = 0.0f64;
         if !self.periodic {
             // clip to the patch's footprint [0, ncc] x [0, ncr]
-            let (w, h) = self.extent();
+            let (w, h) = (self.ncc as f64, self.ncr as f64);
             let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
             for (oa, da, hi) in [(o.x, d.x, w), (o.y, d.y, h)] {
                 if da == 0.0 {
@@ -342,7 +362,7 @@ impl Heightfield {
                     if self.inside(tri, fx, fy) {
                         best = Some(Hit {
                             t,
-                            normal: DVec3::new(-b, -c, 1.0).normalize(),
+                            normal: self.normal_of(b, c).normalize(),
                             facet: id,
                         });
                     }

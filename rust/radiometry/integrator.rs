@@ -170,7 +170,7 @@ impl Scene {
     }
 
     /// Bidirectional reflectance factor for the sun towards `sun` and the
-    /// sensor towards `view` (grid-frame unit vectors from
+    /// sensor towards `view` (unit vectors (east, north, up) from
     /// [`super::direction`]), over `spp` paths of at most `max_depth`
     /// scattering events.
     pub fn brf(
@@ -192,7 +192,7 @@ impl Scene {
                 let end = ((blk + 1) * BLOCK).min(spp);
                 for i in blk * BLOCK..end {
                     let key = StreamKey::new(seed, TAG_BRF ^ i);
-                    let (x, y) = (key.uniform(0) * w, key.uniform(1) * h);
+                    let (x, y) = (key.uniform(0) * w, -key.uniform(1) * h);
                     let o = self.sensor_ray(x, y, view);
                     let r = norm * self.radiance(o, view, sun, max_depth, key, 2);
                     s1 += r;
@@ -218,7 +218,7 @@ impl Scene {
                 let end = ((blk + 1) * BLOCK).min(spp);
                 for i in blk * BLOCK..end {
                     let key = StreamKey::new(seed, TAG_ALBEDO ^ i);
-                    let (x, y) = (key.uniform(0) * w, key.uniform(1) * h);
+                    let (x, y) = (key.uniform(0) * w, -key.uniform(1) * h);
                     let mut o = self.sensor_ray(x, y, sun);
                     let mut d = -sun;
                     let mut skip = None;
@@ -303,7 +303,7 @@ impl Scene {
                     let key =
                         StreamKey::new(seed, TAG_IMAGE ^ pixel.wrapping_mul(spp).wrapping_add(k));
                     let x = (j as f64 + key.uniform(0)) * pw;
-                    let y = (i as f64 + key.uniform(1)) * ph;
+                    let y = -(i as f64 + key.uniform(1)) * ph;
                     let o = self.sensor_ray(x, y, view);
                     s += self.radiance(o, view, sun, max_depth, key, 2);
                 }

@@ -34,9 +34,9 @@ use crate::error::{CoreError, CoreResult};
 use glam::DVec3;
 
 /// A direction given as `(azimuth, zenith)` in degrees (azimuth clockwise
-/// from north, zenith from the vertical), as a unit vector of the grid frame
-/// (column, row, up); it points away from the surface (towards the sun or
-/// the sensor). The zenith must lie in [0, 90).
+/// from north, zenith from the vertical), as a unit vector (east, north,
+/// up); it points away from the surface (towards the sun or the sensor).
+/// The zenith must lie in [0, 90).
 pub fn direction(az_zen: (f64, f64), param: &str) -> CoreResult<DVec3> {
     let (az, zen) = az_zen;
     if !az.is_finite() || !zen.is_finite() {
@@ -52,6 +52,5 @@ pub fn direction(az_zen: (f64, f64), param: &str) -> CoreResult<DVec3> {
         ));
     }
     let (a, z) = (az.to_radians(), zen.to_radians());
-    // east = sin(a) sin(z), north = cos(a) sin(z); the row axis points south
-    Ok(DVec3::new(a.sin() * z.sin(), -a.cos() * z.sin(), z.cos()))
+    Ok(DVec3::new(a.sin() * z.sin(), a.cos() * z.sin(), z.cos()))
 }

@@ -38,7 +38,7 @@ fn rough(n: usize, amp: f64, seed: u64) -> Vec<f64> {
 
 fn scene(z: &[f64], rows: usize, cols: usize, periodic: bool, mat: &str, p: &[f64]) -> Scene {
     Scene {
-        hf: Heightfield::new(z, rows, cols, 1.0, periodic, Split::NeSw).unwrap(),
+        hf: Heightfield::new(z, rows, cols, (1.0, 1.0), periodic, Split::NeSw).unwrap(),
         material: material::from_name(mat, p).unwrap(),
     }
 }
@@ -49,19 +49,20 @@ fn dir(az: f64, zen: f64) -> DVec3 {
 
 #[test]
 fn directions_follow_the_conventions() {
-    // azimuth 90 = east = +column; azimuth 0 = north = -row
+    // (east, north, up): azimuth 90 = east, azimuth 0 = north
     let e = dir(90.0, 90.0 - 1e-9);
     assert!((e - DVec3::X).length() < 1e-6);
     let n = dir(0.0, 60.0);
-    assert!((n - DVec3::new(0.0, -(60f64.to_radians().sin()), 0.5)).length() < 1e-12);
+    assert!((n - DVec3::new(0.0, 60f64.to_radians().sin(), 0.5)).length() < 1e-12);
     for bad in [(0.0, 90.0), (0.0, -1.0), (f64::NAN, 0.0), (0.0, 120.0)] {
         let e = direction(bad, "sun").unwrap_err().to_string();
         assert!(e.starts_with("sun: "), "{e}");
     }
 }
 
-/// Möller & Trumbore (1997) on explicit triangles of `tiles x tiles` copies
-/// of the tile (periodic) or of the patch alone: the nearest hit's t and normal.
+/// Möller & Trumbore (1997) on explicit triangles (vertex `(r, c)` at
+/// `(c, -r, z)`) of `tiles x tiles` copies of the tile (periodic) or of the
+/// patch alone: the nearest hit's t and normal.
 fn brute(
     z: &[f64],
     rows: usize,
@@ -87,7 +88,7 @@ fn brute(
                 for c in 0..ncc {
                     let (gx, gy) = (c + tx * ncc, r + ty * ncr);
                     let v = |dr: i64, dc: i64| {
-                        DVec3::new((gx + dc) as f64, (gy + dr) as f64, h(r + dr, c + dc))
+                        DVec3::new((gx + dc) as f64, -((gy + dr) as f64), h(r + dr, c + dc))
                     };
                     let (nw, ne, sw, se) = (v(0, 0), v(0, 1), v(1, 0), v(1, 1));
                     for tri in [[nw, ne, sw], [ne, se, sw]] {
@@ -129,13 +130,13 @@ fn traversal_agrees_with_brute_force_periodic_and_not() {
     let z = rough(7, 3.0, 4)[..rows * cols].to_vec();
     let key = StreamKey::new(11, 1);
     for periodic in [true, false] {
-        let hf = Heightfield::new(&z, rows, cols, 1.0, periodic, Split::NeSw).unwrap();
+        let hf = Heightfield::new(&z, rows, cols, (1.0, 1.0), periodic, Split::NeSw).unwrap();
         let mut hits = 0;
         for i in 0..3000u64 {
             let u = |k: u64| key.uniform(10 * i + k);
             let o = DVec3::new(
                 u(0) * 9.0 - 1.0,
-                u(1) * 7.0 - 1.0,
+                1.0 - u(1) * 7.0,
                 hf.zmin + u(2) * (hf.zmax - hf.zmin + 2.0),
             );
             // directions mostly downward but some climbing, some grazing
@@ -163,7 +164,7 @@ fn traversal_agrees_with_brute_force_periodic_and_not() {
                 (None, None) => {}
                 // the brute force sees only 13 x 13 tiles: a far hit it misses is fine
                 (Some(a), None) if periodic && a.t > 6.0 * 5.0 => {}
-                (a, b) => panic!("periodic={periodic} i={i}: {a:?} vs {b:?}"),
+                (a, b) => panic!("periodic={periodic} i={i}: {a:?} vs {b:?} o={o} d={d}"),
             }
         }
         assert!(hits > if periodic { 1000 } else { 300 }, "{hits}");
@@ -442,15 +443,23 @@ fn bad_input_names_the_parameter() {
         "material"
     );
     assert_eq!(
-        p(Heightfield::new(&[0.0, f64::NAN, 0.0, 0.0], 2, 2, 1.0, true, Split::NeSw).unwrap_err()),
+        p(Heightfield::new(
+            &[0.0, f64::NAN, 0.0, 0.0],
+            2,
+            2,
+            (1.0, 1.0),
+            true,
+            Split::NeSw
+        )
+        .unwrap_err()),
         "dem"
     );
     assert_eq!(
-        p(Heightfield::new(&[0.0; 4], 2, 2, 0.0, true, Split::NeSw).unwrap_err()),
+        p(Heightfield::new(&[0.0; 4], 2, 2, (1.0, 0.0), true, Split::NeSw).unwrap_err()),
         "cell_size"
     );
     assert_eq!(
-        p(Heightfield::new(&[0.0; 2], 1, 2, 1.0, false, Split::NeSw).unwrap_err()),
+        p(Heightfield::new(&[0.0; 2], 1, 2, (1.0, 1.0), false, Split::NeSw).unwrap_err()),
         "dem"
     );
     let s = scene(&[0.0; 4], 2, 2, true, "lambertian", &[0.5]);
@@ -479,9 +488,9 @@ fn nw_se_split_is_also_exact() {
             z[r * 4 + c] = 0.3 * c as f64 + 0.1 * r as f64;
         }
     }
-    let a = Heightfield::new(&z, 4, 4, 1.0, false, Split::NeSw).unwrap();
-    let b = Heightfield::new(&z, 4, 4, 1.0, false, Split::NwSe).unwrap();
-    let o = DVec3::new(1.3, 1.7, 10.0);
+    let a = Heightfield::new(&z, 4, 4, (1.0, 1.0), false, Split::NeSw).unwrap();
+    let b = Heightfield::new(&z, 4, 4, (1.0, 1.0), false, Split::NwSe).unwrap();
+    let o = DVec3::new(1.3, -1.7, 10.0);
     let (ha, hb) = (
         a.intersect(o, -DVec3::Z, None).unwrap(),
         b.intersect(o, -DVec3::Z, None).unwrap(),
@@ -554,4 +563,43 @@ fn phong_matches_its_closed_form_and_its_sampler_its_density() {
     let chi2: f64 = count.iter().map(|&c| (c as f64 - e).powi(2) / e).sum();
     assert!(chi2 < 43.8, "{chi2}");
     assert!(Phong::new(0.6, 0.6, 2.0).is_err());
+}
+
+#[test]
+fn rectangular_cells_give_world_normals_and_exact_nadir_brf() {
+    // the plane z = gx x + gy y (x east, y north) sampled with cells 2 m x 3 m
+    let (gx, gy, dx, dy) = (0.4, -0.25, 2.0, 3.0);
+    let (rows, cols) = (5, 6);
+    let mut z = vec![0.0; rows * cols];
+    for r in 0..rows {
+        for c in 0..cols {
+            z[r * cols + c] = gx * c as f64 * dx + gy * (-(r as f64) * dy);
+        }
+    }
+    let n = DVec3::new(-gx, -gy, 1.0).normalize();
+    for split in [Split::NeSw, Split::NwSe] {
+        let hf = Heightfield::new(&z, rows, cols, (dx, dy), false, split).unwrap();
+        let (x, y) = (3.7, -5.1);
+        let hit = hf
+            .intersect(DVec3::new(x, y, 100.0), -DVec3::Z, None)
+            .unwrap();
+        assert!((100.0 - hit.t - (gx * x + gy * y)).abs() < 1e-12);
+        assert!((hit.normal - n).length() < 1e-12);
+        // an oblique ray too
+        let d = DVec3::new(0.3, -0.2, -0.9).normalize();
+        let o = DVec3::new(1.0, -2.0, 5.0);
+        let hit = hf.intersect(o, d, None).unwrap();
+        let p = o + hit.t * d;
+        assert!((p.z - (gx * p.x + gy * p.y)).abs() < 1e-9);
+        for (area, nn) in hf.facets() {
+            assert!((area - 0.5 * dx * dy / n.z).abs() < 1e-12 && (nn - n).length() < 1e-12);
+        }
+        // nadir sun and view on a plane: BRF = rho n_z exactly
+        let s = Scene {
+            hf,
+            material: material::from_name("lambertian", &[0.6]).unwrap(),
+        };
+        let e = s.brf(DVec3::Z, DVec3::Z, 1000, 3, 0).unwrap();
+        assert!((e.value - 0.6 * n.z).abs() < 1e-9, "{e:?}");
+    }
 }

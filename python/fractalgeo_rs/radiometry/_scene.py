@@ -226,6 +226,17 @@ def _seed(value) -> int:
     return int(value)
 
 
+def _cell_size(value) -> Tuple[float, float]:
+    if isinstance(value, numbers.Real) and not isinstance(value, bool):
+        v = check_positive_float(value, "cell_size")
+        return (v, v)
+    try:
+        dx, dy = value
+    except (TypeError, ValueError):
+        raise TypeError(f"cell_size: expected a number or (dx, dy), got {value!r}") from None
+    return (check_positive_float(dx, "cell_size"), check_positive_float(dy, "cell_size"))
+
+
 def _edge_mismatch(z: np.ndarray) -> Optional[str]:
     """A description of the opposite edges of a periodic tile that do not
     join smoothly: the RMS step across the wrap (last row to first row, last
@@ -261,8 +272,9 @@ class Scene:
     dem : numpy.ndarray
         The heights (float64, read-only copy), metres; row 0 is north,
         columns go east.
-    cell_size : float
-        Cell side in metres (the DEM's units).
+    cell_size : tuple of float
+        ``(dx, dy)``: cell size east-west and north-south, in the unit of
+        the heights.
     periodic : bool
         Whether the DEM is one tile of an infinite periodic surface.
     material : Lambertian, OrenNayar or Phong
@@ -290,7 +302,8 @@ class Scene:
     tracing", *Eurographics '87*, 3-10, 1987.
     """
 
-    def __init__(self, dem: np.ndarray, cell_size: float, periodic: bool, material: Material, split: str):
+    def __init__(self, dem: np.ndarray, cell_size: Tuple[float, float], periodic: bool, material: Material,
+                 split: str):
         self.dem = dem
         self.cell_size = cell_size
         self.periodic = periodic
@@ -302,12 +315,12 @@ class Scene:
                 f"periodic={self.periodic}, material={self.material!r}, split={self.split!r})")
 
     @classmethod
-    def from_dem(cls, dem, cell_size: float = 1.0, periodic: bool = True,
+    def from_dem(cls, dem, cell_size: Union[float, Tuple[float, float]] = 1.0, periodic: bool = True,
                  material: Optional[Material] = None, split: str = "ne-sw") -> "Scene":
         """A scene of two triangular facets per DEM cell.
 
-        Vertex ``(r, c)`` sits at ``x = c * cell_size`` east, ``y = -r *
-        cell_size`` north, height ``dem[r, c]``. With ``split="ne-sw"`` the
+        Vertex ``(r, c)`` sits at ``x = c * dx`` east, ``y = -r * dy``
+        north, height ``dem[r, c]``. With ``split="ne-sw"`` the
         facets of a cell are (NW, SW, NE) and (NE, SW, SE), counter-clockwise
         seen from above, so normals point up.
 
@@ -315,8 +328,10 @@ class Scene:
         ----------
         dem : array_like, shape (rows, cols)
             Heights in the same unit as ``cell_size``; NaN is an error.
-        cell_size : float
-            Cell side (> 0).
+        cell_size : float or (float, float)
+            Cell side, or ``(dx, dy)`` east-west and north-south (> 0), in
+            the unit of the heights (e.g. the ``info["cell_size"]`` of the
+            bundled geographic DEMs, in metres).
         periodic : bool
             True: the DEM is one period of an infinite surface, ``rows x
             cols`` cells, the sample after the last column (row) being the
@@ -341,7 +356,7 @@ class Scene:
         >>> import numpy as np
         >>> from fractalgeo_rs.radiometry import Scene
         >>> Scene.from_dem(np.zeros((4, 5)), cell_size=30.0)
-        Scene(4 x 5 heights, cell_size=30.0, periodic=True, material=Lambertian(rho=0.5), split='ne-sw')
+        Scene(4 x 5 heights, cell_size=(30.0, 30.0), periodic=True, material=Lambertian(rho=0.5), split='ne-sw')
 
         References
         ----------
@@ -364,7 +379,7 @@ class Scene:
         need = 1 if periodic else 2
         if z.shape[0] < need or z.shape[1] < need:
             raise ValueError(f"dem: expected at least {need} x {need} heights, got {z.shape}")
-        cell_size = check_positive_float(cell_size, "cell_size")
+        cell_size = _cell_size(cell_size)
         if material is None:
             material = Lambertian(0.5)
         if not isinstance(material, (Lambertian, OrenNayar, Phong)):
@@ -379,7 +394,7 @@ class Scene:
         z.setflags(write=False)
         return cls(z, cell_size, periodic, material, split)
 
-    def _args(self) -> Tuple[np.ndarray, float, bool, str, str, List[float]]:
+    def _args(self) -> Tuple[np.ndarray, Tuple[float, float], bool, str, str, List[float]]:
         name, params = self.material._spec()
         return (self.dem, self.cell_size, self.periodic, self.split, name, params)
 
