@@ -97,18 +97,20 @@ def main() -> None:
     z, cell = tile(), 1.0
     scene = Scene.from_dem(z, cell_size=cell, material=Lambertian(args.rho))
 
-    # rays per CPU second, one thread
-    n = 400_000
+    # paths per second on one thread (wall) and per CPU second
+    n = 2_000_000
     for label, sun, depth in [("single scattering, sun 30 deg (1 primary + 1 shadow ray)", (90.0, 30.0), 1),
                               ("multiple scattering, max_depth 10", (90.0, 30.0), 10)]:
         _, wall, c = cpu(lambda: scene.brf(sun=sun, spp=n, max_depth=depth, n_threads=1))
-        print(f"{label}: {n / c / 1e6:.2f} M paths per CPU second ({wall:.2f} s wall)")
+        print(f"{label}: {n / wall / 1e6:.2f} M paths/s on one thread, {n / c / 1e6:.2f} M per CPU second")
     _, wall, c = cpu(lambda: scene.albedo(sun=(90.0, 30.0), spp=n, max_depth=1, n_threads=1))
-    print(f"albedo, max_depth 1 (a sun ray and an escape ray): {n / c / 1e6:.2f} M paths per CPU second")
+    print(f"albedo, max_depth 1 (a sun ray and an escape ray): {n / wall / 1e6:.2f} M paths/s on one thread, "
+          f"{n / c / 1e6:.2f} M per CPU second")
     big = Scene.from_dem(fg.fbm_surface((1024, 1024), 0.7, method="spectral", periodic=True, seed=2, sigma=0.5),
                          material=Lambertian(args.rho))
     _, wall, c = cpu(lambda: big.brf(sun=(90.0, 30.0), spp=n, max_depth=1, n_threads=1))
-    print(f"1024 x 1024 DEM, single scattering: {n / c / 1e6:.2f} M paths per CPU second")
+    print(f"1024 x 1024 DEM, single scattering: {n / wall / 1e6:.2f} M paths/s on one thread, "
+          f"{n / c / 1e6:.2f} M per CPU second")
 
     mi = None
     if not args.no_mitsuba:
