@@ -16,6 +16,7 @@
 //! | [`lsystem`] | L-systems, turtle geometry and IFS |
 //! | [`transform`] | moving-window maps of local dimension |
 //! | [`radar`] | speckle and side-looking SAR geometry |
+//! | [`radiometry`] | the virtual radiometric experiment: BRF, albedo and images of rough surfaces |
 //!
 //! Crate-level services that every domain may use (and that use no domain):
 //!
@@ -41,6 +42,7 @@ pub mod lsystem;
 pub mod parallel;
 pub mod progress;
 pub mod radar;
+pub mod radiometry;
 pub mod rng;
 pub mod sample;
 pub mod synth;

@@ -30,7 +30,7 @@ FOUNDATION = {"_core", "_warn", "_compat"}
 SERVICES = {"_validation", "_progress", "_backend", "_scales", "_zscale", "fit", "io", "plotting", "data",
             "_cli_common"}
 GEOMETRY = {"geometry"}
-DOMAINS = {"dimension", "synth", "transform", "dem", "lsystem", "tin", "radar"}
+DOMAINS = {"dimension", "synth", "transform", "dem", "lsystem", "tin", "radar", "radiometry"}
 TOP = {"__init__", "cli", "demo"}
 
 # The domains a domain may import (downward edges only).
@@ -42,6 +42,7 @@ DOMAIN_DEPS = {
     "dem": {"synth"},  # synth._common.resolve_seed: _validation.check_seed is the same function
     "tin": {"dem"},
     "radar": {"synth"},  # fBm surfaces for physical optics
+    "radiometry": set(),
 }
 
 # Edges that break the layers today and are being removed by the work of

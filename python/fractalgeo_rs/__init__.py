@@ -25,7 +25,7 @@ import types
 from typing import TYPE_CHECKING, Any, Dict, List, Optional
 
 if TYPE_CHECKING:  # the names for type checkers and IDEs (not executed)
-    from fractalgeo_rs import data, geometry, io, radar, tin
+    from fractalgeo_rs import data, geometry, io, radar, radiometry, tin
     from fractalgeo_rs._core import __version__
     from fractalgeo_rs.dem import fractal_resample, hillshade, lakes
     from fractalgeo_rs.dimension import (
@@ -68,6 +68,7 @@ _EXPORTS: Dict[str, Optional[str]] = {
     "geometry": None,
     "io": None,
     "radar": None,
+    "radiometry": None,
     "tin": None,
     # results
     "DimensionFit": "fractalgeo_rs.fit",

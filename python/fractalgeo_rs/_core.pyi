@@ -71,6 +71,9 @@ __all__ = [
     "radar_geometry",
     "radar_project",
     "speckle_f64",
+    "radiometry_albedo",
+    "radiometry_brf",
+    "radiometry_render",
 ]
 
 # ---- geometry ----
@@ -515,3 +518,46 @@ def radar_geocode(
     flags: npt.NDArray[np.uint8],
     n_threads: Optional[int] = None,
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
+# ---- radiometry ----
+def radiometry_brf(
+    dem: npt.NDArray[np.float64],
+    cell_size: Tuple[float, float],
+    periodic: bool,
+    split: str,
+    material: str,
+    params: Sequence[float],
+    sun: Tuple[float, float],
+    view: Tuple[float, float],
+    spp: int,
+    max_depth: int,
+    seed: int,
+    n_threads: Optional[int] = None,
+) -> Tuple[float, float, int]: ...
+def radiometry_albedo(
+    dem: npt.NDArray[np.float64],
+    cell_size: Tuple[float, float],
+    periodic: bool,
+    split: str,
+    material: str,
+    params: Sequence[float],
+    sun: Tuple[float, float],
+    spp: int,
+    max_depth: int,
+    seed: int,
+    n_threads: Optional[int] = None,
+) -> Tuple[float, float, int]: ...
+def radiometry_render(
+    dem: npt.NDArray[np.float64],
+    cell_size: Tuple[float, float],
+    periodic: bool,
+    split: str,
+    material: str,
+    params: Sequence[float],
+    sun: Tuple[float, float],
+    view: Tuple[float, float],
+    shape: Tuple[int, int],
+    spp: int,
+    max_depth: int,
+    seed: int,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float32]: ...

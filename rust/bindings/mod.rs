@@ -16,6 +16,7 @@ mod io;
 mod lsystem;
 mod progress;
 mod radar;
+mod radiometry;
 mod synth;
 mod tin;
 mod transform;
@@ -45,5 +46,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     transform::register(m)?;
     tin::register(m)?;
     radar::register(m)?;
+    radiometry::register(m)?;
     Ok(())
 }

@@ -1,0 +1,605 @@
+//! Tests against closed forms, invariants and an independent brute-force
+//! ray caster.
+use super::direction;
+use super::heightfield::{Heightfield, Split};
+use super::integrator::Scene;
+use super::material::{self, Bsdf};
+use super::oren_nayar::OrenNayar;
+use crate::error::CoreError;
+use crate::parallel::run_in_pool;
+use crate::rng::StreamKey;
+use glam::DVec3;
+
+/// A periodic rough surface: a sum of random Fourier modes of an `n x n`
+/// tile (heights in metres for 1 m cells), amplitude `amp`.
+fn rough(n: usize, amp: f64, seed: u64) -> Vec<f64> {
+    let k = StreamKey::new(seed, 0);
+    let mut z = vec![0.0; n * n];
+    let mut idx = 0;
+    for kx in -3i64..=3 {
+        for ky in -3i64..=3 {
+            if kx == 0 && ky == 0 {
+                continue;
+            }
+            let a = amp * (k.uniform(idx) - 0.5) / ((kx * kx + ky * ky) as f64).sqrt();
+            let ph = 2.0 * std::f64::consts::PI * k.uniform(idx + 1);
+            idx += 2;
+            for r in 0..n {
+                for c in 0..n {
+                    let arg = 2.0 * std::f64::consts::PI * (kx * c as i64 + ky * r as i64) as f64
+                        / n as f64;
+                    z[r * n + c] += a * (arg + ph).cos();
+                }
+            }
+        }
+    }
+    z
+}
+
+fn scene(z: &[f64], rows: usize, cols: usize, periodic: bool, mat: &str, p: &[f64]) -> Scene {
+    Scene {
+        hf: Heightfield::new(z, rows, cols, (1.0, 1.0), periodic, Split::NeSw).unwrap(),
+        material: material::from_name(mat, p).unwrap(),
+    }
+}
+
+fn dir(az: f64, zen: f64) -> DVec3 {
+    direction((az, zen), "sun").unwrap()
+}
+
+#[test]
+fn directions_follow_the_conventions() {
+    // (east, north, up): azimuth 90 = east, azimuth 0 = north
+    let e = dir(90.0, 90.0 - 1e-9);
+    assert!((e - DVec3::X).length() < 1e-6);
+    let n = dir(0.0, 60.0);
+    assert!((n - DVec3::new(0.0, 60f64.to_radians().sin(), 0.5)).length() < 1e-12);
+    for bad in [(0.0, 90.0), (0.0, -1.0), (f64::NAN, 0.0), (0.0, 120.0)] {
+        let e = direction(bad, "sun").unwrap_err().to_string();
+        assert!(e.starts_with("sun: "), "{e}");
+    }
+}
+
+/// Möller & Trumbore (1997) on explicit triangles (vertex `(r, c)` at
+/// `(c, -r, z)`) of `tiles x tiles` copies of the tile (periodic) or of the
+/// patch alone: the nearest hit's t and normal.
+fn brute(
+    z: &[f64],
+    rows: usize,
+    cols: usize,
+    periodic: bool,
+    o: DVec3,
+    d: DVec3,
+    tiles: i64,
+) -> Option<(f64, DVec3)> {
+    let h = |r: i64, c: i64| {
+        z[(r.rem_euclid(rows as i64) as usize) * cols + c.rem_euclid(cols as i64) as usize]
+    };
+    let (ncr, ncc) = if periodic {
+        (rows as i64, cols as i64)
+    } else {
+        (rows as i64 - 1, cols as i64 - 1)
+    };
+    let range = if periodic { -tiles..=tiles } else { 0..=0 };
+    let mut best: Option<(f64, DVec3)> = None;
+    for ty in range.clone() {
+        for tx in range.clone() {
+            for r in 0..ncr {
+                for c in 0..ncc {
+                    let (gx, gy) = (c + tx * ncc, r + ty * ncr);
+                    let v = |dr: i64, dc: i64| {
+                        DVec3::new((gx + dc) as f64, -((gy + dr) as f64), h(r + dr, c + dc))
+                    };
+                    let (nw, ne, sw, se) = (v(0, 0), v(0, 1), v(1, 0), v(1, 1));
+                    for tri in [[nw, ne, sw], [ne, se, sw]] {
+                        let e1 = tri[1] - tri[0];
+                        let e2 = tri[2] - tri[0];
+                        let pv = d.cross(e2);
+                        let det = e1.dot(pv);
+                        if det.abs() < 1e-14 {
+                            continue;
+                        }
+                        let tv = o - tri[0];
+                        let u = tv.dot(pv) / det;
+                        let qv = tv.cross(e1);
+                        let w = d.dot(qv) / det;
+                        let t = e2.dot(qv) / det;
+                        if u >= 0.0
+                            && w >= 0.0
+                            && u + w <= 1.0
+                            && t > 1e-10
+                            && best.is_none_or(|b| t < b.0)
+                        {
+                            let mut n = e1.cross(e2).normalize();
+                            if n.z < 0.0 {
+                                n = -n;
+                            }
+                            best = Some((t, n));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    best
+}
+
+#[test]
+fn traversal_agrees_with_brute_force_periodic_and_not() {
+    let (rows, cols) = (5, 7);
+    let z = rough(7, 3.0, 4)[..rows * cols].to_vec();
+    let key = StreamKey::new(11, 1);
+    for periodic in [true, false] {
+        let hf = Heightfield::new(&z, rows, cols, (1.0, 1.0), periodic, Split::NeSw).unwrap();
+        let mut hits = 0;
+        for i in 0..3000u64 {
+            let u = |k: u64| key.uniform(10 * i + k);
+            let o = DVec3::new(
+                u(0) * 9.0 - 1.0,
+                1.0 - u(1) * 7.0,
+                hf.zmin + u(2) * (hf.zmax - hf.zmin + 2.0),
+            );
+            // directions mostly downward but some climbing, some grazing
+            let d = DVec3::new(u(3) - 0.5, u(4) - 0.5, -0.9 * u(5) + 0.25).normalize();
+            let mine = hf.intersect(o, d, None);
+            let theirs = brute(&z, rows, cols, periodic, o, d, 6);
+            // origin below the surface: both may disagree on which side; skip
+            let below = {
+                let probe = hf.intersect(DVec3::new(o.x, o.y, hf.zmax + 1.0), -DVec3::Z, None);
+                probe.is_some_and(|p| hf.zmax + 1.0 - p.t > o.z)
+            };
+            if below {
+                continue;
+            }
+            match (mine, theirs) {
+                (Some(a), Some((t, n))) => {
+                    hits += 1;
+                    assert!(
+                        (a.t - t).abs() < 1e-9 * (1.0 + t),
+                        "periodic={periodic} i={i} {} {t}",
+                        a.t
+                    );
+                    assert!((a.normal - n).length() < 1e-9);
+                }
+                (None, None) => {}
+                // the brute force sees only 13 x 13 tiles: a far hit it misses is fine
+                (Some(a), None) if periodic && a.t > 6.0 * 5.0 => {}
+                (a, b) => panic!("periodic={periodic} i={i}: {a:?} vs {b:?} o={o} d={d}"),
+            }
+        }
+        assert!(hits > if periodic { 1000 } else { 300 }, "{hits}");
+    }
+}
+
+#[test]
+fn flat_plane_brf_and_albedo_are_rho_exactly() {
+    let z = vec![2.5; 16];
+    for periodic in [true, false] {
+        let s = scene(&z, 4, 4, periodic, "lambertian", &[0.37]);
+        for (sun, view) in [
+            ((0.0, 0.0), (0.0, 0.0)),
+            ((135.0, 60.0), (10.0, 30.0)),
+            ((270.0, 85.0), (90.0, 0.0)),
+        ] {
+            for depth in [1, 5] {
+                let e = s
+                    .brf(dir(sun.0, sun.1), dir(view.0, view.1), 2000, depth, 1)
+                    .unwrap();
+                if periodic || (sun.1 == 0.0 && view.1 == 0.0) {
+                    assert!(
+                        (e.value - 0.37).abs() < 1e-6,
+                        "{periodic} {sun:?} {view:?} {e:?}"
+                    );
+                    assert!(e.se < 1e-6);
+                }
+            }
+            if periodic {
+                let a = s.albedo(dir(sun.0, sun.1), 2000, 5, 1).unwrap();
+                assert!((a.value - 0.37).abs() < 1e-6 && a.se < 1e-6, "{a:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn nadir_single_scattering_is_the_area_weighted_nz() {
+    let n = 12;
+    let z = rough(n, 4.0, 2);
+    let rho = 0.6;
+    // independent facet sums from explicit vertices
+    let h = |r: usize, c: usize| z[(r % n) * n + c % n];
+    let (mut num, mut den) = (0.0, 0.0);
+    for r in 0..n {
+        for c in 0..n {
+            let v = |dr: usize, dc: usize| {
+                DVec3::new((c + dc) as f64, -((r + dr) as f64), h(r + dr, c + dc))
+            };
+            for [a, b, cc] in [[v(0, 0), v(1, 0), v(0, 1)], [v(0, 1), v(1, 0), v(1, 1)]] {
+                let cr = (b - a).cross(cc - a); // counter-clockwise from above: up
+                assert!(cr.z > 0.0);
+                let area = 0.5 * cr.length();
+                let nz = cr.z / cr.length();
+                num += area * nz * nz;
+                den += area * nz;
+            }
+        }
+    }
+    let expect = rho * num / den;
+    let s = scene(&z, n, n, true, "lambertian", &[rho]);
+    let e = s.brf(DVec3::Z, DVec3::Z, 200_000, 1, 3).unwrap();
+    assert!((e.value - expect).abs() < 3.0 * e.se, "{e:?} vs {expect}");
+    assert!(expect < 0.95 * rho); // the surface is rough enough to matter
+}
+
+fn v_grooves(slope_deg: f64, n: usize) -> Vec<f64> {
+    // grooves along the rows (north-south), period 2 columns
+    let h = slope_deg.to_radians().tan();
+    let mut z = vec![0.0; n * n];
+    for r in 0..n {
+        for c in 0..n {
+            z[r * n + c] = if c % 2 == 0 { 0.0 } else { h };
+        }
+    }
+    z
+}
+
+#[test]
+fn v_grooves_single_scattering_nadir_is_rho_cos_s_for_any_sun() {
+    let s_deg: f64 = 30.0;
+    let z = v_grooves(s_deg, 8);
+    let rho = 0.8;
+    let expect = rho * s_deg.to_radians().cos();
+    let sc = scene(&z, 8, 8, true, "lambertian", &[rho]);
+    // sun across the grooves (azimuth 90/270), along them (0), oblique; lit
+    // and shadowed (theta + s > 90, tan s tan theta > 1)
+    for (az, zen) in [
+        (0.0, 0.0),
+        (90.0, 20.0),
+        (270.0, 45.0),
+        (90.0, 70.0),
+        (90.0, 80.0),
+        (0.0, 75.0),
+        (40.0, 65.0),
+    ] {
+        let e = sc.brf(dir(az, zen), DVec3::Z, 100_000, 1, 5).unwrap();
+        assert!(
+            (e.value - expect).abs() < 3.0 * e.se + 1e-9,
+            "sun ({az}, {zen}): {e:?} vs {expect}"
+        );
+    }
+    // the oblique closed form in the plane across the grooves, nadir view:
+    // L = rho/pi E 1/2 [f1 cos(theta - s) + f2 cos(theta + s)]; as BRF / cos(theta)
+    // (f1 = min(1, 2/(1 + tan s tan theta)), f2 = 1 iff theta + s < 90).
+    for zen in [20.0f64, 50.0, 70.0] {
+        let (t, s) = (zen.to_radians(), s_deg.to_radians());
+        let f1 = (2.0 / (1.0 + s.tan() * t.tan())).min(1.0);
+        let f2 = if t + s < std::f64::consts::FRAC_PI_2 {
+            1.0
+        } else {
+            0.0
+        };
+        let brf = rho * 0.5 * (f1 * (t - s).cos() + f2 * (t + s).cos()) / t.cos();
+        assert!((brf - expect).abs() < 1e-12); // the identity, checked by hand
+    }
+}
+
+#[test]
+fn energy_is_conserved_with_rho_one() {
+    let z = rough(16, 6.0, 9);
+    let s = scene(&z, 16, 16, true, "lambertian", &[1.0]);
+    for zen in [0.0, 45.0, 80.0] {
+        let a = s.albedo(dir(30.0, zen), 20_000, 1000, 2).unwrap();
+        assert!((a.value - 1.0).abs() < 1e-3, "zenith {zen}: {a:?}");
+    }
+    // and with fewer bounces some energy is still trapped
+    let a = s.albedo(dir(30.0, 45.0), 20_000, 1, 2).unwrap();
+    assert!(a.value < 0.995, "{a:?}");
+}
+
+#[test]
+fn brf_is_reciprocal() {
+    let z = rough(16, 5.0, 21);
+    for (mat, p) in [("lambertian", vec![0.5]), ("oren-nayar", vec![0.7, 0.4])] {
+        let s = scene(&z, 16, 16, true, mat, &p);
+        for ((a1, z1), (a2, z2)) in [((0.0, 30.0), (180.0, 50.0)), ((45.0, 60.0), (100.0, 20.0))] {
+            let (sun, view) = (dir(a1, z1), dir(a2, z2));
+            let f = s.brf(sun, view, 200_000, 6, 7).unwrap();
+            let b = s.brf(view, sun, 200_000, 6, 8).unwrap();
+            // BRF * cos(sun) is the symmetric quantity; here the pair
+            // BRF(sun, view) and BRF(view, sun) are equal as factors
+            let tol = 3.0 * (f.se * f.se + b.se * b.se).sqrt();
+            assert!((f.value - b.value).abs() < tol, "{mat}: {f:?} vs {b:?}");
+        }
+    }
+}
+
+#[test]
+fn single_scattering_never_exceeds_multiple() {
+    let z = rough(16, 5.0, 3);
+    let mut last_share = f64::INFINITY;
+    for rho in [0.9, 0.3, 0.05, 0.01] {
+        let s = scene(&z, 16, 16, true, "lambertian", &[rho]);
+        let (sun, view) = (dir(10.0, 40.0), dir(200.0, 25.0));
+        let one = s.brf(sun, view, 20_000, 1, 4).unwrap();
+        let many = s.brf(sun, view, 20_000, 20, 4).unwrap();
+        assert!(one.value <= many.value, "{one:?} {many:?}");
+        // the multiple-scattering share goes to 0 with rho (about as rho)
+        let share = (many.value - one.value) / many.value;
+        assert!(share < last_share, "{rho}: {share}");
+        last_share = share;
+    }
+    assert!(last_share < 0.02, "{last_share}");
+}
+
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    let z = rough(8, 4.0, 5);
+    let s = scene(&z, 8, 8, true, "lambertian", &[0.4]);
+    let go = |n| {
+        run_in_pool(Some(n), || {
+            Ok((
+                s.brf(dir(0.0, 30.0), dir(90.0, 10.0), 5000, 4, 9)?,
+                s.albedo(dir(0.0, 30.0), 5000, 4, 9)?,
+                s.render(dir(0.0, 30.0), DVec3::Z, (9, 11), 4, 3, 9)?,
+            ))
+        })
+        .unwrap()
+    };
+    let (a, b) = (go(1), go(2));
+    assert_eq!(a.0, b.0);
+    assert_eq!(a.1, b.1);
+    assert_eq!(a.2, b.2);
+}
+
+#[test]
+fn image_mean_is_the_brf() {
+    // flat: every pixel is rho/pi cos(theta) exactly
+    let s = scene(&[1.0; 9], 3, 3, true, "lambertian", &[0.5]);
+    let img = s.render(dir(0.0, 60.0), DVec3::Z, (4, 5), 3, 2, 0).unwrap();
+    for v in img {
+        assert!((v as f64 - 0.5 / std::f64::consts::PI * 0.5).abs() < 1e-7);
+    }
+}
+
+#[test]
+fn non_periodic_patches_lose_light_at_the_edges() {
+    let z = rough(16, 5.0, 1);
+    let p = scene(&z, 16, 16, true, "lambertian", &[1.0]);
+    let f = scene(&z, 16, 16, false, "lambertian", &[1.0]);
+    let sun = dir(90.0, 70.0);
+    let ap = p.albedo(sun, 20_000, 200, 1).unwrap();
+    let af = f.albedo(sun, 20_000, 200, 1).unwrap();
+    assert!((ap.value - 1.0).abs() < 1e-3);
+    assert!(af.value < 0.99, "{af:?}"); // sun rays leave through the sides
+}
+
+#[test]
+fn oren_nayar_matches_its_closed_form() {
+    let (rho, sigma) = (0.6, 0.35);
+    let on = OrenNayar::new(rho, sigma).unwrap();
+    let s2 = sigma * sigma;
+    let (a, b) = (1.0 - 0.5 * s2 / (s2 + 0.33), 0.45 * s2 / (s2 + 0.09));
+    let key = StreamKey::new(3, 3);
+    let pi = std::f64::consts::PI;
+    for i in 0..2000u64 {
+        let (ti, to) = (key.uniform(4 * i) * 1.5, key.uniform(4 * i + 1) * 1.5);
+        let (pi_, po) = (
+            key.uniform(4 * i + 2) * 2.0 * pi,
+            key.uniform(4 * i + 3) * 2.0 * pi,
+        );
+        let w = |t: f64, p: f64| DVec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos());
+        let (al, be) = (ti.max(to), ti.min(to));
+        let expect = rho / pi * (a + b * (pi_ - po).cos().max(0.0) * al.sin() * be.tan());
+        let got = on.eval(w(ti, pi_), w(to, po));
+        assert!((got - expect).abs() < 1e-12, "{got} {expect}");
+        assert!((got - on.eval(w(to, po), w(ti, pi_))).abs() < 1e-15); // reciprocal
+    }
+    // nadir view: f = rho A / pi for any light
+    assert!((on.eval(DVec3::new(0.6, 0.0, 0.8), DVec3::Z) - rho * a / pi).abs() < 1e-15);
+    // energy bound at rho = 1, any view
+    let one = OrenNayar::new(1.0, 1.0).unwrap();
+    for t in [0.0f64, 0.5, 1.0, 1.4, 1.55] {
+        let alb = one.albedo(DVec3::new(t.sin(), 0.0, t.cos()));
+        assert!(alb <= 1.0 && alb > 0.5, "{t}: {alb}");
+    }
+}
+
+#[test]
+fn cosine_sampler_passes_chi_square() {
+    // cos^2(theta) of a cosine-weighted direction is uniform on (0, 1)
+    let l = material::from_name("lambertian", &[1.0]).unwrap();
+    let key = StreamKey::new(1, 2);
+    let (bins, n) = (20usize, 100_000u64);
+    let mut count = vec![0u64; bins];
+    for i in 0..n {
+        let s = l
+            .sample(DVec3::Z, [key.uniform(2 * i), key.uniform(2 * i + 1)])
+            .unwrap();
+        assert!((s.pdf - l.pdf(s.wi, DVec3::Z)).abs() < 1e-15);
+        count[((s.wi.z * s.wi.z * bins as f64) as usize).min(bins - 1)] += 1;
+    }
+    let e = n as f64 / bins as f64;
+    let chi2: f64 = count.iter().map(|&c| (c as f64 - e).powi(2) / e).sum();
+    assert!(chi2 < 43.8, "{chi2}"); // 19 dof, p = 0.001
+}
+
+#[test]
+fn bad_input_names_the_parameter() {
+    let p = |e: CoreError| match e {
+        CoreError::InvalidArgument { param, .. } => param,
+        CoreError::OutOfMemory { param, .. } => format!("oom:{param}"),
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(
+        p(material::from_name("lambertian", &[1.5]).unwrap_err()),
+        "rho"
+    );
+    assert_eq!(
+        p(material::from_name("oren-nayar", &[0.5, -1.0]).unwrap_err()),
+        "sigma"
+    );
+    assert_eq!(
+        p(material::from_name("hapke", &[0.5]).unwrap_err()),
+        "material"
+    );
+    assert_eq!(
+        p(Heightfield::new(
+            &[0.0, f64::NAN, 0.0, 0.0],
+            2,
+            2,
+            (1.0, 1.0),
+            true,
+            Split::NeSw
+        )
+        .unwrap_err()),
+        "dem"
+    );
+    assert_eq!(
+        p(Heightfield::new(&[0.0; 4], 2, 2, (1.0, 0.0), true, Split::NeSw).unwrap_err()),
+        "cell_size"
+    );
+    assert_eq!(
+        p(Heightfield::new(&[0.0; 2], 1, 2, (1.0, 1.0), false, Split::NeSw).unwrap_err()),
+        "dem"
+    );
+    let s = scene(&[0.0; 4], 2, 2, true, "lambertian", &[0.5]);
+    assert_eq!(p(s.brf(DVec3::Z, DVec3::Z, 0, 1, 0).unwrap_err()), "spp");
+    assert_eq!(
+        p(s.brf(DVec3::Z, DVec3::Z, 1, 0, 0).unwrap_err()),
+        "max_depth"
+    );
+    assert_eq!(
+        p(s.render(DVec3::Z, DVec3::Z, (100_000, 10_000), 1, 1, 0)
+            .unwrap_err()),
+        "oom:shape"
+    );
+    assert_eq!(
+        p(s.render(DVec3::Z, DVec3::Z, (0, 3), 1, 1, 0).unwrap_err()),
+        "shape"
+    );
+}
+
+#[test]
+fn nw_se_split_is_also_exact() {
+    // a single tilted plane gives the same facets under either split
+    let mut z = vec![0.0; 16];
+    for r in 0..4 {
+        for c in 0..4 {
+            z[r * 4 + c] = 0.3 * c as f64 + 0.1 * r as f64;
+        }
+    }
+    let a = Heightfield::new(&z, 4, 4, (1.0, 1.0), false, Split::NeSw).unwrap();
+    let b = Heightfield::new(&z, 4, 4, (1.0, 1.0), false, Split::NwSe).unwrap();
+    let o = DVec3::new(1.3, -1.7, 10.0);
+    let (ha, hb) = (
+        a.intersect(o, -DVec3::Z, None).unwrap(),
+        b.intersect(o, -DVec3::Z, None).unwrap(),
+    );
+    assert!((ha.t - hb.t).abs() < 1e-12 && (ha.normal - hb.normal).length() < 1e-12);
+    assert!((10.0 - ha.t - (0.3 * 1.3 + 0.1 * 1.7)).abs() < 1e-12);
+}
+
+#[test]
+fn phong_matches_its_closed_form_and_its_sampler_its_density() {
+    use super::phong::Phong;
+    let pi = std::f64::consts::PI;
+    let (kd, ks, n) = (0.3, 0.6, 12.0);
+    let ph = Phong::new(kd, ks, n).unwrap();
+    let key = StreamKey::new(5, 5);
+    let w = |t: f64, p: f64| DVec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos());
+    for i in 0..2000u64 {
+        let (ti, to) = (key.uniform(4 * i) * 1.5, key.uniform(4 * i + 1) * 1.5);
+        let (pi_, po) = (
+            key.uniform(4 * i + 2) * 2.0 * pi,
+            key.uniform(4 * i + 3) * 2.0 * pi,
+        );
+        // angle to the mirror direction (theta_o, phi_o + pi)
+        let ca = ti.cos() * to.cos() - ti.sin() * to.sin() * (pi_ - po).cos();
+        let expect = kd / pi + ks * (n + 2.0) / (2.0 * pi) * ca.max(0.0).powf(n);
+        let got = ph.eval(w(ti, pi_), w(to, po));
+        assert!(
+            (got - expect).abs() < 1e-12 * (1.0 + expect),
+            "{got} {expect}"
+        );
+        assert!((got - ph.eval(w(to, po), w(ti, pi_))).abs() < 1e-12 * (1.0 + got));
+    }
+    // normal incidence: albedo kd + ks exactly (quadrature to 1e-4)
+    assert!((ph.albedo(DVec3::Z) - (kd + ks)).abs() < 1e-4);
+    // the sampler's mean weight is the albedo (its pdf is its density)
+    for t in [0.0f64, 0.7, 1.3] {
+        let wo = DVec3::new(t.sin(), 0.0, t.cos());
+        let m = 400_000u64;
+        let (mut s1, mut s2) = (0.0, 0.0);
+        for i in 0..m {
+            if let Some(smp) = ph.sample(
+                wo,
+                [key.uniform(10_000 + 2 * i), key.uniform(10_001 + 2 * i)],
+            ) {
+                assert!((smp.pdf - ph.pdf(smp.wi, wo)).abs() < 1e-12 * (1.0 + smp.pdf));
+                s1 += smp.weight;
+                s2 += smp.weight * smp.weight;
+            }
+        }
+        let mean = s1 / m as f64;
+        let se = ((s2 / m as f64 - mean * mean) / m as f64).sqrt();
+        let alb = ph.albedo(wo);
+        assert!(
+            (mean - alb).abs() < 4.0 * se + 1e-4,
+            "{t}: {mean} +- {se} vs {alb}"
+        );
+        assert!(alb <= kd + ks + 1e-4);
+    }
+    // the lobe alone around the normal: cos(alpha)^(n+1) is uniform
+    let lobe = Phong::new(0.0, 1.0, n).unwrap();
+    let (bins, m) = (20usize, 100_000u64);
+    let mut count = vec![0u64; bins];
+    for i in 0..m {
+        let s = lobe
+            .sample(DVec3::Z, [key.uniform(2 * i), key.uniform(2 * i + 1)])
+            .unwrap();
+        count[((s.wi.z.powf(n + 1.0) * bins as f64) as usize).min(bins - 1)] += 1;
+    }
+    let e = m as f64 / bins as f64;
+    let chi2: f64 = count.iter().map(|&c| (c as f64 - e).powi(2) / e).sum();
+    assert!(chi2 < 43.8, "{chi2}");
+    assert!(Phong::new(0.6, 0.6, 2.0).is_err());
+}
+
+#[test]
+fn rectangular_cells_give_world_normals_and_exact_nadir_brf() {
+    // the plane z = gx x + gy y (x east, y north) sampled with cells 2 m x 3 m
+    let (gx, gy, dx, dy) = (0.4, -0.25, 2.0, 3.0);
+    let (rows, cols) = (5, 6);
+    let mut z = vec![0.0; rows * cols];
+    for r in 0..rows {
+        for c in 0..cols {
+            z[r * cols + c] = gx * c as f64 * dx + gy * (-(r as f64) * dy);
+        }
+    }
+    let n = DVec3::new(-gx, -gy, 1.0).normalize();
+    for split in [Split::NeSw, Split::NwSe] {
+        let hf = Heightfield::new(&z, rows, cols, (dx, dy), false, split).unwrap();
+        let (x, y) = (3.7, -5.1);
+        let hit = hf
+            .intersect(DVec3::new(x, y, 100.0), -DVec3::Z, None)
+            .unwrap();
+        assert!((100.0 - hit.t - (gx * x + gy * y)).abs() < 1e-12);
+        assert!((hit.normal - n).length() < 1e-12);
+        // an oblique ray too
+        let d = DVec3::new(0.3, -0.2, -0.9).normalize();
+        let o = DVec3::new(1.0, -2.0, 5.0);
+        let hit = hf.intersect(o, d, None).unwrap();
+        let p = o + hit.t * d;
+        assert!((p.z - (gx * p.x + gy * p.y)).abs() < 1e-9);
+        for (area, nn) in hf.facets() {
+            assert!((area - 0.5 * dx * dy / n.z).abs() < 1e-12 && (nn - n).length() < 1e-12);
+        }
+        // nadir sun and view on a plane: BRF = rho n_z exactly
+        let s = Scene {
+            hf,
+            material: material::from_name("lambertian", &[0.6]).unwrap(),
+        };
+        let e = s.brf(DVec3::Z, DVec3::Z, 1000, 3, 0).unwrap();
+        assert!((e.value - 0.6 * n.z).abs() < 1e-9, "{e:?}");
+    }
+}

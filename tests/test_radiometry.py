@@ -1,0 +1,327 @@
+"""The radiometric experiment against closed forms and invariants.
+
+Expected values never come from the code under test: the facet sums are
+computed here from the DEM with NumPy, the V-groove and flat-plane values
+are closed forms, and energy conservation, reciprocity and the ordering of
+single and multiple scattering are physical invariants.
+"""
+import numpy as np
+import pytest
+
+import fractalgeo_rs as fg
+from fractalgeo_rs.radiometry import Estimate, Lambertian, OrenNayar, Phong, Scene
+
+
+def periodic_surface(n=16, amp=4.0, seed=0, modes=3):
+    """A periodic rough surface: random Fourier modes with a 1/k spectrum."""
+    rng = np.random.default_rng(seed)
+    r, c = np.mgrid[0:n, 0:n]
+    z = np.zeros((n, n))
+    for kx in range(-modes, modes + 1):
+        for ky in range(-modes, modes + 1):
+            if kx == 0 and ky == 0:
+                continue
+            a = amp * rng.standard_normal() / np.hypot(kx, ky) ** 1.5
+            z += a * np.cos(2 * np.pi * (kx * c + ky * r) / n + rng.uniform(0, 2 * np.pi))
+    return z
+
+
+def grooves(slope_deg, n=8, cell=1.0):
+    """Periodic V-grooves along the rows (north-south), period 2 cells."""
+    h = cell * np.tan(np.radians(slope_deg))
+    return np.where(np.arange(n) % 2 == 1, h, 0.0)[None, :].repeat(n, 0)
+
+
+def facet_sums(z, cell=1.0, cell_y=None):
+    """sum(A nz^2), sum(A nz) over the NE-SW facets of a periodic DEM with
+    cells ``cell`` (east-west) by ``cell_y`` (north-south, default ``cell``)."""
+    cy = cell if cell_y is None else cell_y
+    zp = np.pad(z, ((0, 1), (0, 1)), mode="wrap")
+    # corner: (east, north) offset in cells, heights of that corner of every cell
+    corner = {"nw": ((0, 0), zp[:-1, :-1]), "ne": ((1, 0), zp[:-1, 1:]),
+              "sw": ((0, -1), zp[1:, :-1]), "se": ((1, -1), zp[1:, 1:])}
+    num = den = 0.0
+    for tri in (("nw", "sw", "ne"), ("ne", "sw", "se")):
+        (pa, a), (pb, b), (pc, c) = (corner[k] for k in tri)
+
+        def edge(p, h):
+            return np.stack([np.full_like(a, (p[0] - pa[0]) * cell), np.full_like(a, (p[1] - pa[1]) * cy), h - a], -1)
+
+        cr = np.cross(edge(pb, b), edge(pc, c))
+        length = np.linalg.norm(cr, axis=-1)
+        assert (cr[..., 2] > 0).all()  # counter-clockwise seen from above
+        area, nz = 0.5 * length, cr[..., 2] / length
+        num += float(np.sum(area * nz * nz))
+        den += float(np.sum(area * nz))
+    return num, den
+
+
+def close(e, expect, k=3.0):
+    return abs(e.value - expect) <= k * e.se + 1e-9
+
+
+@pytest.mark.parametrize("periodic", [True, False])
+def test_flat_plane_is_rho_for_every_direction(periodic):
+    s = Scene.from_dem(np.full((5, 6), 12.0), cell_size=30.0, periodic=periodic, material=Lambertian(0.42))
+    for sun, view in [((0, 0), "nadir"), ((135, 60), (10, 30)), ((270, 85), (90, 0)), ((10, 30), (190, 70))]:
+        for depth in (1, 4):
+            e = s.brf(sun=sun, view=view, spp=3000, max_depth=depth)
+            if periodic or (sun[1] == 0 and view == "nadir"):
+                assert abs(e.value - 0.42) < 1e-6 and e.se < 1e-6, (sun, view, e)
+    if periodic:
+        for zen in (0, 45, 80):
+            a = s.albedo(sun=(33, zen), spp=3000)
+            assert abs(a.value - 0.42) < 1e-6 and a.se < 1e-6
+
+
+def test_nadir_single_scattering_is_the_facet_mean_of_nz():
+    z = periodic_surface(16, 5.0, seed=3)
+    num, den = facet_sums(z, cell=2.0)
+    rho = 0.7
+    s = Scene.from_dem(z, cell_size=2.0, material=Lambertian(rho))
+    e = s.brf(sun=(0, 0), view=(0, 0), spp=200_000, max_depth=1, seed=1)
+    assert close(e, rho * num / den), (e, rho * num / den)
+    assert rho * num / den < 0.97 * rho
+    # rectangular cells (a geographic DEM's metres east-west and north-south)
+    num, den = facet_sums(z, cell=1.5, cell_y=3.0)
+    s = Scene.from_dem(z, cell_size=(1.5, 3.0), material=Lambertian(rho))
+    e = s.brf(sun=(0, 0), view=(0, 0), spp=200_000, max_depth=1, seed=1)
+    assert close(e, rho * num / den), (e, rho * num / den)
+
+
+def test_v_grooves_nadir_single_scattering_is_rho_cos_s():
+    s_deg, rho = 25.0, 0.9
+    sc = Scene.from_dem(grooves(s_deg), material=Lambertian(rho))
+    expect = rho * np.cos(np.radians(s_deg))
+    # unshadowed and shadowed suns (across the grooves at 75 and 85 degrees)
+    for sun in [(0, 0), (90, 30), (270, 50), (0, 80), (45, 60), (90, 75), (270, 85)]:
+        e = sc.brf(sun=sun, spp=100_000, max_depth=1, seed=2)
+        assert close(e, expect), (sun, e, expect)
+
+
+@pytest.mark.parametrize("zenith", [0.0, 45.0, 80.0])
+def test_white_periodic_surface_reflects_everything(zenith):
+    z = fg.fbm_surface((32, 32), 0.5, method="spectral", periodic=True, seed=4, sigma=3.0)
+    s = Scene.from_dem(z, material=Lambertian(1.0))
+    a = s.albedo(sun=(60.0, zenith), spp=20_000, max_depth=2000, seed=5)
+    assert abs(a.value - 1.0) < 1e-3, a
+    assert s.albedo(sun=(60.0, zenith), spp=20_000, max_depth=1, seed=5).value < 1.0
+
+
+@pytest.mark.parametrize("material", [Lambertian(0.6), OrenNayar(0.6, 0.5), Phong(0.3, 0.4, 10.0)])
+def test_brf_is_reciprocal(material):
+    z = fg.fbm_surface((16, 16), 0.7, method="spectral", periodic=True, seed=6, sigma=2.0)
+    s = Scene.from_dem(z, material=material)
+    for a, b in [((0, 35), (180, 55)), ((70, 60), (300, 15))]:
+        f = s.brf(sun=a, view=b, spp=200_000, max_depth=5, seed=1)
+        g = s.brf(sun=b, view=a, spp=200_000, max_depth=5, seed=2)
+        assert abs(f.value - g.value) < 3 * np.hypot(f.se, g.se), (a, b, f, g)
+
+
+def test_single_scattering_never_exceeds_multiple():
+    z = periodic_surface(16, 1.5, seed=8)
+    last = np.inf
+    for rho in (0.9, 0.5, 0.1, 0.01):
+        s = Scene.from_dem(z, material=Lambertian(rho))
+        one = s.brf(sun=(20, 50), view=(250, 30), spp=20_000, max_depth=1, seed=3)
+        many = s.brf(sun=(20, 50), view=(250, 30), spp=20_000, max_depth=30, seed=3)
+        assert one.value <= many.value  # same paths: multiple adds non-negative terms
+        share = (many.value - one.value) / many.value
+        assert share < last, (rho, share)  # goes to 0 with rho
+        last = share
+    assert last < 0.02
+
+
+def test_results_identical_for_any_thread_count():
+    s = Scene.from_dem(periodic_surface(12, 4.0, seed=9), material=OrenNayar(0.5, 0.3))
+    for f in (lambda n: s.brf(sun=(10, 40), view=(100, 20), spp=5000, max_depth=4, n_threads=n),
+              lambda n: s.albedo(sun=(10, 40), spp=5000, max_depth=4, n_threads=n)):
+        assert f(1) == f(2)
+    a = s.render(sun=(10, 40), shape=(7, 9), spp=3, n_threads=1)
+    b = s.render(sun=(10, 40), shape=(7, 9), spp=3, n_threads=2)
+    assert a.dtype == np.float32 and a.shape == (7, 9)
+    np.testing.assert_array_equal(a, b)
+
+
+def test_image_mean_estimates_the_brf():
+    z = periodic_surface(8, 3.0, seed=10)
+    s = Scene.from_dem(z, material=Lambertian(0.5))
+    img = s.render(sun=(0, 30), view=(45, 20), shape=(16, 16), spp=200, max_depth=3, seed=7)
+    brf = s.brf(sun=(0, 30), view=(45, 20), spp=400_000, max_depth=3, seed=8)
+    per_pixel = np.pi * img.astype(np.float64) / np.cos(np.radians(30))
+    se_img = per_pixel.std() / np.sqrt(img.size)  # pixels are independent
+    assert abs(per_pixel.mean() - brf.value) < 4 * np.hypot(se_img, brf.se) + 1e-3
+
+
+def test_a_finite_patch_loses_light_through_its_sides():
+    z = periodic_surface(16, 5.0, seed=11)
+    tile = Scene.from_dem(z, material=Lambertian(1.0))
+    patch = Scene.from_dem(z, periodic=False, material=Lambertian(1.0))
+    assert abs(tile.albedo(sun=(90, 70), spp=20_000, max_depth=300).value - 1.0) < 1e-3
+    assert patch.albedo(sun=(90, 70), spp=20_000, max_depth=300).value < 0.99
+
+
+def test_bad_input_is_a_clear_error():
+    z = np.zeros((4, 4))
+    s = Scene.from_dem(z)
+    with pytest.raises(ValueError, match=r"^sun: zenith must be in \[0, 90\)"):
+        s.brf(sun=(0, 90))
+    with pytest.raises(ValueError, match="^view: zenith"):
+        s.brf(sun=(0, 10), view=(0, 95))
+    with pytest.raises(TypeError, match="^sun: expected"):
+        s.albedo(sun=30.0)
+    with pytest.raises(ValueError, match="^rho: expected a reflectance in"):
+        Lambertian(1.5)
+    with pytest.raises(ValueError, match="^rho"):
+        OrenNayar(-0.1, 0.2)
+    with pytest.raises(ValueError, match="^sigma"):
+        OrenNayar(0.5, float("nan"))
+    with pytest.raises(ValueError, match=r"^ks: expected kd \+ ks <= 1"):
+        Phong(0.6, 0.6, 5.0)
+    with pytest.raises(ValueError, match="^exponent"):
+        Phong(0.2, 0.2, -1.0)
+    bad = z.copy()
+    bad[2, 1] = np.nan
+    with pytest.raises(ValueError, match="^dem: expected finite heights.*row 2, column 1"):
+        Scene.from_dem(bad)
+    with pytest.raises(ValueError, match="^dem: expected a 2D"):
+        Scene.from_dem(np.zeros(5))
+    with pytest.raises(ValueError, match="^spp"):
+        s.brf(sun=(0, 0), spp=0)
+    with pytest.raises(ValueError, match="^max_depth"):
+        s.brf(sun=(0, 0), max_depth=0)
+    with pytest.raises(ValueError, match="^split"):
+        Scene.from_dem(z, split="diagonal")
+    with pytest.raises(TypeError, match="^material"):
+        Scene.from_dem(z, material=0.5)
+    with pytest.raises(ValueError, match="^cell_size"):
+        Scene.from_dem(z, cell_size=0)
+    with pytest.raises(ValueError, match="^cell_size"):
+        Scene.from_dem(z, cell_size=(1.0, -2.0))
+    with pytest.raises(TypeError, match="^cell_size"):
+        Scene.from_dem(z, cell_size="30 m")
+    with pytest.raises(ValueError, match="^seed"):
+        s.brf(sun=(0, 0), seed=-1)
+    with pytest.raises(MemoryError, match="^shape"):
+        s.render(sun=(0, 0), shape=(100_000, 10_000))
+    with pytest.raises(ValueError, match="^n_threads"):
+        s.brf(sun=(0, 0), n_threads=0)
+
+
+def test_the_kernel_checks_too():
+    from fractalgeo_rs import _core
+
+    z = np.zeros((3, 3))
+    with pytest.raises(ValueError, match="^sun: zenith"):
+        _core.radiometry_brf(z, (1.0, 1.0), True, "ne-sw", "lambertian", [0.5], (0, 91), (0, 0), 10, 1, 0)
+    with pytest.raises(ValueError, match="^rho"):
+        _core.radiometry_albedo(z, (1.0, 1.0), True, "ne-sw", "lambertian", [2.0], (0, 0), 10, 1, 0)
+    with pytest.raises(ValueError, match="^material"):
+        _core.radiometry_albedo(z, (1.0, 1.0), True, "ne-sw", "hapke", [0.5], (0, 0), 10, 1, 0)
+    with pytest.raises(MemoryError, match="^shape"):
+        _core.radiometry_render(z, (1.0, 1.0), True, "ne-sw", "lambertian", [0.5], (0, 0), (0, 0), (10**5, 10**5), 1, 1, 0)
+
+
+def test_mismatched_periodic_edges_warn_and_mirroring_fixes_them():
+    ramp = np.add.outer(np.arange(10.0), np.zeros(10))  # a north-south trend
+    with pytest.warns(UserWarning, match="north-south edges"):
+        Scene.from_dem(ramp)
+    mirrored = np.block([[ramp, ramp[:, ::-1]], [ramp[::-1], ramp[::-1, ::-1]]])
+    Scene.from_dem(mirrored)  # no warning (warnings are errors in this suite)
+    Scene.from_dem(ramp, periodic=False)
+
+
+def test_inputs_are_not_modified_and_any_layout_works():
+    z = periodic_surface(8, 2.0, seed=12)
+    before = z.copy()
+    a = Scene.from_dem(z).brf(sun=(0, 20), spp=2000)
+    b = Scene.from_dem(np.asfortranarray(z)).brf(sun=(0, 20), spp=2000)
+    np.testing.assert_array_equal(z, before)
+    assert a == b and isinstance(a, Estimate)
+    assert not Scene.from_dem(z).dem.flags.writeable
+
+
+def _unit(az, zen):
+    a, z = np.radians(az), np.radians(zen)
+    return np.array([np.sin(a) * np.sin(z), np.cos(a) * np.sin(z), np.cos(z)])
+
+
+def test_a_flat_plane_returns_pi_times_the_facet_brdf():
+    """On a flat plane every path sees one facet, lit: BRF = pi f(sun, view)
+    exactly, for any model (closed forms of Oren-Nayar 1994 and
+    Lafortune-Willems 1994 written here in angles)."""
+    kd, ks, n = 0.2, 0.5, 8.0
+    rho, sigma = 0.6, 0.4
+    glossy = Scene.from_dem(np.zeros((4, 4)), material=Phong(kd, ks, n))
+    rough = Scene.from_dem(np.zeros((4, 4)), material=OrenNayar(rho, sigma))
+    a = 1 - 0.5 * sigma**2 / (sigma**2 + 0.33)
+    b = 0.45 * sigma**2 / (sigma**2 + 0.09)
+    for sun, view in [((0, 30), (180, 30)), ((0, 30), (150, 40)), ((90, 60), (0, 10)), ((10, 50), (20, 70))]:
+        si, vo = _unit(*sun), _unit(*view)
+        ca = max(0.0, float(si @ np.array([-vo[0], -vo[1], vo[2]])))
+        phong = np.pi * (kd / np.pi + ks * (n + 2) / (2 * np.pi) * ca**n)
+        alpha, beta = np.radians(max(sun[1], view[1])), np.radians(min(sun[1], view[1]))
+        cdphi = np.cos(np.radians(sun[0] - view[0]))
+        oren = rho * (a + b * max(0.0, cdphi) * np.sin(alpha) * np.tan(beta))
+        for depth in (1, 3):
+            assert abs(glossy.brf(sun=sun, view=view, spp=300, max_depth=depth).value - phong) < 1e-9
+            assert abs(rough.brf(sun=sun, view=view, spp=300, max_depth=depth).value - oren) < 1e-9
+
+
+def vgroove_single_brf(rho, s_deg, sun, view, m=400_000):
+    """Single-scattering BRF of periodic V-grooves with sun and view in the
+    plane across the grooves, from the exact 2D lit-and-visible geometry of
+    one groove (Torrance and Sparrow 1967): the groove x in [-1, 1] cells,
+    height h |x|; a point is lit (seen) when the ray to the sun (sensor)
+    clears the peak on its side; each point counts with its projected
+    width (n . v) / v_z on the reference line. Midpoint rule, m points."""
+    h = np.tan(np.radians(s_deg))
+    x = (np.arange(m) + 0.5) / m * 2 - 1
+    z = h * np.abs(x)
+    nx, nz = np.where(x < 0, h, -h) / np.hypot(1, h), 1 / np.hypot(1, h)
+
+    def in_plane(az, zen):  # (east, up) of a direction of azimuth 90 or 270
+        t = np.radians(zen)
+        return (1.0 if az == 90 else -1.0) * np.sin(t), np.cos(t)
+
+    def clear(dx, dz):
+        if dx == 0:
+            return np.ones_like(x, bool)
+        far = 1 - x if dx > 0 else x + 1  # horizontal distance to the peak ahead
+        return z + far * dz / abs(dx) >= h - 1e-12
+
+    (sx, sz), (vx, vz) = in_plane(*sun), in_plane(*view)
+    ns, nv = nx * sx + nz * sz, nx * vx + nz * vz
+    seen = clear(sx, sz) & (ns > 0) & clear(vx, vz) & (nv > 0)
+    length = 2.0 / m * np.hypot(1, h)  # facet length per point
+    radiance = np.sum(seen * rho / np.pi * ns * nv / vz) * length / 2.0  # per unit reference width
+    return np.pi * radiance / sz
+
+
+def test_v_grooves_oblique_sun_and_view_match_the_interval_geometry():
+    s_deg, rho = 30.0, 0.8
+    sc = Scene.from_dem(grooves(s_deg), material=Lambertian(rho))
+    # nadir check of the reference itself: rho cos(s)
+    assert abs(vgroove_single_brf(rho, s_deg, (90, 50), (0, 0)) - rho * np.cos(np.radians(s_deg))) < 1e-5
+    for sun, view in [((90, 50), (270, 40)), ((90, 70), (90, 30)), ((270, 40), (90, 20)),
+                      ((90, 45), (90, 45)), ((90, 80), (90, 60)), ((90, 80), (270, 20))]:
+        expect = vgroove_single_brf(rho, s_deg, sun, view)
+        assert expect > 0.05
+        e = sc.brf(sun=sun, view=view, spp=200_000, max_depth=1, seed=4)
+        assert abs(e.value - expect) < 3 * e.se + 1e-5, (sun, view, e, expect)
+
+
+def test_real_dem_warns_raw_and_conserves_energy_mirrored():
+    """The bundled SRTM Alps DEM (rectangular geographic cells): as a
+    periodic tile its edges do not match (a warning); mirrored it tiles, and
+    a white surface then reflects all the sun's flux."""
+    z, info = fg.data.srtm_alps()
+    z = z[:96, :128]
+    cell = tuple(float(v) for v in info["cell_size"])
+    with pytest.warns(UserWarning, match="opposite edges do not match"):
+        Scene.from_dem(z, cell_size=cell)
+    m = np.block([[z, z[:, ::-1]], [z[::-1], z[::-1, ::-1]]])
+    white = Scene.from_dem(m, cell_size=cell, material=Lambertian(1.0))
+    for zen in (0.0, 60.0):
+        a = white.albedo(sun=(135.0, zen), spp=20_000, max_depth=1000)
+        assert abs(a.value - 1.0) < 1e-3, a
