@@ -20,4 +20,4 @@ def test_sar_needs_a_cell_size(tmp_path, capsys):
     src = tmp_path / "dem.npy"
     np.save(src, np.zeros((8, 8)))
     assert main(["sar", str(src), str(tmp_path / "o.npy"), "--incidence", "35"]) == 1
-    assert "cell_size" in capsys.readouterr().err
+    assert "--cell-size" in capsys.readouterr().err

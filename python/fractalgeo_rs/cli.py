@@ -44,6 +44,7 @@ _COMMANDS = {
     "transform": ("fractalgeo_rs.transform._cli",
                   "map of local fractal dimension (moving window) as a float32 GeoTIFF"),
     "tin": ("fractalgeo_rs.tin._cli", "error-bounded triangulated mesh (TIN) of a DEM as PLY or OBJ"),
+    "sar": ("fractalgeo_rs.radar._cli", "synthetic SAR intensity image of a DEM (layover, shadow, speckle)"),
 }
 
 
