@@ -107,6 +107,23 @@ impl Scene {
         DVec3::new(w.dot(t), w.dot(b), w.dot(n))
     }
 
+    /// One scattering draw at a facet with frame `(t, b, n)` for light
+    /// leaving along local `wo`: the new world direction and the sampling
+    /// weight, from the uniforms `dim`, `dim + 1` of `key` (`dim` advances).
+    #[inline]
+    fn scatter(
+        &self,
+        (t, b, n): (DVec3, DVec3, DVec3),
+        wo: DVec3,
+        key: StreamKey,
+        dim: &mut u64,
+    ) -> Option<(DVec3, f64)> {
+        let u = [key.uniform(*dim), key.uniform(*dim + 1)];
+        *dim += 2;
+        let smp = self.material.sample(wo, u)?;
+        Some((smp.wi.x * t + smp.wi.y * b + smp.wi.z * n, smp.weight))
+    }
+
     /// Start of a ray through the reference-plane point `(x, y)` going
     /// against `v` (from above the highest facet).
     #[inline]
@@ -153,16 +170,14 @@ impl Scene {
             if depth == max_depth {
                 break;
             }
-            let u = [key.uniform(dim), key.uniform(dim + 1)];
-            dim += 2;
-            let Some(smp) = self.material.sample(wo, u) else {
+            let Some((wi, weight)) = self.scatter((t, b, n), wo, key, &mut dim) else {
                 break;
             };
-            throughput *= smp.weight;
+            throughput *= weight;
             if throughput == 0.0 {
                 break;
             }
-            d = smp.wi.x * t + smp.wi.y * b + smp.wi.z * n;
+            d = wi;
             o = p;
             skip = Some(facet);
         }
@@ -239,18 +254,16 @@ impl Scene {
                         let (p, facet) = hf.wrap(o + hit.t * d, hit.facet);
                         let (t, b) = basis(n);
                         let wo = Self::local(n, t, b, -d);
-                        let u = [key.uniform(dim), key.uniform(dim + 1)];
-                        dim += 2;
                         // reciprocity: sample the reflected direction as an
                         // incident one for the light's arrival direction
-                        let Some(smp) = self.material.sample(wo, u) else {
+                        let Some((wi, weight)) = self.scatter((t, b, n), wo, key, &mut dim) else {
                             break;
                         };
-                        throughput *= smp.weight;
+                        throughput *= weight;
                         if throughput == 0.0 {
                             break;
                         }
-                        d = smp.wi.x * t + smp.wi.y * b + smp.wi.z * n;
+                        d = wi;
                         o = p;
                         skip = Some(facet);
                     }

@@ -1,7 +1,7 @@
 //! The Lambertian (perfectly diffuse) reflector: `f = rho / pi`.
 use glam::DVec3;
 
-use super::material::{check_unit, cosine_hemisphere, Bsdf, BsdfSample};
+use super::material::{check_unit, cosine_pdf, cosine_sample, Bsdf, BsdfSample};
 use crate::error::CoreResult;
 use std::f64::consts::FRAC_1_PI;
 
@@ -29,25 +29,10 @@ impl Bsdf for Lambertian {
         }
     }
     fn sample(&self, wo: DVec3, u: [f64; 2]) -> Option<BsdfSample> {
-        if wo.z <= 0.0 {
-            return None;
-        }
-        let wi = cosine_hemisphere(u);
-        if wi.z <= 0.0 {
-            return None;
-        }
-        Some(BsdfSample {
-            wi,
-            weight: self.rho,
-            pdf: wi.z * FRAC_1_PI,
-        })
+        cosine_sample(wo, u, |_| self.rho)
     }
     fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
-        if wi.z > 0.0 && wo.z > 0.0 {
-            wi.z * FRAC_1_PI
-        } else {
-            0.0
-        }
+        cosine_pdf(wi, wo)
     }
     fn albedo(&self, wo: DVec3) -> f64 {
         if wo.z > 0.0 {

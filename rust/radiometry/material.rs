@@ -43,6 +43,35 @@ pub fn cosine_hemisphere(u: [f64; 2]) -> DVec3 {
     DVec3::new(r * phi.cos(), r * phi.sin(), z)
 }
 
+/// A cosine-weighted draw of `wi` for `wo` (both above the facet), with the
+/// sampling weight `f cos / pdf` given by `weight(wi)`: the sampler of every
+/// model that importance-samples the cosine (Lambertian, Oren-Nayar).
+#[inline]
+pub fn cosine_sample(wo: DVec3, u: [f64; 2], weight: impl Fn(DVec3) -> f64) -> Option<BsdfSample> {
+    if wo.z <= 0.0 {
+        return None;
+    }
+    let wi = cosine_hemisphere(u);
+    if wi.z <= 0.0 {
+        return None;
+    }
+    Some(BsdfSample {
+        wi,
+        weight: weight(wi),
+        pdf: wi.z * std::f64::consts::FRAC_1_PI,
+    })
+}
+
+/// The density of [`cosine_sample`], per steradian (0 below the facet).
+#[inline]
+pub fn cosine_pdf(wi: DVec3, wo: DVec3) -> f64 {
+    if wi.z > 0.0 && wo.z > 0.0 {
+        wi.z * std::f64::consts::FRAC_1_PI
+    } else {
+        0.0
+    }
+}
+
 /// An orthonormal basis `(t, b)` completing the unit vector `n`
 /// (Duff et al. 2017, "Building an orthonormal basis, revisited").
 #[inline]

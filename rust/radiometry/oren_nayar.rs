@@ -10,7 +10,7 @@
 //! quadrature.
 use glam::DVec3;
 
-use super::material::{check_unit, cosine_hemisphere, Bsdf, BsdfSample};
+use super::material::{check_unit, cosine_hemisphere, cosine_pdf, cosine_sample, Bsdf, BsdfSample};
 use crate::error::{CoreError, CoreResult};
 use std::f64::consts::{FRAC_1_PI, PI};
 
@@ -66,25 +66,10 @@ impl Bsdf for OrenNayar {
         self.rho * FRAC_1_PI * (self.a + self.b * term)
     }
     fn sample(&self, wo: DVec3, u: [f64; 2]) -> Option<BsdfSample> {
-        if wo.z <= 0.0 {
-            return None;
-        }
-        let wi = cosine_hemisphere(u);
-        if wi.z <= 0.0 {
-            return None;
-        }
-        Some(BsdfSample {
-            wi,
-            weight: PI * self.eval(wi, wo),
-            pdf: wi.z * FRAC_1_PI,
-        })
+        cosine_sample(wo, u, |wi| PI * self.eval(wi, wo))
     }
     fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
-        if wi.z > 0.0 && wo.z > 0.0 {
-            wi.z * FRAC_1_PI
-        } else {
-            0.0
-        }
+        cosine_pdf(wi, wo)
     }
     fn albedo(&self, wo: DVec3) -> f64 {
         if wo.z <= 0.0 {
