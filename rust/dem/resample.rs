@@ -1892,7 +1892,13 @@ mod tests {
             assert!(bad.is_err());
         }
         let p = params(2, Support::Point, true);
-        let one = resample(z.view(), h.view(), s.view(), &params(1, Support::Point, true)).unwrap();
+        let one = resample(
+            z.view(),
+            h.view(),
+            s.view(),
+            &params(1, Support::Point, true),
+        )
+        .unwrap();
         let s3b = ndarray::stack![Axis(0), s, s.mapv(|x| 0.0 * x)];
         let h3 = ndarray::stack![Axis(0), h, h];
         let lv0 = resample_levels(z.view(), h3.view(), s3b.view(), &p).unwrap();
