@@ -202,7 +202,8 @@ def _check_window(window, shape=None):
 
 
 @renamed_parameters({"window": "window_size"}, since="0.2.0")
-def resample_analysis(dem, *, window_size=33, support="point", block=2, nodata=None, n_threads=None):
+def resample_analysis(dem, *, window_size=33, support="point", block=2, nodata=None, n_threads=None,
+                      model="fbm", factor=2, cell_size=None):
     r"""Local Hurst exponent and increment scale of a DEM.
 
     Over each ``window_size x window_size`` window, the mean squared increments at lags
@@ -234,6 +235,15 @@ def resample_analysis(dem, *, window_size=33, support="point", block=2, nodata=N
         Height value meaning "no data" (NaN is always missing).
     n_threads : int, optional
         Threads (default all cores); the maps do not depend on it.
+    model : {"fbm", "smooth"}, default "fbm"
+        ``"smooth"``: also fit the inner-scale model of
+        :func:`fractalgeo_rs.fractal_resample` (its default) and return its
+        maps, diagnostics and the per-level parameters for ``factor``.
+    factor : int, default 2
+        ``model="smooth"``: the resampling factor the per-level maps are for.
+    cell_size : float or (float, float), optional
+        ``model="smooth"``: ground size of a cell, for
+        :attr:`ResampleAnalysis.inner_scale_ground`.
 
     Returns
     -------
@@ -254,9 +264,15 @@ def resample_analysis(dem, *, window_size=33, support="point", block=2, nodata=N
     (0.593, 0.584)
     """
     check_choice(support, "support", ("point", "area"))
+    check_choice(model, "model", ("fbm", "smooth"))
     n_threads = check_n_threads(n_threads)
     z = _as_float(dem, nodata)
     window = _check_window(window_size, z.shape)
+    if model == "smooth":
+        levels = _levels(factor)
+        cell = _cell_size(cell_size, dem)
+        _warn_window(window, z.shape)
+        return _smooth_maps(z, window, support, block, levels, cell, True)
     half = window // 2
     hurst, sigma, n_clip, n_ok = _analyse_padded(z, half, support, block, border=_pad_width(half),
                                                  n_threads=n_threads)
