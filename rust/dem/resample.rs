@@ -845,7 +845,13 @@ fn noise_sd(detail: bool, sd_unit: f64, sigma: f64, h: f64, scale: f64) -> f64 {
     if !detail || sigma == 0.0 {
         return 0.0;
     }
-    sigma * scale.powf(h.clamp(H_MIN, H_MAX)) * sd_unit
+    sigma * h_factor(sd_unit, h, scale)
+}
+
+/// The part of the residual sd that depends on `H` only: `(2^-l)^H sd_unit`.
+#[inline]
+fn h_factor(sd_unit: f64, h: f64, scale: f64) -> f64 {
+    scale.powf(h.clamp(H_MIN, H_MAX)) * sd_unit
 }
 
 /// `sd` times the standard normal keyed by the global fine position.
@@ -857,12 +863,13 @@ fn draw(sd: f64, key: &StreamKey, g0: u64, g1: u64, gcols: u64, i: usize, j: usi
     sd * key.normal2(g0 + i as u64, g1 + j as u64, gcols)
 }
 
-/// Weights and residual sd of the full stencil for the last `(H, sigma)`
-/// seen: the table lookup and the power are redone only when they change.
+/// Weights and residual sd of the full stencil for the last `H` seen: the
+/// table lookup and the power are redone only when `H` changes (a map of
+/// `sigma` alone costs one product per sample).
 struct ParamCache {
     h: f64,
-    s: f64,
     w: [f64; NP],
+    hf: f64,
     sd: f64,
     detail: bool,
     scale: f64,
@@ -872,8 +879,8 @@ impl ParamCache {
     fn new(detail: bool, scale: f64) -> Self {
         ParamCache {
             h: f64::NAN,
-            s: f64::NAN,
             w: [0.0; NP],
+            hf: 0.0,
             sd: 0.0,
             detail,
             scale,
@@ -881,13 +888,17 @@ impl ParamCache {
     }
     #[inline]
     fn update(&mut self, t: &Table, h: f64, s: f64) {
-        if h.to_bits() != self.h.to_bits() || s.to_bits() != self.s.to_bits() {
+        if h.to_bits() != self.h.to_bits() {
             let (w, sd) = t.at(h);
             self.w = w;
-            self.sd = noise_sd(self.detail, sd, s, h, self.scale);
+            self.hf = h_factor(sd, h, self.scale);
             self.h = h;
-            self.s = s;
         }
+        self.sd = if !self.detail || s == 0.0 {
+            0.0
+        } else {
+            s * self.hf
+        };
     }
     #[inline]
     fn noise(&self, key: &StreamKey, g0: u64, g1: u64, gcols: u64, i: usize, j: usize) -> f64 {
@@ -1434,11 +1445,12 @@ fn area_partial(
         .collect()
 }
 
-/// Area entry and residual scale for the last `(H, sigma)` seen.
+/// Area entry and residual scale for the last `H` seen (`sigma` alone
+/// costs one product).
 struct AreaCache {
     h: f64,
-    s: f64,
     e: AreaEntry,
+    hf: f64,
     sd: f64,
     detail: bool,
     scale: f64,
@@ -1450,11 +1462,11 @@ impl AreaCache {
     fn new(detail: bool, scale: f64) -> Self {
         AreaCache {
             h: f64::NAN,
-            s: f64::NAN,
             e: AreaEntry {
                 w: [[0.0; NB]; 4],
                 l: [0.0; 6],
             },
+            hf: 0.0,
             sd: 0.0,
             detail,
             scale,
@@ -1463,20 +1475,29 @@ impl AreaCache {
     }
     #[inline]
     fn update(&mut self, t: &AreaTable, h: f64, s: f64) {
-        if !self.full || h.to_bits() != self.h.to_bits() || s.to_bits() != self.s.to_bits() {
-            self.set(t, h, s);
+        if !self.full || h.to_bits() != self.h.to_bits() {
+            self.set(t, h);
             self.full = true;
         }
+        self.set_sigma(s);
     }
     fn update_uncached(&mut self, t: &AreaTable, h: f64, s: f64) {
-        self.set(t, h, s);
+        self.set(t, h);
+        self.set_sigma(s);
         self.full = false;
     }
-    fn set(&mut self, t: &AreaTable, h: f64, s: f64) {
+    fn set(&mut self, t: &AreaTable, h: f64) {
         self.e = t.at(h);
-        self.sd = noise_sd(self.detail, 1.0, s, h, self.scale);
+        self.hf = h_factor(1.0, h, self.scale);
         self.h = h;
-        self.s = s;
+    }
+    #[inline]
+    fn set_sigma(&mut self, s: f64) {
+        self.sd = if !self.detail || s == 0.0 {
+            0.0
+        } else {
+            s * self.hf
+        };
     }
 }
 

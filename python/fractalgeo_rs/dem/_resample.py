@@ -243,7 +243,7 @@ def resample_analysis(dem, *, window_size=33, support="point", block=2, nodata=N
         ``model="smooth"``: the resampling factor the per-level maps are for.
     cell_size : float or (float, float), optional
         ``model="smooth"``: ground size of a cell, for
-        :attr:`ResampleAnalysis.inner_scale_ground`.
+        :attr:`~fractalgeo_rs.dem.ResampleAnalysis.inner_scale_ground`.
 
     Returns
     -------

@@ -113,7 +113,7 @@ def fractal_resample(dem, factor=2, *, hurst="local", sigma="local", window_size
         (e.g. 3 arc-seconds at 44 N: about (92.6, 66.7) m). Default: from
         xarray coords, else unknown. Used by ``min_scale`` (the larger side)
         and to report the inner scale in ground units
-        (:attr:`ResampleAnalysis.inner_scale_ground`); the model is fitted
+        (:attr:`~fractalgeo_rs.dem.ResampleAnalysis.inner_scale_ground`); the model is fitted
         and drawn in cells (rows and columns pooled).
     nodata : float, optional
         Value marking holes, in addition to NaN.
