@@ -344,6 +344,14 @@ impl Table {
             .collect();
         Table { entries }
     }
+    /// The node `k` when `h` is within 1e-9 (in node units) of one.
+    #[inline]
+    fn node(&self, h: f64) -> Option<usize> {
+        let n = self.entries.len();
+        let t = ((h.clamp(H_MIN, H_MAX) - H_MIN) / (H_MAX - H_MIN)) * (n - 1) as f64;
+        let k = t.round();
+        ((t - k).abs() < 1e-9).then_some(k as usize)
+    }
     /// Interpolated weights and standard deviation at `h`.
     #[inline]
     fn at(&self, h: f64) -> ([f64; NP], f64) {
@@ -747,6 +755,13 @@ fn level_point(
         let (step, ph) = (t / 4, t % 4);
         let st = &stencils[t];
         let full = &tables[t];
+        // `(2^-l)^H sd_unit` at every node of the table (see `ParamCache`).
+        let node_hf: Vec<f64> = full
+            .entries
+            .iter()
+            .enumerate()
+            .map(|(k, e)| h_factor(e.var.max(0.0).sqrt(), h_node(k, N_FULL), scale))
+            .collect();
         let all = st.all();
         let key = stream(p, l, step as u64);
         // Targets of row i: the phase's cells of the step (every 4th column).
@@ -792,7 +807,7 @@ fn level_point(
                 let val = if !(h.is_finite() && s.is_finite()) {
                     f64::NAN
                 } else if row_inside && j >= 3 && j + 3 < fc {
-                    pc.update(full, h, s);
+                    pc.update(full, &node_hf, h, s);
                     let c0 = i * fc + j;
                     // Every stencil offset has |dr|, |dc| <= 3.
                     assert!(c0 >= 3 * fc + 3 && c0 + 3 * fc + 3 < len);
@@ -811,11 +826,17 @@ fn level_point(
                     if hole {
                         f64::NAN
                     } else {
+                        // The full stencil as in the fast path (the same
+                        // bits: a tile's edge and the whole array agree).
                         let (w, sd) = if m == all {
-                            full.at(h)
+                            pc.update(full, &node_hf, h, s);
+                            (pc.w, pc.sd)
                         } else {
                             match partial.map.get(&m) {
-                                Some(t) => t.at(h),
+                                Some(t) => {
+                                    let (w, sd) = t.at(h);
+                                    (w, noise_sd(detail, sd, s, h, scale))
+                                }
                                 None => (([0.0; NP]), f64::NAN),
                             }
                         };
@@ -826,7 +847,6 @@ fn level_point(
                                     * get((i as isize + dr) as usize, (j as isize + dc) as usize);
                             }
                         }
-                        let sd = noise_sd(detail, sd, s, h, scale);
                         acc + draw(sd, &key, g0, g1, gcols, i, j)
                     }
                 };
@@ -887,11 +907,21 @@ impl ParamCache {
         }
     }
     #[inline]
-    fn update(&mut self, t: &Table, h: f64, s: f64) {
+    fn update(&mut self, t: &Table, node_hf: &[f64], h: f64, s: f64) {
         if h.to_bits() != self.h.to_bits() {
-            let (w, sd) = t.at(h);
-            self.w = w;
-            self.hf = h_factor(sd, h, self.scale);
+            match t.node(h) {
+                // H on a node of the table (the estimated maps are rounded
+                // to them): its weights, and sd and power from the node.
+                Some(k) => {
+                    self.w = t.entries[k].w;
+                    self.hf = node_hf[k];
+                }
+                None => {
+                    let (w, sd) = t.at(h);
+                    self.w = w;
+                    self.hf = h_factor(sd, h, self.scale);
+                }
+            }
             self.h = h;
         }
         self.sd = if !self.detail || s == 0.0 {

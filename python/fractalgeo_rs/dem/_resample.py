@@ -620,10 +620,21 @@ def _maps(z, hurst, sigma, window, support, local_h, local_s, block=2, n_threads
         if warn:
             for msg in notes:
                 warnings.warn(msg, RuntimeWarning, stacklevel=user_stacklevel())
+    # An estimated H map on the nodes of the kernel's tables (steps of
+    # 0.0049): its lookups are then redone only where H changes, from a node.
+    lh = _on_kernel_nodes(h) if local_h else h
     return ResampleAnalysis(h, s, frac, window if (local_h or local_s) else 0, model="fbm",
-                            level_hurst=h[None], level_sigma=s[None],
+                            level_hurst=lh[None], level_sigma=s[None],
                             fraction_smoother=fr_s, fraction_rougher=fr_r, cell_size=cell,
                             notes=tuple(notes))
+
+
+def _on_kernel_nodes(h):
+    """``h`` rounded to the nodes of the kernel's full-stencil tables (201
+    in [0.01, 0.99])."""
+    lo, hi, n = 0.01, 0.99, 201
+    q = (hi - lo) / (n - 1)
+    return lo + np.rint((np.asarray(h) - lo) / q) * q
 
 
 def _warn_window(window, shape):
