@@ -20,7 +20,7 @@ import functools
 
 import numpy as np
 
-from fractalgeo_rs.dem import _resample as R
+from fractalgeo_rs.dem import _resample_grid as R
 
 #: Lags (input cells) of the local fit.
 LAGS = (1, 2, 4, 8)
