@@ -2,8 +2,9 @@
 
 The bundled SRTM 3" DEM of the Maritime Alps (256 x 256, about 66 m x 92 m
 cells; NASA SRTM, US public domain) is coarsened by 4 (every 4th sample),
-then brought back to the original grid by ``scipy.ndimage.zoom(order=3)``
-and by :func:`fractalgeo_rs.fractal_resample` (``hurst="local"``), and the
+then brought back to the original grid by a cubic spline on that grid
+(``scipy.ndimage.map_coordinates(order=3)``) and by
+:func:`fractalgeo_rs.fractal_resample` (the default model), and the
 three are shown as hillshades next to the real DEM::
 
     python examples/fractal_resampling.py --out resampling.png
@@ -42,10 +43,13 @@ def compare(factor=4, seed=1):
     coarse = z[::factor, ::factor]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        frac = fg.fractal_resample(coarse, factor, seed=seed)
+        frac = fg.fractal_resample(coarse, factor, seed=seed, cell_size=(dy * factor, dx * factor))
     n = frac.shape
     real = z[: n[0], : n[1]]
-    bicubic = ndimage.zoom(coarse, factor, order=3)[: n[0], : n[1]]
+    # Cubic spline on the output grid: sample (i, j) at input index (i, j) / factor
+    # (``zoom(coarse, factor)`` cut to this shape would be off by up to half a cell).
+    yy, xx = np.meshgrid(np.arange(n[0]) / factor, np.arange(n[1]) / factor, indexing="ij")
+    bicubic = ndimage.map_coordinates(coarse, [yy, xx], order=3, mode="nearest")
     out = {}
     for name, a in (("real", real), ("bicubic", bicubic), ("fractal", frac)):
         shade = fg.hillshade(a, cell_size=(dy, dx))

@@ -88,6 +88,10 @@ CASES = {
     "hillshade_gdal_byte": (IMG.astype(np.float32), lambda a: _core.hillshade_gdal_byte(a, 1.0, 1.0, 315.0, 45.0, 1.0, False)),
     "fractal_resample": (IMG[:16, :12], lambda a: _core.fractal_resample(
         a, np.full(a.shape, 0.6) + 0.01 * a / a.max(), np.full(a.shape, 1.0), 1, False, 5, [True])),
+    "fractal_resample[per-level hurst]": (
+        np.stack([np.full((16, 12), 0.6), 0.3 + 0.01 * IMG[:16, :12] / IMG.max()]),
+        lambda a: _core.fractal_resample(IMG[:16, :12], a, np.full((2, 16, 12), 1.0), 2, False, 5,
+                                         [True, True])),
     "resample_local_maps": (IMG, lambda a: _core.resample_local_maps(a, 4, 8, 16, (0.05, 0.95))),
     "tin_delaunay": (rng.random((60, 3)), lambda a: _core.tin_delaunay(a)),
     "tin_greedy": (IMG[:20, :17].copy(), lambda a: _core.tin_greedy(a, 0.5)),

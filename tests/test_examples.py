@@ -48,6 +48,9 @@ def test_fractal_resampling_example(tmp_path, capsys):
     with open(out, "rb") as f:
         assert f.read(8) == b"\x89PNG\r\n\x1a\n"
     assert "hillshade roughness" in capsys.readouterr().out
-    # bicubic is smoother than the real DEM, the fractal resampling is not
-    assert r["bicubic"]["lag1"] < 0.9 and r["fractal"]["lag1"] > 1.0
-    assert r["bicubic"]["roughness"] < r["real"]["roughness"] < r["fractal"]["roughness"]
+    # bicubic is smoother than the real DEM; the fractal resampling (inner-scale
+    # model) is close to it: measured lag-1 0.77 and 0.91, hillshade roughness
+    # 0.034, 0.050 against the real 0.048
+    assert r["bicubic"]["lag1"] < 0.85 and abs(r["fractal"]["lag1"] - 1) < 0.15
+    assert r["bicubic"]["roughness"] < 0.8 * r["real"]["roughness"]
+    assert abs(r["fractal"]["roughness"] / r["real"]["roughness"] - 1) < 0.15

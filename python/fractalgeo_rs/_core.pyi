@@ -429,6 +429,7 @@ RESAMPLE_HALO: int
 
 def fractal_resample(
     dem: npt.NDArray[np.float64],
+    # 2D (rows, cols) or 1 x 1 for every level, or 3D (levels, rows, cols) per level
     hurst: npt.NDArray[np.float64],
     sigma: npt.NDArray[np.float64],
     levels: int,

@@ -4,7 +4,9 @@ use crate::dem::analysis::{self, AnalysisParams, AreaTable};
 use crate::dem::hillshade::{self, ShadeParams};
 use crate::dem::resample::{self, ResampleParams, Support};
 use crate::error::CoreError;
-use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::ndarray::{ArrayView3, ArrayViewD, Axis, Ix3};
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArrayDyn};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 /// Hillshade in [0, 1] (NaN = nodata); `dx` per row, `dy` scalar.
@@ -76,15 +78,17 @@ fn shade_to_byte<'py>(
 }
 
 /// Fractal resampling by `2^levels`; `detail[l]` turns the residual of level
-/// `l` on. `origin` and `global_cols` place a tile in the whole input grid.
+/// `l` on. `hurst` and `sigma`: 2D maps (or 1 x 1) for every level, or 3D
+/// `(levels, rows, cols)` (or `(levels, 1, 1)`) per level. `origin` and
+/// `global_cols` place a tile in the whole input grid.
 #[pyfunction]
 #[pyo3(signature = (dem, hurst, sigma, levels, area, seed, detail, origin=(0, 0), global_cols=0, n_threads=None))]
 #[allow(clippy::too_many_arguments)]
 fn fractal_resample<'py>(
     py: Python<'py>,
     dem: PyReadonlyArray2<'py, f64>,
-    hurst: PyReadonlyArray2<'py, f64>,
-    sigma: PyReadonlyArray2<'py, f64>,
+    hurst: PyReadonlyArrayDyn<'py, f64>,
+    sigma: PyReadonlyArrayDyn<'py, f64>,
     levels: u32,
     area: bool,
     seed: u64,
@@ -93,7 +97,9 @@ fn fractal_resample<'py>(
     global_cols: u64,
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let (d, h, s) = (dem.as_array(), hurst.as_array(), sigma.as_array());
+    let d = dem.as_array();
+    let h = per_level(hurst.as_array(), "hurst")?;
+    let s = per_level(sigma.as_array(), "sigma")?;
     let p = ResampleParams {
         levels,
         support: if area { Support::Area } else { Support::Point },
@@ -106,8 +112,22 @@ fn fractal_resample<'py>(
             global_cols
         },
     };
-    let out = run(py, n_threads, || resample::resample(d, h, s, &p))?;
+    let out = run(py, n_threads, || resample::resample_levels(d, h, s, &p))?;
     Ok(out.into_pyarray(py))
+}
+
+/// A 2D parameter map as one level, or a 3D stack of levels.
+fn per_level<'a>(a: ArrayViewD<'a, f64>, name: &str) -> PyResult<ArrayView3<'a, f64>> {
+    let a = if a.ndim() == 2 {
+        a.insert_axis(Axis(0))
+    } else {
+        a
+    };
+    a.into_dimensionality::<Ix3>().map_err(|_| {
+        PyValueError::new_err(format!(
+            "{name}: expected a 2D map or a 3D stack (levels, rows, cols)"
+        ))
+    })
 }
 
 /// Local `H` and `sigma` maps of a DEM block with a NaN halo of

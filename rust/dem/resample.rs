@@ -43,7 +43,7 @@
 //! halo of [`HALO`] input cells equals the same window of the whole.
 use crate::error::{CoreError, CoreResult};
 use crate::synth::rng::StreamKey;
-use ndarray::{Array2, ArrayView2};
+use ndarray::{Array2, ArrayView2, ArrayView3, Axis};
 use rayon::prelude::*;
 use std::collections::{BTreeSet, HashMap};
 use std::sync::{Arc, Mutex, OnceLock};
@@ -344,6 +344,14 @@ impl Table {
             .collect();
         Table { entries }
     }
+    /// The node `k` when `h` is within 1e-9 (in node units) of one.
+    #[inline]
+    fn node(&self, h: f64) -> Option<usize> {
+        let n = self.entries.len();
+        let t = ((h.clamp(H_MIN, H_MAX) - H_MIN) / (H_MAX - H_MIN)) * (n - 1) as f64;
+        let k = t.round();
+        ((t - k).abs() < 1e-9).then_some(k as usize)
+    }
     /// Interpolated weights and standard deviation at `h`.
     #[inline]
     fn at(&self, h: f64) -> ([f64; NP], f64) {
@@ -634,21 +642,64 @@ pub fn resample(
     sigma: ArrayView2<f64>,
     p: &ResampleParams,
 ) -> CoreResult<Array2<f64>> {
-    check(&dem, &hurst, &sigma, p)?;
-    let (hc, sc) = (hurst.as_standard_layout(), sigma.as_standard_layout());
-    let (h, s) = match (hc.as_slice(), sc.as_slice()) {
+    resample_levels(
+        dem,
+        hurst.insert_axis(Axis(0)),
+        sigma.insert_axis(Axis(0)),
+        p,
+    )
+}
+
+/// [`resample`] with parameters per level: `hurst` and `sigma` have shape
+/// `(n, rows, cols)` or `(n, 1, 1)` with `n = 1` (the same for every level)
+/// or `n = levels` (slice `l` for level `l`). At level `l` the semivariogram
+/// is `sigma_l^2 d^(2 H_l) / 2` (`d` in input cells): a scale-dependent
+/// model enters as the power law matching it at the lags of that level.
+pub fn resample_levels(
+    dem: ArrayView2<f64>,
+    hurst: ArrayView3<f64>,
+    sigma: ArrayView3<f64>,
+    p: &ResampleParams,
+) -> CoreResult<Array2<f64>> {
+    let (n, hr, hc) = hurst.dim();
+    if hurst.dim() != sigma.dim() || (n != 1 && n != p.levels as usize) {
+        return Err(CoreError::invalid(
+            "hurst",
+            format!(
+                "the hurst and sigma parameters must have the same shape, with 1 or {} levels, got {:?} and {:?}",
+                p.levels,
+                hurst.dim(),
+                sigma.dim()
+            ),
+        ));
+    }
+    let (hc3, sc3) = (hurst.as_standard_layout(), sigma.as_standard_layout());
+    let (h, s) = match (hc3.as_slice(), sc3.as_slice()) {
         (Some(h), Some(s)) => (h, s),
         _ => return Err(CoreError::Internal("maps not contiguous".into())),
     };
-    let maps = Maps {
-        h,
-        s,
-        rows: hurst.dim().0,
-        cols: hurst.dim().1,
+    let rc = hr * hc;
+    let maps_at = |l: u32| {
+        let k = if n == 1 { 0 } else { l as usize };
+        Maps {
+            h: &h[k * rc..(k + 1) * rc],
+            s: &s[k * rc..(k + 1) * rc],
+            rows: hr,
+            cols: hc,
+        }
     };
-    let level = |v: ArrayView2<f64>, l: u32| match p.support {
-        Support::Point => level_point(v, &maps, p, l),
-        Support::Area => level_area(v, &maps, p, l),
+    check(
+        &dem,
+        &hurst.index_axis(Axis(0), 0),
+        &sigma.index_axis(Axis(0), 0),
+        p,
+    )?;
+    let level = |v: ArrayView2<f64>, l: u32| {
+        let maps = maps_at(l);
+        match p.support {
+            Support::Point => level_point(v, &maps, p, l),
+            Support::Area => level_area(v, &maps, p, l),
+        }
     };
     let mut cur = level(dem.as_standard_layout().view(), 0)?;
     for l in 1..p.levels {
@@ -704,6 +755,13 @@ fn level_point(
         let (step, ph) = (t / 4, t % 4);
         let st = &stencils[t];
         let full = &tables[t];
+        // `(2^-l)^H sd_unit` at every node of the table (see `ParamCache`).
+        let node_hf: Vec<f64> = full
+            .entries
+            .iter()
+            .enumerate()
+            .map(|(k, e)| h_factor(e.var.max(0.0).sqrt(), h_node(k, N_FULL), scale))
+            .collect();
         let all = st.all();
         let key = stream(p, l, step as u64);
         // Targets of row i: the phase's cells of the step (every 4th column).
@@ -749,7 +807,7 @@ fn level_point(
                 let val = if !(h.is_finite() && s.is_finite()) {
                     f64::NAN
                 } else if row_inside && j >= 3 && j + 3 < fc {
-                    pc.update(full, h, s);
+                    pc.update(full, &node_hf, h, s);
                     let c0 = i * fc + j;
                     // Every stencil offset has |dr|, |dc| <= 3.
                     assert!(c0 >= 3 * fc + 3 && c0 + 3 * fc + 3 < len);
@@ -768,11 +826,17 @@ fn level_point(
                     if hole {
                         f64::NAN
                     } else {
+                        // The full stencil as in the fast path (the same
+                        // bits: a tile's edge and the whole array agree).
                         let (w, sd) = if m == all {
-                            full.at(h)
+                            pc.update(full, &node_hf, h, s);
+                            (pc.w, pc.sd)
                         } else {
                             match partial.map.get(&m) {
-                                Some(t) => t.at(h),
+                                Some(t) => {
+                                    let (w, sd) = t.at(h);
+                                    (w, noise_sd(detail, sd, s, h, scale))
+                                }
                                 None => (([0.0; NP]), f64::NAN),
                             }
                         };
@@ -783,7 +847,6 @@ fn level_point(
                                     * get((i as isize + dr) as usize, (j as isize + dc) as usize);
                             }
                         }
-                        let sd = noise_sd(detail, sd, s, h, scale);
                         acc + draw(sd, &key, g0, g1, gcols, i, j)
                     }
                 };
@@ -802,7 +865,13 @@ fn noise_sd(detail: bool, sd_unit: f64, sigma: f64, h: f64, scale: f64) -> f64 {
     if !detail || sigma == 0.0 {
         return 0.0;
     }
-    sigma * scale.powf(h.clamp(H_MIN, H_MAX)) * sd_unit
+    sigma * h_factor(sd_unit, h, scale)
+}
+
+/// The part of the residual sd that depends on `H` only: `(2^-l)^H sd_unit`.
+#[inline]
+fn h_factor(sd_unit: f64, h: f64, scale: f64) -> f64 {
+    scale.powf(h.clamp(H_MIN, H_MAX)) * sd_unit
 }
 
 /// `sd` times the standard normal keyed by the global fine position.
@@ -814,12 +883,13 @@ fn draw(sd: f64, key: &StreamKey, g0: u64, g1: u64, gcols: u64, i: usize, j: usi
     sd * key.normal2(g0 + i as u64, g1 + j as u64, gcols)
 }
 
-/// Weights and residual sd of the full stencil for the last `(H, sigma)`
-/// seen: the table lookup and the power are redone only when they change.
+/// Weights and residual sd of the full stencil for the last `H` seen: the
+/// table lookup and the power are redone only when `H` changes (a map of
+/// `sigma` alone costs one product per sample).
 struct ParamCache {
     h: f64,
-    s: f64,
     w: [f64; NP],
+    hf: f64,
     sd: f64,
     detail: bool,
     scale: f64,
@@ -829,22 +899,36 @@ impl ParamCache {
     fn new(detail: bool, scale: f64) -> Self {
         ParamCache {
             h: f64::NAN,
-            s: f64::NAN,
             w: [0.0; NP],
+            hf: 0.0,
             sd: 0.0,
             detail,
             scale,
         }
     }
     #[inline]
-    fn update(&mut self, t: &Table, h: f64, s: f64) {
-        if h.to_bits() != self.h.to_bits() || s.to_bits() != self.s.to_bits() {
-            let (w, sd) = t.at(h);
-            self.w = w;
-            self.sd = noise_sd(self.detail, sd, s, h, self.scale);
+    fn update(&mut self, t: &Table, node_hf: &[f64], h: f64, s: f64) {
+        if h.to_bits() != self.h.to_bits() {
+            match t.node(h) {
+                // H on a node of the table (the estimated maps are rounded
+                // to them): its weights, and sd and power from the node.
+                Some(k) => {
+                    self.w = t.entries[k].w;
+                    self.hf = node_hf[k];
+                }
+                None => {
+                    let (w, sd) = t.at(h);
+                    self.w = w;
+                    self.hf = h_factor(sd, h, self.scale);
+                }
+            }
             self.h = h;
-            self.s = s;
         }
+        self.sd = if !self.detail || s == 0.0 {
+            0.0
+        } else {
+            s * self.hf
+        };
     }
     #[inline]
     fn noise(&self, key: &StreamKey, g0: u64, g1: u64, gcols: u64, i: usize, j: usize) -> f64 {
@@ -1391,11 +1475,12 @@ fn area_partial(
         .collect()
 }
 
-/// Area entry and residual scale for the last `(H, sigma)` seen.
+/// Area entry and residual scale for the last `H` seen (`sigma` alone
+/// costs one product).
 struct AreaCache {
     h: f64,
-    s: f64,
     e: AreaEntry,
+    hf: f64,
     sd: f64,
     detail: bool,
     scale: f64,
@@ -1407,11 +1492,11 @@ impl AreaCache {
     fn new(detail: bool, scale: f64) -> Self {
         AreaCache {
             h: f64::NAN,
-            s: f64::NAN,
             e: AreaEntry {
                 w: [[0.0; NB]; 4],
                 l: [0.0; 6],
             },
+            hf: 0.0,
             sd: 0.0,
             detail,
             scale,
@@ -1420,20 +1505,29 @@ impl AreaCache {
     }
     #[inline]
     fn update(&mut self, t: &AreaTable, h: f64, s: f64) {
-        if !self.full || h.to_bits() != self.h.to_bits() || s.to_bits() != self.s.to_bits() {
-            self.set(t, h, s);
+        if !self.full || h.to_bits() != self.h.to_bits() {
+            self.set(t, h);
             self.full = true;
         }
+        self.set_sigma(s);
     }
     fn update_uncached(&mut self, t: &AreaTable, h: f64, s: f64) {
-        self.set(t, h, s);
+        self.set(t, h);
+        self.set_sigma(s);
         self.full = false;
     }
-    fn set(&mut self, t: &AreaTable, h: f64, s: f64) {
+    fn set(&mut self, t: &AreaTable, h: f64) {
         self.e = t.at(h);
-        self.sd = noise_sd(self.detail, 1.0, s, h, self.scale);
+        self.hf = h_factor(1.0, h, self.scale);
         self.h = h;
-        self.s = s;
+    }
+    #[inline]
+    fn set_sigma(&mut self, s: f64) {
+        self.sd = if !self.detail || s == 0.0 {
+            0.0
+        } else {
+            s * self.hf
+        };
     }
 }
 
@@ -1815,6 +1909,52 @@ mod tests {
                     assert_eq!(x.to_bits(), whole[(i, j)].to_bits(), "{support:?} {i} {j}");
                 }
             }
+        }
+    }
+
+    #[test]
+    fn per_level_parameters() {
+        // Equal slices give the 2D result bit for bit; changing the last
+        // level's slice changes only what that level draws (the mean of the
+        // first level's samples is kept: even fine positions equal the
+        // one-level result).
+        let z = field(20, 24);
+        let h = Array2::from_elem((20, 24), 0.6);
+        let s = Array2::from_elem((20, 24), 1.5);
+        for support in [Support::Point, Support::Area] {
+            let p = params(2, support, true);
+            let whole = resample(z.view(), h.view(), s.view(), &p).unwrap();
+            let h3 = ndarray::stack![Axis(0), h, h];
+            let s3 = ndarray::stack![Axis(0), s, s];
+            let lv = resample_levels(z.view(), h3.view(), s3.view(), &p).unwrap();
+            assert!(whole
+                .iter()
+                .zip(lv.iter())
+                .all(|(a, b)| a.to_bits() == b.to_bits()));
+            let s3b = ndarray::stack![Axis(0), s, s.mapv(|x| 0.0 * x)];
+            let lv0 = resample_levels(z.view(), h3.view(), s3b.view(), &p).unwrap();
+            assert!(whole.iter().zip(lv0.iter()).any(|(a, b)| a != b));
+            let bad = resample_levels(
+                z.view(),
+                ndarray::stack![Axis(0), h, h, h].view(),
+                ndarray::stack![Axis(0), s, s, s].view(),
+                &p,
+            );
+            assert!(bad.is_err());
+        }
+        let p = params(2, Support::Point, true);
+        let one = resample(
+            z.view(),
+            h.view(),
+            s.view(),
+            &params(1, Support::Point, true),
+        )
+        .unwrap();
+        let s3b = ndarray::stack![Axis(0), s, s.mapv(|x| 0.0 * x)];
+        let h3 = ndarray::stack![Axis(0), h, h];
+        let lv0 = resample_levels(z.view(), h3.view(), s3b.view(), &p).unwrap();
+        for ((i, j), v) in one.indexed_iter() {
+            assert_eq!(v.to_bits(), lv0[(2 * i, 2 * j)].to_bits());
         }
     }
 

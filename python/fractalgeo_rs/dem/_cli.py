@@ -146,8 +146,9 @@ def _run_resample(args: argparse.Namespace) -> int:
         from fractalgeo_rs.dem._resample_dask import run_dask
 
         an = R._maps(z, hurst, sigma, window, args.support, hurst == "local", sigma == "local",
-                     min(1 << levels, 8), args.n_threads)
-        out = run_dask(da.from_array(z, chunks=chunks), levels, an.hurst, an.sigma, window,
+                     min(1 << levels, 8), args.n_threads, levels=levels,
+                     model=R._check_model(None, hurst == "local", sigma == "local"))
+        out = run_dask(da.from_array(z, chunks=chunks), levels, an.level_hurst, an.level_sigma, window,
                        detail, args.support, None, seed, args.n_threads, False)
         prof.update(height=out.shape[0], width=out.shape[1])
         nb = out.numblocks

@@ -1,10 +1,10 @@
 """Fractal resampling of DEMs: finer grids that keep the terrain's roughness."""
 from __future__ import annotations
 
-import functools
 import numbers
 import warnings
 from dataclasses import dataclass
+from typing import Optional, Tuple
 
 import numpy as np
 
@@ -14,11 +14,18 @@ from fractalgeo_rs._warn import user_stacklevel
 from fractalgeo_rs._validation import (as_array, check_choice, check_memory, check_n_threads, check_nodata,
                                       check_positive_float)
 
+from fractalgeo_rs.dem._resample_grid import (  # noqa: F401  (re-exported for the other modules)
+    _H_TABLE,
+    HURST_RANGE,
+    STEP,
+    _block_variogram,
+    _interp_nodes,
+    _node_sums,
+    _ratio_table,
+)
+
 __all__ = ["resample_analysis", "ResampleAnalysis", "HURST_RANGE"]
 
-#: Range the ``"local"`` Hurst map is clipped to (real DEMs are locally
-#: smoother than any fBm at the pixel scale: the lag-1/lag-2 fit gives H > 1).
-HURST_RANGE = (0.05, 0.95)
 _HALO = int(_core.RESAMPLE_HALO)
 
 
@@ -41,6 +48,44 @@ class ResampleAnalysis:
         ``HURST_RANGE``.
     window_size : int
         Side of the square window (cells; 0 when no map was estimated).
+    model : {"fbm", "smooth"}
+        The model the maps describe: ``"fbm"`` (``hurst`` and ``sigma`` are
+        the constant-H fBm of lags 1-2 or the user's values) or
+        ``"smooth"`` (the structure function with an inner scale of
+        docs/resampling.md; ``hurst`` is then the fitted ``H`` of the
+        fractal regime and ``sigma`` the measured lag-1 increment sd).
+    level_hurst, level_sigma : ndarray of float64, shape (levels, rows, cols), or None
+        The per-level exponent and increment scale the kernel draws level
+        ``l`` (coarse spacing ``2^-l`` input cells) with; None from
+        :func:`~fractalgeo_rs.dem.resample_analysis` without ``factor``.
+    inner_scale : ndarray of float64, shape of the DEM, or None
+        ``model="smooth"``: the fitted inner scale ``r`` (input cells;
+        0 where the window is fBm down to the pixel or has no fit): the
+        terrain is smooth below it, and the detail drawn below it is
+        tapered accordingly.
+    inner_scale_global : float
+        ``r`` of the model fitted to the whole DEM's variogram (lags 1, 2,
+        4, ... up to a quarter of its shorter side), input cells; NaN when
+        not computed (Dask input, ``model="fbm"``).
+    hurst_global : float
+        ``H`` of that global fit (NaN when not computed).
+    fraction_smoother, fraction_rougher : float
+        Fractions of the analysis windows (nodes of the ``STEP`` grid with
+        a valid centre) whose lag-1/lag-2 exponent is above / below
+        ``HURST_RANGE``: smoother than any fBm at the pixel scale (the
+        ``"smooth"`` model represents them with its inner scale; ``"fbm"``
+        draws them with ``H = 0.95``, too rough) / rougher than fBm of
+        ``H = 0.05`` (drawn with ``H = 0.05``: too smooth). NaN when not
+        computed.
+    fraction_tapered : float
+        ``model="smooth"``: fraction of the windows whose inner scale is
+        above one output cell, where the detail of the finest level is
+        smaller than constant-H fBm would draw (NaN otherwise).
+    cell_size : tuple of float or None
+        ``(dy, dx)`` ground size of an input cell when known.
+    notes : tuple of str
+        What the diagnostics mean for the output, in sentences (also the
+        text of the warnings emitted).
     window : int
         Deprecated alias of ``window_size`` (renamed in 0.2.0; reading it
         emits a DeprecationWarning; removed in the next release).
@@ -66,6 +111,25 @@ class ResampleAnalysis:
     sigma: np.ndarray
     fraction_clipped: float
     window_size: int
+    model: str = "fbm"
+    level_hurst: Optional[np.ndarray] = None
+    level_sigma: Optional[np.ndarray] = None
+    inner_scale: Optional[np.ndarray] = None
+    inner_scale_global: float = float("nan")
+    hurst_global: float = float("nan")
+    fraction_smoother: float = float("nan")
+    fraction_rougher: float = float("nan")
+    fraction_tapered: float = float("nan")
+    cell_size: Optional[Tuple[float, float]] = None
+    notes: Tuple[str, ...] = ()
+
+    @property
+    def inner_scale_ground(self) -> Optional[np.ndarray]:
+        """:attr:`inner_scale` in ground units (times the geometric mean of
+        the cell's sides), or None when the cell size or the map is unknown."""
+        if self.inner_scale is None or self.cell_size is None:
+            return None
+        return self.inner_scale * float(np.sqrt(self.cell_size[0] * self.cell_size[1]))
 
     @property
     def window(self) -> int:
@@ -78,44 +142,10 @@ class ResampleAnalysis:
 
 # ---------------------------------------------------------------- analysis --
 
-#: Spacing (cells) of the nodes where the window sums are computed; the maps
-#: are interpolated bilinearly between them.
-STEP = 8
-
-
 def _pad_width(half, step=STEP):
     """NaN halo (a multiple of ``step``) the analysis of a block needs: the
     window, the lag-2 increments and one node spacing for the interpolation."""
     return -(-(half + 2 + step) // step) * step
-
-
-def _block_variogram(hurst, lag, n=2):
-    """``Var(Zbar(x + lag) - Zbar(x)) / sigma^2`` for fBm block means, each
-    block the mean of ``n x n`` points at spacing ``1/n`` (the kernel's area
-    model uses ``n = 2``); ``n = 1`` is the point variogram ``lag^(2H)``."""
-    off = (np.arange(n) - (n - 1) / 2) / n
-    yy, xx = np.meshgrid(off, off, indexing="ij")
-    p = np.stack([yy.ravel(), xx.ravel()], 1)
-
-    def gbar(d):
-        dd = p[:, None, :] - (p[None, :, :] + np.array(d))
-        r2 = (dd**2).sum(-1)
-        with np.errstate(divide="ignore"):
-            g = np.where(r2 > 0, 0.5 * r2 ** hurst[..., None, None], 0.0)
-        return g.mean((-1, -2))
-
-    return 2.0 * (gbar((0.0, lag)) - gbar((0.0, 0.0)))
-
-
-_H_TABLE = np.linspace(0.001, 1.5, 1500)
-
-
-@functools.lru_cache(maxsize=8)
-def _ratio_table(n):
-    """``(H, gamma_B(2) / gamma_B(1), gamma_B(1))`` on ``_H_TABLE``."""
-    h = _H_TABLE
-    g1 = _block_variogram(h, 1.0, n)
-    return h, _block_variogram(h, 2.0, n) / g1, g1
 
 
 def _analyse_padded(z, half, support, block=2, step=STEP, border=0, n_threads=None):
@@ -144,7 +174,8 @@ def _check_window(window, shape=None):
 
 
 @renamed_parameters({"window": "window_size"}, since="0.2.0")
-def resample_analysis(dem, *, window_size=33, support="point", block=2, nodata=None, n_threads=None):
+def resample_analysis(dem, *, window_size=33, support="point", block=2, nodata=None, n_threads=None,
+                      model="fbm", factor=2, cell_size=None):
     r"""Local Hurst exponent and increment scale of a DEM.
 
     Over each ``window_size x window_size`` window, the mean squared increments at lags
@@ -176,6 +207,15 @@ def resample_analysis(dem, *, window_size=33, support="point", block=2, nodata=N
         Height value meaning "no data" (NaN is always missing).
     n_threads : int, optional
         Threads (default all cores); the maps do not depend on it.
+    model : {"fbm", "smooth"}, default "fbm"
+        ``"smooth"``: also fit the inner-scale model of
+        :func:`fractalgeo_rs.fractal_resample` (its default) and return its
+        maps, diagnostics and the per-level parameters for ``factor``.
+    factor : int, default 2
+        ``model="smooth"``: the resampling factor the per-level maps are for.
+    cell_size : float or (float, float), optional
+        ``model="smooth"``: ground size of a cell, for
+        :attr:`~fractalgeo_rs.dem.ResampleAnalysis.inner_scale_ground`.
 
     Returns
     -------
@@ -196,21 +236,34 @@ def resample_analysis(dem, *, window_size=33, support="point", block=2, nodata=N
     (0.593, 0.584)
     """
     check_choice(support, "support", ("point", "area"))
+    check_choice(model, "model", ("fbm", "smooth"))
     n_threads = check_n_threads(n_threads)
     z = _as_float(dem, nodata)
     window = _check_window(window_size, z.shape)
+    if model == "smooth":
+        levels = _levels(factor)
+        cell = _cell_size(cell_size, dem)
+        _warn_window(window, z.shape)
+        return _smooth_maps(z, window, support, block, levels, cell, True)
     half = window // 2
     hurst, sigma, n_clip, n_ok = _analyse_padded(z, half, support, block, border=_pad_width(half),
                                                  n_threads=n_threads)
     frac = n_clip / n_ok if n_ok else 0.0
-    _warn_clipped(frac)
+    _warn_clipped(frac, hurst)
     return ResampleAnalysis(hurst, sigma, frac, window)
 
 
-def _warn_clipped(frac):
+def _warn_clipped(frac, hurst=None):
     if frac > 0:
+        side = ""
+        if hurst is not None:
+            lo, hi = HURST_RANGE
+            n_hi = int(np.count_nonzero(hurst >= hi))
+            n_lo = int(np.count_nonzero(hurst <= lo))
+            side = (f" ({n_hi} pixels above {hi}: smoother than fBm at lags 1-2; "
+                    f"{n_lo} below {lo}: rougher)")
         warnings.warn(f"hurst: {100 * frac:.2g} % of the local H values were outside "
-                      f"{HURST_RANGE} and were clipped", RuntimeWarning, stacklevel=user_stacklevel())
+                      f"{HURST_RANGE} and were clipped{side}", RuntimeWarning, stacklevel=user_stacklevel())
 
 
 def _as_float(dem, nodata):
@@ -229,49 +282,6 @@ def _as_float(dem, nodata):
 
 # ------------------------------------------------------- numpy reference --
 # The analysis in numpy, for the tests and the benchmark only.
-
-def _node_sums(a, half, step):
-    """Sums along axis 0 over rows ``[p - half, p + half]`` at the nodes
-    ``p = k step`` whose window fits in ``a``; returns ``(sums, k_first)``.
-
-    Each sum is formed in a fixed order from the values in its window only
-    (blocks of ``step`` rows aligned on the node grid, then the rows left
-    over), so any block of a larger array whose origin is a multiple of
-    ``step`` gives bit-identical sums."""
-    n = a.shape[0]
-    q, rem = divmod(half, step)
-    k0 = -(-half // step)
-    k1 = (n - 3 - half) // step + 1
-    k = np.arange(k0, max(k1, k0))
-    nb = n // step
-    bs = a[0:nb * step:step].copy()
-    for o in range(1, step):
-        bs += a[o:nb * step:step]
-    if q:
-        acc = bs[k - q].copy()
-        for d in range(1, 2 * q):
-            acc += bs[k - q + d]
-    else:
-        acc = np.zeros((k.size,) + a.shape[1:])
-    p = k * step
-    for o in range(-half, -q * step):
-        acc += a[p + o]
-    for o in range(q * step, half + 1):
-        acc += a[p + o]
-    return acc, k0
-
-
-def _interp_nodes(v, k0, lo, hi, step):
-    """Bilinear (along axis 0) interpolation of node values ``v`` (node
-    ``k0 + a`` at row ``(k0 + a) step``) to the rows ``[lo, hi)``, ``lo`` a
-    multiple of ``step`` (rows grouped by node interval: no gathers)."""
-    a0 = lo // step - k0
-    nb = -(-(hi - lo) // step)
-    u = (np.arange(step) / step).reshape((1, step) + (1,) * (v.ndim - 1))
-    out = v[a0:a0 + nb, None] * (1.0 - u)
-    out += v[a0 + 1:a0 + nb + 1, None] * u
-    return out.reshape((nb * step,) + v.shape[1:])[:hi - lo]
-
 
 def _box_sum(a, half, t, step=STEP):
     """Window sums of ``a`` over ``(2 half + 1)^2`` cells at the nodes of a
@@ -380,16 +390,25 @@ def _param_map(value, name, shape, lo, hi, lo_open, hi_open):
 
 
 def _cell_size(cell_size, dem):
+    """``(dy, dx)`` ground size of an input cell: ``cell_size`` (a number or
+    a pair), else from xarray coords, else None (unknown)."""
     if cell_size is None:
         if _is_xarray(dem):
-            d = _coord_step(dem)
-            if d is not None:
-                return d
-        return 1.0
-    return check_positive_float(cell_size, "cell_size")
+            return _coord_step(dem)
+        return None
+    if isinstance(cell_size, (tuple, list, np.ndarray)) and not isinstance(cell_size, str):
+        if len(cell_size) != 2:
+            raise ValueError(f"cell_size: expected a number or a pair (dy, dx), got {cell_size!r}")
+        return (check_positive_float(cell_size[0], "cell_size"),
+                check_positive_float(cell_size[1], "cell_size"))
+    c = check_positive_float(cell_size, "cell_size")
+    return (c, c)
 
 
 def _detail(levels, cell, min_scale):
+    """Detail flag per level: level ``l`` makes cells of ``cell / 2^(l+1)``;
+    detail where the larger side of them is at least ``min_scale``.
+    ``cell``: a number or a pair ``(dy, dx)``."""
     if min_scale is None:
         return [True] * levels
     if isinstance(min_scale, bool) or not isinstance(min_scale, numbers.Real):
@@ -397,8 +416,23 @@ def _detail(levels, cell, min_scale):
     ms = float(min_scale)
     if not (np.isfinite(ms) and ms >= 0):
         raise ValueError(f"min_scale: expected a finite number >= 0 or None, got {ms}")
-    # Level l makes cells of cell / 2^(l+1); detail where they are >= min_scale.
-    return [cell / 2 ** (l + 1) >= ms for l in range(levels)]
+    c = float(max(cell)) if isinstance(cell, (tuple, list)) else float(cell)
+    return [c / 2 ** (lvl + 1) >= ms for lvl in range(levels)]
+
+
+_GEO_NAMES = ("lat", "lon", "latitude", "longitude")
+
+
+def _is_geographic_xarray(da):
+    """Whether a DataArray's coords look like degrees (names or units)."""
+    for dim in da.dims[-2:]:
+        if str(dim).lower() in _GEO_NAMES:
+            return True
+        if dim in da.coords:
+            units = str(da[dim].attrs.get("units", "")).lower()
+            if "degree" in units:
+                return True
+    return False
 
 
 def _check_memory(shape, f):
@@ -417,17 +451,21 @@ def _is_dask(a):
 
 
 def _coord_step(da):
-    y, x = da.dims[-2:]
-    try:
-        cx = np.asarray(da[x].values, dtype=float)
-        if cx.size >= 2:
-            return abs(float(cx[1] - cx[0]))
-    except (KeyError, TypeError, ValueError):
-        pass
-    return None
+    """``(dy, dx)`` from the last two dims' coords, or None."""
+    steps = []
+    for dim in da.dims[-2:]:
+        try:
+            c = np.asarray(da[dim].values, dtype=float)
+        except (KeyError, TypeError, ValueError):
+            return None
+        if c.size < 2 or not np.isfinite(c[1] - c[0]) or c[1] == c[0]:
+            return None
+        steps.append(abs(float(c[1] - c[0])))
+    return (steps[0], steps[1])
 
 
-def run_numpy(dem, levels, hurst, sigma, window, detail, support, nodata, seed, n_threads):
+def run_numpy(dem, levels, hurst, sigma, window, detail, support, nodata, seed, n_threads,
+              model=None, cell=None, clip_min=None, warn=True):
     """In-memory run on checked options; returns ``(out, analysis)``."""
     z = _as_float(dem, nodata)
     _check_shape(z.shape)
@@ -436,13 +474,19 @@ def run_numpy(dem, levels, hurst, sigma, window, detail, support, nodata, seed, 
     _check_memory(z.shape, 1 << levels)
     local_h = isinstance(hurst, str) and hurst == "local"
     local_s = isinstance(sigma, str) and sigma == "local"
-    an = _maps(z, hurst, sigma, window, support, local_h, local_s, min(1 << levels, 8), n_threads)
-    h, s = an.hurst, an.sigma
-    if h.strides == (0, 0) and s.strides == (0, 0):
+    model = _check_model(model, local_h, local_s)
+    an = _maps(z, hurst, sigma, window, support, local_h, local_s, min(1 << levels, 8), n_threads,
+               levels=levels, model=model, cell=cell, warn=warn)
+    h, s = an.level_hurst, an.level_sigma
+    if h.strides[1:] == (0, 0) and s.strides[1:] == (0, 0):
         # Constant maps: the kernel takes them as 1 x 1.
-        h, s = np.ascontiguousarray(h[:1, :1]), np.ascontiguousarray(s[:1, :1])
+        h, s = np.ascontiguousarray(h[:, :1, :1]), np.ascontiguousarray(s[:, :1, :1])
+    else:
+        h, s = np.ascontiguousarray(h), np.ascontiguousarray(s)
     out = _core.fractal_resample(z, h, s, levels, support == "area", seed, detail,
                                  (0, 0), z.shape[1], n_threads)
+    if clip_min is not None:
+        np.maximum(out, clip_min, out=out)
     return out, an
 
 
@@ -451,17 +495,159 @@ def _check_shape(shape):
         raise ValueError(f"dem: the kriging stencil needs at least 4 x 4 samples, got {shape}")
 
 
-def _maps(z, hurst, sigma, window, support, local_h, local_s, block=2, n_threads=None):
+def _maps(z, hurst, sigma, window, support, local_h, local_s, block=2, n_threads=None, *,
+          levels=1, model="fbm", cell=None, warn=True):
+    """The parameters of a run: a :class:`ResampleAnalysis` whose
+    ``level_hurst`` / ``level_sigma`` are what the kernel takes (stacks of
+    ``levels``, or of 1 for every level). Warnings only about what was
+    estimated (never about a parameter the user fixed)."""
+    # Fixed parameters are checked before anything is estimated.
+    h_fix = None if local_h else _param_map(hurst, "hurst", z.shape, 0.0, 1.0, True, True)
+    s_fix = None if local_s else _param_map(sigma, "sigma", z.shape, 0.0, np.inf, False, False)
+    if warn and (local_h or local_s):
+        _warn_window(window, z.shape)
+    if model == "smooth":
+        return _smooth_maps(z, window, support, block, levels, cell, warn)
     frac = 0.0
+    h_raw = None
+    fr_s = fr_r = float("nan")
     if local_h or local_s:
-        a = resample_analysis(z, window_size=window, support=support, block=block, n_threads=n_threads)
-        h_map, s_map, frac = a.hurst, a.sigma, a.fraction_clipped
-    h = h_map if local_h else _param_map(hurst, "hurst", z.shape, 0.0, 1.0, True, True)
-    s = s_map if local_s else _param_map(sigma, "sigma", z.shape, 0.0, np.inf, False, False)
+        half = window // 2
+        h_map, s_map, n_clip, n_ok = _analyse_padded(z, half, support, block, border=_pad_width(half),
+                                                     n_threads=n_threads)
+        if local_h:
+            frac = n_clip / n_ok if n_ok else 0.0
+            h_raw = h_map
+            ok = s_map > 0
+            n = max(int(np.count_nonzero(ok)), 1)
+            fr_s = int(np.count_nonzero(ok & (h_map >= HURST_RANGE[1]))) / n
+            fr_r = int(np.count_nonzero(ok & (h_map <= HURST_RANGE[0]))) / n
+    h = h_map if local_h else h_fix
+    if local_s:
+        s = s_map
+        if support == "area" and not local_h:
+            # sigma^2 = g1 / gamma_block(1; H) with the user's H, not the
+            # local one the kernel divided by.
+            hh, _, g1tab = _ratio_table(block)
+            g1 = s_map**2 * np.interp(h_map, hh, g1tab)
+            s = np.sqrt(g1 / np.interp(np.clip(h, hh[0], hh[-1]), hh, g1tab))
+    else:
+        s = s_fix
     if (h.strides == (0, 0)) != (s.strides == (0, 0)):
         h, s = np.ascontiguousarray(h), np.ascontiguousarray(s)
-    return ResampleAnalysis(h, s, frac,
-                            window if (local_h or local_s) else 0)
+    notes = []
+    if h_raw is not None:
+        lo, hi = HURST_RANGE
+        if fr_s > 0:
+            notes.append(f"hurst: {100 * fr_s:.3g} % of the windows are smoother than fBm at lags 1-2 "
+                         f"(H > {hi}): detail there is drawn with H = {hi} and is rougher than the DEM "
+                         f"below the coarse cell; model='smooth' (the default with hurst and sigma "
+                         f"'local') tapers it below the fitted inner scale")
+        if fr_r > 0:
+            notes.append(f"hurst: {100 * fr_r:.3g} % of the windows are rougher than fBm of H = {lo} at "
+                         f"lags 1-2: detail there is drawn with H = {lo} and is smoother than the DEM")
+        if warn:
+            for msg in notes:
+                warnings.warn(msg, RuntimeWarning, stacklevel=user_stacklevel())
+    # An estimated H map on the nodes of the kernel's tables (steps of
+    # 0.0049): its lookups are then redone only where H changes, from a node.
+    lh = _on_kernel_nodes(h) if local_h else h
+    return ResampleAnalysis(h, s, frac, window if (local_h or local_s) else 0, model="fbm",
+                            level_hurst=lh[None], level_sigma=s[None],
+                            fraction_smoother=fr_s, fraction_rougher=fr_r, cell_size=cell,
+                            notes=tuple(notes))
+
+
+def _on_kernel_nodes(h):
+    """``h`` rounded to the nodes of the kernel's full-stencil tables (201
+    in [0.01, 0.99])."""
+    lo, hi, n = 0.01, 0.99, 201
+    q = (hi - lo) / (n - 1)
+    return lo + np.rint((np.asarray(h) - lo) / q) * q
+
+
+def _warn_window(window, shape):
+    if window > min(shape):
+        warnings.warn(f"window_size: {window} is larger than the DEM's shorter side {min(shape)}: "
+                      f"the local maps are close to one fit of the whole DEM",
+                      RuntimeWarning, stacklevel=user_stacklevel())
+
+
+def _smooth_maps(z, window, support, block, levels, cell, warn):
+    """The scale-aware model (``_resample_model``): per-level maps from the
+    fit at the analysis nodes, interpolated to the pixels."""
+    from fractalgeo_rs.dem import _resample_model as M
+
+    half = window // 2
+    t = M.pad_width(half)
+    mb = 0 if support == "point" else block
+    f = 1 << levels
+    zp = np.pad(z, t, constant_values=np.nan)
+    lh, ls, r_map, h_map, counts = M.analyse_padded(zp, half, mb, levels, M.INNER_SCALE_FLOOR / f)
+    n_ok, n_smooth, n_rough, n_taper, n_centre = counts
+    r_glob, h_glob = M.global_fit(z, mb)
+    fr_s = n_smooth / n_ok if n_ok else 0.0
+    fr_r = n_rough / n_ok if n_ok else 0.0
+    fr_t = n_taper / n_ok if n_ok else 0.0
+    lo = HURST_RANGE[0]
+    notes, warn_msgs = [], []
+    unit = ""
+    scale = 1.0
+    if cell is not None:
+        scale = float(np.sqrt(cell[0] * cell[1]))
+        unit = " ground units"
+    if fr_t > 0:
+        notes.append(f"{100 * fr_t:.3g} % of the windows have an inner scale above one output cell "
+                     f"(global fit: r = {scale * r_glob:.3g}{unit or ' input cells'}, H = {h_glob:.2f}): "
+                     f"the detail below it was tapered (smoother than constant-H fBm), "
+                     f"{100 * fr_s:.3g} % of the windows are smoother than fBm at lags 1-2")
+    if fr_r > 0:
+        msg = (f"hurst: {100 * fr_r:.3g} % of the windows are rougher than fBm of H = {lo} at lags 1-2: "
+               f"detail there is drawn with H >= {lo} and is smoother than the DEM")
+        notes.append(msg)
+        warn_msgs.append(msg)
+    if n_centre > n_ok:
+        msg = (f"window_size: {100 * (n_centre - n_ok) / n_centre:.3g} % of the windows with a valid "
+               f"centre have no valid increments (holes): no random detail there; a larger "
+               f"window_size fills them")
+        notes.append(msg)
+        warn_msgs.append(msg)
+    if warn:
+        for msg in warn_msgs:
+            warnings.warn(msg, RuntimeWarning, stacklevel=user_stacklevel())
+    return ResampleAnalysis(h_map, ls[0], fr_r, window, model="smooth", level_hurst=lh,
+                            level_sigma=ls, inner_scale=r_map, inner_scale_global=r_glob,
+                            hurst_global=h_glob, fraction_smoother=fr_s, fraction_rougher=fr_r,
+                            fraction_tapered=fr_t, cell_size=cell, notes=tuple(notes))
+
+
+def _check_model(model, local_h, local_s):
+    """``model``: None -> "smooth" when H and sigma are both estimated."""
+    if model is None:
+        return "smooth" if (local_h and local_s) else "fbm"
+    check_choice(model, "model", ("smooth", "fbm"))
+    if model == "smooth" and not (local_h and local_s):
+        raise ValueError("model: 'smooth' fits H, sigma and the inner scale from the DEM; it needs "
+                         "hurst='local' and sigma='local' (use model='fbm' with fixed values)")
+    return model
+
+
+def _bicubic_aligned(c, f, support="point"):
+    """Cubic-spline interpolation (``scipy.ndimage.map_coordinates``,
+    order 3) at the cell centres of :func:`fractal_resample`'s finer grid:
+    input index ``a / f`` (point support: the input samples are kept) or
+    ``(a + 0.5) / f - 0.5`` (area support). The baseline of
+    docs/resampling.md; ``ndimage.zoom(c, f)`` cut to the output shape is
+    not on this grid (it stretches the input by ``(f n - 1) / (n - 1)``)."""
+    from scipy import ndimage
+
+    c = np.asarray(c, dtype=np.float64)
+    if support == "point":
+        ax = [np.arange(f * (n - 1) + 1) / f for n in c.shape]
+    else:
+        ax = [(np.arange(f * n) + 0.5) / f - 0.5 for n in c.shape]
+    yy, xx = np.meshgrid(ax[0], ax[1], indexing="ij")
+    return ndimage.map_coordinates(c, [yy, xx], order=3, mode="nearest")
 
 
 def fine_coords(c, f, support):

@@ -16,12 +16,38 @@ def _out_bounds(a, b, n, f, point):
     return f * a, f * b
 
 
-def _analysis_maps(dem, hurst, sigma, window, support, nodata, block=2, n_threads=None):
-    """Hurst and sigma maps as dask arrays chunked like ``dem``."""
+def _analysis_maps(dem, hurst, sigma, window, support, nodata, block=2, n_threads=None, levels=1,
+                   model="fbm"):
+    """Per-level hurst and sigma stacks ``(n, rows, cols)`` (``n`` = 1 or
+    ``levels``) as dask arrays chunked like ``dem`` in the last two axes."""
     import dask.array as da
 
     local_h = isinstance(hurst, str) and hurst == "local"
     local_s = isinstance(sigma, str) and sigma == "local"
+    shape = dem.shape
+    z = dem.map_blocks(R._as_float, nodata, dtype=np.float64) if (local_h or local_s) else None
+    if model == "smooth":
+        from fractalgeo_rs.dem import _resample_model as M
+
+        half = window // 2
+        t = M.pad_width(half)
+        mb = 0 if support == "point" else block
+        floor = M.INNER_SCALE_FLOOR / (1 << levels)
+
+        def smooth_fn(b):
+            lh, ls, _, _, _ = M.analyse_padded(b, half, mb, levels, floor)
+            return np.concatenate([lh, ls])
+
+        padded, core = halo_blocks(z, t, R.STEP)
+        hs = padded.map_blocks(smooth_fn, dtype=np.float64, new_axis=0,
+                               chunks=((2 * levels,),) + core)
+        chunks = ((levels,),) + dem.chunks
+        return hs[:levels].rechunk(chunks), hs[levels:].rechunk(chunks)
+    if isinstance(hurst, np.ndarray) and hurst.ndim == 3:
+        # Per-level stacks computed beforehand (the CLI).
+        chunks = ((hurst.shape[0],),) + dem.chunks
+        return (da.from_array(np.ascontiguousarray(hurst), chunks=chunks),
+                da.from_array(np.ascontiguousarray(sigma), chunks=chunks))
     if local_h or local_s:
         half = window // 2
         t = R._pad_width(half)
@@ -30,22 +56,31 @@ def _analysis_maps(dem, hurst, sigma, window, support, nodata, block=2, n_thread
             h, s, _, _ = R._analyse_padded(b, half, support, block, n_threads=n_threads)
             return np.stack([h, s])
 
-        z = dem.map_blocks(R._as_float, nodata, dtype=np.float64)
         # Chunks on multiples of the node step: the nodes sit on one global grid.
         padded, core = halo_blocks(z, t, R.STEP)
         hs = padded.map_blocks(block_fn, dtype=np.float64, new_axis=0,
                                chunks=((2,),) + core)
-        h_map, s_map = hs[0], hs[1]
-    shape = dem.shape
+        h_map, s_map = hs[0].rechunk(dem.chunks), hs[1].rechunk(dem.chunks)
     h = h_map if local_h else da.from_array(
         R._param_map(hurst, "hurst", shape, 0.0, 1.0, True, True), chunks=dem.chunks)
-    s = s_map if local_s else da.from_array(
-        R._param_map(sigma, "sigma", shape, 0.0, np.inf, False, False), chunks=dem.chunks)
-    return h.rechunk(dem.chunks), s.rechunk(dem.chunks)
+    if local_s:
+        s = s_map
+        if support == "area" and not local_h:
+            hh, _, g1tab = R._ratio_table(block)
+
+            def user_sigma(sl, hl, hu):
+                g1 = sl**2 * np.interp(hl, hh, g1tab)
+                return np.sqrt(g1 / np.interp(np.clip(hu, hh[0], hh[-1]), hh, g1tab))
+
+            s = da.map_blocks(user_sigma, s_map, h_map, h, dtype=np.float64)
+    else:
+        s = da.from_array(R._param_map(sigma, "sigma", shape, 0.0, np.inf, False, False),
+                          chunks=dem.chunks)
+    return h.rechunk(dem.chunks)[None], s.rechunk(dem.chunks)[None]
 
 
 def run_dask(dem, levels, hurst, sigma, window, detail, support, nodata, seed, n_threads,
-             return_analysis):
+             return_analysis, model=None, clip_min=None):
     """Lazy fractal resampling of a 2D dask array."""
     import dask
     import dask.array as da
@@ -55,7 +90,13 @@ def run_dask(dem, levels, hurst, sigma, window, detail, support, nodata, seed, n
     R._check_shape(dem.shape)
     f = 1 << levels
     point = support == "point"
-    h_map, s_map = _analysis_maps(dem, hurst, sigma, window, support, nodata, min(f, 8), n_threads)
+    local_h = isinstance(hurst, str) and hurst == "local"
+    local_s = isinstance(sigma, str) and sigma == "local"
+    model = R._check_model(model, local_h, local_s)
+    if local_h or local_s:
+        R._warn_window(window, dem.shape)
+    h_map, s_map = _analysis_maps(dem, hurst, sigma, window, support, nodata, min(f, 8), n_threads,
+                                  levels, model)
     n0, n1 = dem.shape
     halo = R._HALO
     row_edges = np.concatenate([[0], np.cumsum(dem.chunks[0])])
@@ -79,11 +120,15 @@ def run_dask(dem, levels, hurst, sigma, window, detail, support, nodata, seed, n
             u0, u1 = max(c - halo, 0), min(d + halo, n1)
             fc, fd = _out_bounds(c, d, n1, f, point)
             sl = (slice(t0, t1), slice(u0, u1))
-            part = dask.delayed(tile)(dem[sl], h_map[sl], s_map[sl], t0, u0,
+            part = dask.delayed(tile)(dem[sl], h_map[(slice(None),) + sl], s_map[(slice(None),) + sl],
+                                      t0, u0,
                                       fa - f * t0, fb - f * t0, fc - f * u0, fd - f * u0)
             row.append(da.from_delayed(part, shape=(fb - fa, fd - fc), dtype=np.float64))
         rows.append(row)
     out = da.block(rows)
+    if clip_min is not None:
+        out = da.maximum(out, clip_min)
     if return_analysis:
-        return out, R.ResampleAnalysis(h_map, s_map, float("nan"), window)
+        return out, R.ResampleAnalysis(h_map[0], s_map[0], float("nan"), window, model=model,
+                                       level_hurst=h_map, level_sigma=s_map)
     return out

@@ -1,0 +1,309 @@
+"""The scale-aware ("smooth") model of fractal resampling: a structure
+function with an inner scale, fitted to the coarse DEM's variogram at lags
+1, 2, 4 and 8 cells in every analysis window, and the per-level power laws
+the kernel draws each x2 level with.
+
+The model (input cells as the length unit)::
+
+    D(h) = a r^(2H) ((1 + (h / r)^2)^H - 1)
+
+is smooth (``D ~ h^2``) below the inner scale ``r`` and fBm with Hurst
+exponent ``H`` above it; ``r = 0`` is fBm (``D = a h^(2H)``). A level whose
+coarse spacing is ``s`` input cells is drawn as fBm with the local exponent
+``H_s = log2(D(s) / D(s / 2)) / 2`` and the amplitude that gives ``D(s)``
+at lag ``s``: the power law that matches the model at the two lags the
+level's new samples sit between.
+"""
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from fractalgeo_rs.dem import _resample_grid as R
+
+#: Lags (input cells) of the local fit.
+LAGS = (1, 2, 4, 8)
+#: Grids of the fit: H of the fractal regime and the inner scale r (input
+#: cells; 0 is fBm).
+H_GRID = np.linspace(0.05, 0.95, 37)
+R_GRID = np.concatenate([[0.0], np.geomspace(0.02, 64.0, 72)])
+#: Fewest increments per lag for a window's fit (else the lag-1/lag-2 fBm
+#: fit, else no detail).
+MIN_PAIRS = 16
+#: Smallest inner scale of the default model, in output cells (a DEM is
+#: smooth at its own pixel: its heights are not point values of a fractal).
+INNER_SCALE_FLOOR = 1.0
+#: Range of the per-level exponents passed to the kernel (its tables) and
+#: the number of nodes of its full-stencil tables (``rust/dem/resample.rs``).
+LEVEL_H = (0.01, 0.99)
+H_TABLE_NODES = 201
+
+
+def shape_point(h, r, hurst):
+    """``D(h) / a`` of point samples (broadcasting ``h``, ``r``, ``hurst``)."""
+    h, r, hurst = np.broadcast_arrays(np.asarray(h, float), np.asarray(r, float),
+                                      np.asarray(hurst, float))
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        rr = np.where(r > 0, r, 1.0)
+        smooth = rr ** (2 * hurst) * np.expm1(hurst * np.log1p((h / rr) ** 2))
+        return np.where(r > 0, smooth, h ** (2 * hurst))
+
+
+def shape_block(lag, r, hurst, n):
+    """``D_B(lag) / a`` of block means (each cell the mean of ``n x n``
+    points at spacing ``1 / n``): ``mean f(|p - q|) - mean f(|p - p'|)``
+    over the points ``p``, ``p'`` of one block and ``q`` of the block
+    ``lag`` cells away (rows or columns: the model is isotropic)."""
+    m = np.arange(-(n - 1), n)
+    w = (n - np.abs(m)) / n**2
+    dy, dx = np.meshgrid(m / n, m / n, indexing="ij")
+    ww = np.outer(w, w)
+    r = np.asarray(r, float)[..., None, None]
+    hurst = np.asarray(hurst, float)[..., None, None]
+    d0 = np.hypot(dy, dx)
+    base = (ww * shape_point(d0, r, hurst)).sum((-1, -2))
+    d1 = np.hypot(dy, dx + lag)
+    return (ww * shape_point(d1, r, hurst)).sum((-1, -2)) - base
+
+
+@functools.lru_cache(maxsize=8)
+def model_table(block, lags=LAGS):
+    """``(r, H, log_shape)``: every model of the grid and its log structure
+    function at ``lags`` (point samples for ``block = 0``, else block means
+    of ``block x block`` points)."""
+    rr, hh = np.meshgrid(R_GRID, H_GRID, indexing="ij")
+    rr, hh = rr.ravel(), hh.ravel()
+    cols = []
+    for k in lags:
+        v = shape_point(float(k), rr, hh) if block == 0 else shape_block(float(k), rr, hh, block)
+        cols.append(np.log(v))
+    return rr, hh, np.stack(cols, 1)
+
+
+@functools.lru_cache(maxsize=8)
+def _tree(block, lags=LAGS):
+    from scipy.spatial import cKDTree
+
+    _, _, ls = model_table(block, lags)
+    return cKDTree(ls - ls.mean(1, keepdims=True))
+
+
+def fit(logd, block, lags=LAGS):
+    """Least-squares fit of the model's shape to log structure functions
+    ``logd`` (``(..., len(lags))``, amplitude free): ``(r, H, log_shape)``
+    of the nearest model of the grid in the centred log space."""
+    rr, hh, ls = model_table(block, lags)
+    q = logd - logd.mean(-1, keepdims=True)
+    flat = q.reshape(-1, len(lags))
+    idx = np.zeros(flat.shape[0], dtype=np.intp)
+    ok = np.isfinite(flat).all(1)
+    if ok.any():
+        idx[ok] = _tree(block, lags).query(flat[ok])[1]
+    shp = logd.shape[:-1]
+    return rr[idx].reshape(shp), hh[idx].reshape(shp), ls[idx].reshape(shp + (len(lags),))
+
+
+def level_params(r, hurst, amp, levels):
+    """Per-level ``(H_l, sigma_l)`` (stacks of ``levels``) of the model
+    ``amp * shape_point`` at the coarse spacings ``s = 2^-l``:
+    ``H_l = log2(D(s) / D(s/2)) / 2`` (clipped to ``LEVEL_H``) and
+    ``sigma_l = sqrt(D(s)) s^-H_l``, the kernel's power law through
+    ``D(s)`` and ``D(s/2)``."""
+    hs, ss = [], []
+    for lvl in range(levels):
+        s = 2.0 ** -lvl
+        d1 = amp * shape_point(s, r, hurst)
+        d2 = amp * shape_point(s / 2, r, hurst)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            h = np.clip(0.5 * np.log2(d1 / d2), *LEVEL_H)
+        h = np.where(np.isfinite(h), h, 0.5)
+        sig = np.sqrt(np.maximum(d1, 0.0)) * s ** (-h)
+        hs.append(h)
+        ss.append(np.where(np.isfinite(sig), sig, 0.0))
+    return np.stack(hs), np.stack(ss)
+
+
+def pad_width(half, step=R.STEP):
+    """NaN halo (a multiple of ``step``) the model analysis of a block
+    needs: the window, the largest lag and one node spacing."""
+    return -(-(half + max(LAGS) + step) // step) * step
+
+
+def node_variograms(z, half, step=R.STEP):
+    """Window sums of squared increments and their counts at every lag of
+    ``LAGS`` (rows and columns pooled, each increment in the window of its
+    first sample) at the nodes of a ``step`` grid of the NaN-padded block
+    ``z`` (origin a multiple of ``step``): ``(sums, counts, k0r, k0c)``,
+    arrays ``(len(LAGS), nodes_r, nodes_c)``, node ``(a, b)`` at pixel
+    ``((k0r + a) step, (k0c + b) step)``. Each sum is formed in a fixed
+    order from its window only (``_resample._node_sums``), so any block of a
+    larger array gives the same bits."""
+    m = np.isfinite(z)
+    zz = np.where(m, z, 0.0)
+    # Valid samples filling a rectangle (a DEM without holes in its NaN
+    # halo): the counts are products of 1D counts (integers, exact in
+    # float64: the same bits as the 2D sums) and the increments need no mask.
+    rows = np.flatnonzero(m.any(1))
+    cols = np.flatnonzero(m.any(0))
+    rect = False
+    if rows.size and cols.size:
+        r0, r1, c0, c1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
+        rect = bool(m[r0:r1, c0:c1].all())
+
+    def sums_1d(lo, hi, lag, n):
+        u = np.zeros((n, 1))
+        u[lo:max(hi - lag, lo)] = 1.0
+        return R._node_sums(u, half, step)[0][:, 0]
+
+    sums, counts = [], []
+    k0r = k0c = 0
+    for lag in LAGS:
+        s = np.zeros(z.shape)
+        d = zz[lag:] - zz[:-lag]
+        d *= d
+        if rect:
+            d[:r0] = 0.0
+            d[max(r1 - lag, 0):] = 0.0
+        else:
+            ok = m[lag:] & m[:-lag]
+            d *= ok
+        s[:-lag] = d
+        d = zz[:, lag:] - zz[:, :-lag]
+        d *= d
+        if rect:
+            d[:, :c0] = 0.0
+            d[:, max(c1 - lag, 0):] = 0.0
+        else:
+            ok = m[:, lag:] & m[:, :-lag]
+            d *= ok
+        s[:, :-lag] += d
+        rsum, k0r = R._node_sums(s, half, step)
+        csum, k0c = R._node_sums(np.ascontiguousarray(rsum.T), half, step)
+        sums.append(csum.T)
+        if rect:
+            ur, u0 = sums_1d(r0, r1, lag, z.shape[0]), sums_1d(r0, r1, 0, z.shape[0])
+            vc, v0 = sums_1d(c0, c1, lag, z.shape[1]), sums_1d(c0, c1, 0, z.shape[1])
+            counts.append(ur[:, None] * v0[None] + u0[:, None] * vc[None])
+        else:
+            c = np.zeros(z.shape)
+            c[:-lag] += m[lag:] & m[:-lag]
+            c[:, :-lag] += m[:, lag:] & m[:, :-lag]
+            rc, _ = R._node_sums(c, half, step)
+            cc, _ = R._node_sums(np.ascontiguousarray(rc.T), half, step)
+            counts.append(cc.T)
+    return np.stack(sums), np.stack(counts), k0r, k0c
+
+
+def interp_to_pixels(v, k0r, k0c, shape, t, step=R.STEP):
+    """Bilinear interpolation of node values ``v`` (``(..., nodes_r,
+    nodes_c)``) to the pixels of a block of ``shape`` trimmed by ``t``."""
+    lead = v.shape[:-2]
+    flat = v.reshape((-1,) + v.shape[-2:])
+    out = []
+    for a in flat:
+        rows = R._interp_nodes(np.ascontiguousarray(a), k0r, t, shape[0] - t, step)
+        out.append(R._interp_nodes(np.ascontiguousarray(rows.T), k0c, t, shape[1] - t, step).T)
+    return np.stack(out).reshape(lead + (shape[0] - 2 * t, shape[1] - 2 * t))
+
+
+def analyse_nodes(z, half, block, levels, r_floor=0.0, step=R.STEP):
+    """The model fit at the nodes of a NaN-padded block (see
+    :func:`node_variograms`). Returns a dict of node arrays: ``r``, ``H``
+    (the fit, ``r`` at least ``r_floor``; ``r = 0`` and the lag-1/lag-2
+    ``H`` where a lag has too few increments), ``h12`` (raw lag-1/lag-2 exponent, NaN where none),
+    ``valid`` (the window has lag-1 increments), ``level_h``, ``level_s``
+    (``levels`` stacks), and ``k0r``, ``k0c``."""
+    s, c, k0r, k0c = node_variograms(z, half, step)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d = s / c
+        logd = np.log(np.moveaxis(d, 0, -1))
+    enough = (np.moveaxis(c, 0, -1) >= MIN_PAIRS).all(-1) & np.isfinite(logd).all(-1)
+    r, hfit, ls = fit(np.where(enough[..., None], logd, np.nan), block)
+    d1, d2 = d[0], d[1]
+    valid = np.isfinite(d1) & (c[0] > 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = d2 / d1
+    if block == 0:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            h12 = 0.5 * np.log2(ratio)
+    else:
+        hh, rt, _ = R._ratio_table(block)
+        h12 = np.interp(np.where(np.isfinite(ratio), ratio, 1.0), rt, hh, left=0.0, right=2.0)
+    h12 = np.where(np.isfinite(ratio) & (d1 > 0), h12, np.nan)
+    # Windows without all four lags: fBm of the lag-1/lag-2 exponent.
+    fb = ~enough
+    r = np.where(fb, 0.0, np.maximum(r, r_floor))
+    hfit = np.where(fb, np.clip(np.where(np.isfinite(h12), h12, 0.5), *R.HURST_RANGE), hfit)
+    # Amplitude from the lag-1 structure function (of the block means for
+    # area support): D(1) of the fitted model equals the measured one.
+    one = shape_point(1.0, r, hfit) if block == 0 else shape_block(1.0, r, hfit, block)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        amp = np.where(valid & (d1 > 0), d1 / one, 0.0)
+    amp = np.where(np.isfinite(amp), amp, 0.0)
+    lh, lsg = level_params(r, hfit, amp, levels)
+    return dict(r=r, H=hfit, h12=h12, valid=valid, enough=enough, level_h=lh, level_s=lsg,
+                k0r=k0r, k0c=k0c)
+
+
+def analyse_padded(z, half, block, levels, r_floor, step=R.STEP):
+    """Pixel maps of a NaN-padded block trimmed by ``pad_width(half)``:
+    ``(level_h, level_s, r, H)`` (``levels`` stacks, then the inner scale
+    and the fitted H) and the counts of the nodes in the block's core
+    ``(n_valid, n_smooth, n_rough, n_tapered, n_centre)`` (valid: lag-1
+    increments in the window; smooth / rough: lag-1/lag-2 exponent above /
+    below ``HURST_RANGE``; tapered: inner scale above one output cell;
+    centre: a finite centre pixel). ``r_floor``: the inner scale used is at least this
+    (input cells)."""
+    nd = analyse_nodes(z, half, block, levels, r_floor, step)
+    t = pad_width(half, step)
+    shape = z.shape
+    k0r, k0c = nd["k0r"], nd["k0c"]
+    maps = interp_to_pixels(np.concatenate([nd["level_h"], nd["level_s"], nd["r"][None],
+                                            nd["H"][None]]), k0r, k0c, shape, t, step)
+    lv = nd["level_h"].shape[0]
+    level_h, level_s, r_map, h_map = maps[:lv], maps[lv:2 * lv], maps[2 * lv], maps[2 * lv + 1]
+    # H on the nodes of the kernel's tables (201 in [0.01, 0.99], steps of
+    # 0.0049): the kernel then redoes its table lookup only where H changes.
+    q = (LEVEL_H[1] - LEVEL_H[0]) / (H_TABLE_NODES - 1)
+    level_h = LEVEL_H[0] + np.rint((level_h - LEVEL_H[0]) / q) * q
+    # Counts over the nodes whose pixel lies in the block's core.
+    ar = (k0r + np.arange(nd["r"].shape[0])) * step
+    ac = (k0c + np.arange(nd["r"].shape[1])) * step
+    inside = (((ar >= t) & (ar < shape[0] - t))[:, None] & ((ac >= t) & (ac < shape[1] - t))[None])
+    core_ok = np.zeros_like(inside)
+    ii, jj = np.nonzero(inside)
+    core_ok[ii, jj] = np.isfinite(z[ar[ii], ac[jj]])
+    v = core_ok & nd["valid"]
+    h12 = nd["h12"]
+    lo, hi = R.HURST_RANGE
+    r_out = 2.0 ** -levels
+    counts = (int(v.sum()), int((v & (h12 > hi)).sum()), int((v & (h12 < lo)).sum()),
+              int((v & nd["enough"] & (nd["r"] > r_out * (1 + 1e-9))).sum()), int(core_ok.sum()))
+    return level_h, level_s, r_map, h_map, counts
+
+
+def global_fit(z, block):
+    """The model fitted to the whole DEM's variogram at every lag ``2^k``
+    up to a quarter of its shorter side: ``(r, H)`` (input cells)."""
+    n = min(z.shape)
+    lags = tuple(2**k for k in range(0, 16) if 2**k <= max(n // 4, 2))
+    if len(lags) < 3:
+        return float("nan"), float("nan")
+    logd = []
+    for k in lags:
+        # Lag k from the pairs starting on every max(2, k)-th row (unbiased;
+        # all lags together cost about 1.5 passes over the DEM).
+        t = max(2, k)
+        a = z[k::t] - z[:-k:t][: z[k::t].shape[0]]
+        b = z[::t, k:] - z[::t, :-k]
+        cnt = int(np.count_nonzero(np.isfinite(a)) + np.count_nonzero(np.isfinite(b)))
+        if cnt == 0:
+            return float("nan"), float("nan")
+        v = float(np.nansum(a * a) + np.nansum(b * b))
+        logd.append(np.log(v / cnt) if v > 0 else np.nan)
+    ld = np.array(logd)
+    if not np.isfinite(ld).all():
+        return float("nan"), float("nan")
+    r, h, _ = fit(ld[None], block, lags)
+    return float(r[0]), float(h[0])
