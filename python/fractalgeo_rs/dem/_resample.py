@@ -15,13 +15,13 @@ from fractalgeo_rs._validation import (as_array, check_choice, check_memory, che
                                       check_positive_float)
 
 from fractalgeo_rs.dem._resample_grid import (  # noqa: F401  (re-exported for the other modules)
-    _H_TABLE,
+    H_TABLE,
     HURST_RANGE,
     STEP,
-    _block_variogram,
-    _interp_nodes,
-    _node_sums,
-    _ratio_table,
+    block_variogram,
+    interp_nodes,
+    node_sums,
+    ratio_table,
 )
 
 __all__ = ["resample_analysis", "ResampleAnalysis", "HURST_RANGE"]
@@ -158,7 +158,7 @@ def _analyse_padded(z, half, support, block=2, step=STEP, border=0, n_threads=No
     (``rust/dem/analysis.rs``): window sums at the nodes of a ``step`` grid,
     each formed in a fixed order from its window only, interpolated
     bilinearly, so any such block of a larger array gives the same bits."""
-    table = None if support == "point" else _ratio_table(block)
+    table = None if support == "point" else ratio_table(block)
     return _core.resample_local_maps(z, half, step, border, HURST_RANGE, table, n_threads)
 
 
@@ -288,10 +288,10 @@ def _box_sum(a, half, t, step=STEP):
     ``step`` grid, interpolated bilinearly to the pixels of ``a`` trimmed by
     ``t`` (a value depends only on the values in the windows of its 4 nodes,
     computed in a fixed order)."""
-    r, k0 = _node_sums(a, half, step)
-    c, k1 = _node_sums(np.ascontiguousarray(r.T), half, step)
-    v = _interp_nodes(c, k1, t, a.shape[1] - t, step).T
-    return _interp_nodes(np.ascontiguousarray(v), k0, t, a.shape[0] - t, step)
+    r, k0 = node_sums(a, half, step)
+    c, k1 = node_sums(np.ascontiguousarray(r.T), half, step)
+    v = interp_nodes(c, k1, t, a.shape[1] - t, step).T
+    return interp_nodes(np.ascontiguousarray(v), k0, t, a.shape[0] - t, step)
 
 
 def _analyse_padded_reference(z, half, support, block=2, step=STEP):
@@ -332,7 +332,7 @@ def _analyse_padded_reference(z, half, support, block=2, step=STEP):
     else:
         # Block means: invert the regularised variogram ratio for H, then
         # sigma^2 = g1 / gamma_block(1; H).
-        hh, rr, g1tab = _ratio_table(block)
+        hh, rr, g1tab = ratio_table(block)
         hraw = np.where(ok, np.interp(np.where(ok, ratio, 1.0), rr, hh, left=-1.0, right=9.0), np.nan)
         hraw = np.where(hraw == -1.0, 0.0, np.where(hraw == 9.0, 2.0, hraw))
         hc = np.clip(np.where(ok, hraw, 0.5), *HURST_RANGE)
@@ -528,7 +528,7 @@ def _maps(z, hurst, sigma, window, support, local_h, local_s, block=2, n_threads
         if support == "area" and not local_h:
             # sigma^2 = g1 / gamma_block(1; H) with the user's H, not the
             # local one the kernel divided by.
-            hh, _, g1tab = _ratio_table(block)
+            hh, _, g1tab = ratio_table(block)
             g1 = s_map**2 * np.interp(h_map, hh, g1tab)
             s = np.sqrt(g1 / np.interp(np.clip(h, hh[0], hh[-1]), hh, g1tab))
     else:

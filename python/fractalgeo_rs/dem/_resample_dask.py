@@ -66,7 +66,7 @@ def _analysis_maps(dem, hurst, sigma, window, support, nodata, block=2, n_thread
     if local_s:
         s = s_map
         if support == "area" and not local_h:
-            hh, _, g1tab = R._ratio_table(block)
+            hh, _, g1tab = R.ratio_table(block)
 
             def user_sigma(sl, hl, hu):
                 g1 = sl**2 * np.interp(hl, hh, g1tab)

@@ -16,7 +16,7 @@ HURST_RANGE = (0.05, 0.95)
 STEP = 8
 
 
-def _block_variogram(hurst, lag, n=2):
+def block_variogram(hurst, lag, n=2):
     """``Var(Zbar(x + lag) - Zbar(x)) / sigma^2`` for fBm block means, each
     block the mean of ``n x n`` points at spacing ``1/n`` (the kernel's area
     model uses ``n = 2``); ``n = 1`` is the point variogram ``lag^(2H)``."""
@@ -34,18 +34,18 @@ def _block_variogram(hurst, lag, n=2):
     return 2.0 * (gbar((0.0, lag)) - gbar((0.0, 0.0)))
 
 
-_H_TABLE = np.linspace(0.001, 1.5, 1500)
+H_TABLE = np.linspace(0.001, 1.5, 1500)
 
 
 @functools.lru_cache(maxsize=8)
-def _ratio_table(n):
-    """``(H, gamma_B(2) / gamma_B(1), gamma_B(1))`` on ``_H_TABLE``."""
-    h = _H_TABLE
-    g1 = _block_variogram(h, 1.0, n)
-    return h, _block_variogram(h, 2.0, n) / g1, g1
+def ratio_table(n):
+    """``(H, gamma_B(2) / gamma_B(1), gamma_B(1))`` on ``H_TABLE``."""
+    h = H_TABLE
+    g1 = block_variogram(h, 1.0, n)
+    return h, block_variogram(h, 2.0, n) / g1, g1
 
 
-def _node_sums(a, half, step):
+def node_sums(a, half, step):
     """Sums along axis 0 over rows ``[p - half, p + half]`` at the nodes
     ``p = k step`` whose window fits in ``a``; returns ``(sums, k_first)``.
 
@@ -76,7 +76,7 @@ def _node_sums(a, half, step):
     return acc, k0
 
 
-def _interp_nodes(v, k0, lo, hi, step):
+def interp_nodes(v, k0, lo, hi, step):
     """Bilinear (along axis 0) interpolation of node values ``v`` (node
     ``k0 + a`` at row ``(k0 + a) step``) to the rows ``[lo, hi)``, ``lo`` a
     multiple of ``step`` (rows grouped by node interval: no gathers)."""

@@ -137,7 +137,7 @@ def node_variograms(z, half, step=R.STEP):
     ``z`` (origin a multiple of ``step``): ``(sums, counts, k0r, k0c)``,
     arrays ``(len(LAGS), nodes_r, nodes_c)``, node ``(a, b)`` at pixel
     ``((k0r + a) step, (k0c + b) step)``. Each sum is formed in a fixed
-    order from its window only (``_resample._node_sums``), so any block of a
+    order from its window only (``_resample.node_sums``), so any block of a
     larger array gives the same bits."""
     m = np.isfinite(z)
     zz = np.where(m, z, 0.0)
@@ -154,7 +154,7 @@ def node_variograms(z, half, step=R.STEP):
     def sums_1d(lo, hi, lag, n):
         u = np.zeros((n, 1))
         u[lo:max(hi - lag, lo)] = 1.0
-        return R._node_sums(u, half, step)[0][:, 0]
+        return R.node_sums(u, half, step)[0][:, 0]
 
     sums, counts = [], []
     k0r = k0c = 0
@@ -178,8 +178,8 @@ def node_variograms(z, half, step=R.STEP):
             ok = m[:, lag:] & m[:, :-lag]
             d *= ok
         s[:, :-lag] += d
-        rsum, k0r = R._node_sums(s, half, step)
-        csum, k0c = R._node_sums(np.ascontiguousarray(rsum.T), half, step)
+        rsum, k0r = R.node_sums(s, half, step)
+        csum, k0c = R.node_sums(np.ascontiguousarray(rsum.T), half, step)
         sums.append(csum.T)
         if rect:
             ur, u0 = sums_1d(r0, r1, lag, z.shape[0]), sums_1d(r0, r1, 0, z.shape[0])
@@ -189,8 +189,8 @@ def node_variograms(z, half, step=R.STEP):
             c = np.zeros(z.shape)
             c[:-lag] += m[lag:] & m[:-lag]
             c[:, :-lag] += m[:, lag:] & m[:, :-lag]
-            rc, _ = R._node_sums(c, half, step)
-            cc, _ = R._node_sums(np.ascontiguousarray(rc.T), half, step)
+            rc, _ = R.node_sums(c, half, step)
+            cc, _ = R.node_sums(np.ascontiguousarray(rc.T), half, step)
             counts.append(cc.T)
     return np.stack(sums), np.stack(counts), k0r, k0c
 
@@ -202,8 +202,8 @@ def interp_to_pixels(v, k0r, k0c, shape, t, step=R.STEP):
     flat = v.reshape((-1,) + v.shape[-2:])
     out = []
     for a in flat:
-        rows = R._interp_nodes(np.ascontiguousarray(a), k0r, t, shape[0] - t, step)
-        out.append(R._interp_nodes(np.ascontiguousarray(rows.T), k0c, t, shape[1] - t, step).T)
+        rows = R.interp_nodes(np.ascontiguousarray(a), k0r, t, shape[0] - t, step)
+        out.append(R.interp_nodes(np.ascontiguousarray(rows.T), k0c, t, shape[1] - t, step).T)
     return np.stack(out).reshape(lead + (shape[0] - 2 * t, shape[1] - 2 * t))
 
 
@@ -228,7 +228,7 @@ def analyse_nodes(z, half, block, levels, r_floor=0.0, step=R.STEP):
         with np.errstate(divide="ignore", invalid="ignore"):
             h12 = 0.5 * np.log2(ratio)
     else:
-        hh, rt, _ = R._ratio_table(block)
+        hh, rt, _ = R.ratio_table(block)
         h12 = np.interp(np.where(np.isfinite(ratio), ratio, 1.0), rt, hh, left=0.0, right=2.0)
     h12 = np.where(np.isfinite(ratio) & (d1 > 0), h12, np.nan)
     # Windows without all four lags: fBm of the lag-1/lag-2 exponent.
