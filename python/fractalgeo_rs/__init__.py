@@ -20,6 +20,7 @@ type checkers.
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import sys
 import types
 from typing import TYPE_CHECKING, Any, Dict, List, Optional
@@ -127,8 +128,16 @@ __all__: List[str] = list(_EXPORTS)
 
 
 def __getattr__(name: str) -> Any:
-    """Import a public name on first use and keep it in the module."""
+    """Import a public name on first use and keep it in the module.
+
+    A subpackage that is not a top-level export (``fractalgeo_rs.lsystem``,
+    ``fractalgeo_rs.synth``, ...) is imported on first attribute access too,
+    as the eager imports did (``fg.lsystem.LSystem`` keeps working)."""
     if name not in _EXPORTS:
+        if not name.startswith("_") and importlib.util.find_spec(f"{__name__}.{name}") is not None:
+            module = importlib.import_module(f"{__name__}.{name}")
+            globals()[name] = module
+            return module
         raise AttributeError(f"module 'fractalgeo_rs' has no attribute {name!r}")
     source = _EXPORTS[name]
     value: Any
