@@ -61,6 +61,10 @@ _CHILD = textwrap.dedent("""
     import resource, sys
     import fractalgeo_rs as fg
     import numpy as np
+    # the package imports lazily: load the modules the calls use before the
+    # limit, as an eager import did, so the limit meets the calls' own
+    # allocations and not the import of scipy and the package's modules
+    import fractalgeo_rs.dimension, fractalgeo_rs.io, fractalgeo_rs.lsystem, fractalgeo_rs.synth
     resource.setrlimit(resource.RLIMIT_AS, (3 * 2**30, 3 * 2**30))
     calls = {calls!r}
     for call in calls:
