@@ -77,7 +77,7 @@ def test_geometric_optics_closed_form():
 def test_geometric_optics_equals_smrt():
     """SMRT 1.7 ``geometrical_optics_backscatter`` (mean_square_slope=0.05,
     SMRT's per-axis slope variance, = our 2 sigma^2 / l^2; eps = 15 + 3j),
-    values measured in /work/shared/docs/RADIOMETRY_REFERENCES.md."""
+    values measured with SMRT 1.7 (pip install smrt) and recorded here."""
     l = 1.0
     sigma = math.sqrt(0.05 / 2) * l
     got = _quiet(incidence=[0.0, 10.0, 20.0, 30.0], model="geometric_optics", wavelength=C_BAND,
