@@ -121,3 +121,18 @@ def test_every_lazy_export_is_typed_and_resolves():
             assert obj is importlib.import_module(f"fractalgeo_rs.{name}")
         else:
             assert obj is getattr(importlib.import_module(module), name)
+
+
+def test_subpackages_import_on_attribute_access_and_odd_names_do_not():
+    # fg.lsystem, fg.synth: subpackages that are not top-level exports still
+    # resolve as the eager package did; a dotted or private name is only an
+    # AttributeError (getattr with a default, as documentation tools do)
+    import subprocess
+    import sys
+
+    code = ("import fractalgeo_rs as fg, inspect\n"
+            "assert fg.lsystem.LSystem is fg.LSystem and inspect.ismodule(fg.synth)\n"
+            "assert getattr(fg, 'fit.ScaleSegment', None) is None\n"
+            "assert getattr(fg, '_nope', None) is None and getattr(fg, 'nope', None) is None\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr

@@ -127,6 +127,14 @@ _EXPORTS: Dict[str, Optional[str]] = {
 __all__: List[str] = list(_EXPORTS)
 
 
+def _is_submodule(name: str) -> bool:
+    """``fractalgeo_rs.<name>`` is a module or subpackage of the package."""
+    try:
+        return importlib.util.find_spec(f"{__name__}.{name}") is not None
+    except (ImportError, ValueError):
+        return False
+
+
 def __getattr__(name: str) -> Any:
     """Import a public name on first use and keep it in the module.
 
@@ -134,7 +142,7 @@ def __getattr__(name: str) -> Any:
     ``fractalgeo_rs.synth``, ...) is imported on first attribute access too,
     as the eager imports did (``fg.lsystem.LSystem`` keeps working)."""
     if name not in _EXPORTS:
-        if not name.startswith("_") and importlib.util.find_spec(f"{__name__}.{name}") is not None:
+        if name.isidentifier() and not name.startswith("_") and _is_submodule(name):
             module = importlib.import_module(f"{__name__}.{name}")
             globals()[name] = module
             return module
