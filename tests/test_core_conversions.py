@@ -99,3 +99,18 @@ def test_map_bindings_take_float32_and_float64_alike(name):
 def test_map_bindings_refuse_other_dtypes_naming_the_parameter(name):
     with pytest.raises(TypeError, match="float32 or float64"):
         MAPS[name](np.nan_to_num(IMG).astype(np.int32))
+
+
+@pytest.mark.parametrize("method", ["dbc", "blanket"])
+def test_fractal_transform_reads_float32_in_place_with_the_float64_result(method):
+    import warnings
+
+    import fractalgeo_rs as fg
+
+    z = np.nan_to_num(IMG)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # range warnings of a smooth test image
+        a = fg.fractal_transform(z, method=method, window_size=9)
+        b = fg.fractal_transform(z.astype(np.float64), method=method, window_size=9)
+    np.testing.assert_array_equal(a, b)
+    assert np.isfinite(a).any()
