@@ -2,16 +2,53 @@
 //! a [`Mesh`] crosses into Python as a dict of arrays (named fields, read
 //! by `fractalgeo_rs.geometry.Mesh`) and comes back from any object with
 //! those attributes ([`MeshIn`]); a `GeoGrid` is read from any object with
-//! `origin, cell_size, rotation, crs` attributes ([`GeoGridIn`]).
+//! `origin, cell_size, rotation, crs` attributes ([`GeoGridIn`]); the
+//! kernels' keyword enums ([`Split`], [`MeshFormat`]) are read from a str.
 use super::convert::{run, run_on_grid};
+use crate::error::CoreResult;
 use crate::geometry::{GeoGrid, Mesh, Split};
+use crate::io::mesh::MeshFormat;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyString};
 
 fn rows<T: Copy, const N: usize>(v: Vec<[T; N]>) -> Array2<T> {
     Array2::from_shape_fn((v.len(), N), |(i, k)| v[i][k])
+}
+
+/// A kernel enum from a Python str: the kernel's `parse` reads it (an
+/// unknown value is its ValueError naming `param`); anything but a str is a
+/// TypeError naming `param`.
+fn keyword<T>(
+    obj: &Borrowed<'_, '_, PyAny>,
+    param: &str,
+    parse: fn(&str) -> CoreResult<T>,
+) -> PyResult<T> {
+    match obj.cast::<PyString>() {
+        Ok(s) => Ok(parse(&s.to_cow()?)?),
+        Err(_) => Err(PyTypeError::new_err(format!(
+            "{param}: expected a str, got {}",
+            obj.get_type().name()?
+        ))),
+    }
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Split {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        keyword(&obj, "split", Split::parse)
+    }
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for MeshFormat {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        keyword(&obj, "format", MeshFormat::parse)
+    }
 }
 
 /// A [`Mesh`] on its way to Python: a dict `{"origin", "vertices",
@@ -105,13 +142,12 @@ fn mesh_from_grid<'py>(
     py: Python<'py>,
     dem: PyReadonlyArray2<'py, f64>,
     grid: GeoGridIn,
-    split: &str,
+    split: Split,
     n_threads: Option<usize>,
 ) -> PyResult<MeshOut> {
     let g = grid.into_grid()?;
-    let s = Split::parse(split)?;
     let (m, _) = run_on_grid(py, &dem, n_threads, |z, r, c| {
-        Mesh::from_grid(z, r, c, &g, s)
+        Mesh::from_grid(z, r, c, &g, split)
     })?;
     Ok(MeshOut(m))
 }

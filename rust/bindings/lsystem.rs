@@ -4,17 +4,17 @@
 //! back as RuntimeError, never as a PanicException.
 use super::convert::{array2, rows_in, run, run_on_grid};
 use super::geometry::{MeshIn, MeshOut};
+use crate::io::mesh::MeshFormat;
 use crate::lsystem::derive::LSystem;
 use crate::lsystem::grammar::{parse_module_string, parse_rule_text, ModString};
+use crate::lsystem::ifs;
 use crate::lsystem::mesh::build_mesh;
 use crate::lsystem::terrain::{plants_on_terrain as scene_kernel, SceneParams};
 use crate::lsystem::turtle::{polylines, segments, TurtleParams};
-use crate::lsystem::{export, ifs};
 use crate::parallel::run_in_pool;
 use glam::DVec3;
 use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -270,18 +270,11 @@ fn turtle_mesh<'py>(
 /// Write a mesh as OBJ (`format="obj"`) or binary PLY (`format="ply"`), atomically.
 #[pyfunction]
 #[pyo3(signature = (path, format, mesh))]
-fn write_mesh(py: Python<'_>, path: PathBuf, format: &str, mesh: MeshIn<'_>) -> PyResult<()> {
+fn write_mesh(py: Python<'_>, path: PathBuf, format: MeshFormat, mesh: MeshIn<'_>) -> PyResult<()> {
     let m = mesh.into_mesh()?;
-    match format {
-        "obj" => run(py, Some(1), || export::write_obj(&m, &path))?,
-        "ply" => run(py, Some(1), || export::write_ply(&m, &path))?,
-        _ => {
-            return Err(PyValueError::new_err(format!(
-                "format: expected 'obj' or 'ply', got {format:?}"
-            )))
-        }
-    }
-    Ok(())
+    run(py, Some(1), || {
+        crate::io::mesh::write_mesh(&m, &path, format)
+    })
 }
 
 /// Plants on a DEM: mesh arrays plus the plant base points (P,3).

@@ -154,7 +154,7 @@ fn gls_transform_map<'py>(
 #[allow(clippy::too_many_arguments)]
 fn dbc_transform_map<'py>(
     py: Python<'py>,
-    image: PyReadonlyArray2<'py, f64>,
+    image: &Bound<'py, PyAny>,
     window_size: usize,
     box_sizes: Vec<usize>,
     z_scale: f64,
@@ -173,9 +173,7 @@ fn dbc_transform_map<'py>(
         step,
         partial_blocks,
     };
-    let (m, _) = run_on_grid(py, &image, n_threads, |z, rows, cols| {
-        dbc_transform(z, rows, cols, &opt)
-    })?;
+    let (m, _) = on_float_image!(py, image, n_threads, dbc_transform, &opt);
     map_pair(py, m)
 }
 
@@ -186,7 +184,7 @@ fn dbc_transform_map<'py>(
 #[allow(clippy::too_many_arguments)]
 fn blanket_transform_map<'py>(
     py: Python<'py>,
-    image: PyReadonlyArray2<'py, f64>,
+    image: &Bound<'py, PyAny>,
     window_size: usize,
     epsilons: Vec<usize>,
     z_scale: f64,
@@ -201,9 +199,7 @@ fn blanket_transform_map<'py>(
         min_valid,
         step,
     };
-    let (m, _) = run_on_grid(py, &image, n_threads, |z, rows, cols| {
-        blanket_transform(z, rows, cols, &opt)
-    })?;
+    let (m, _) = on_float_image!(py, image, n_threads, blanket_transform, &opt);
     map_pair(py, m)
 }
 
@@ -212,16 +208,22 @@ fn blanket_transform_map<'py>(
 #[pyo3(signature = (image, window_size, box_sizes, min_valid, n_threads=None))]
 fn lacunarity_transform_map<'py>(
     py: Python<'py>,
-    image: PyReadonlyArray2<'py, f64>,
+    image: &Bound<'py, PyAny>,
     window_size: usize,
     box_sizes: Vec<usize>,
     min_valid: f64,
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
     let n = box_sizes.len();
-    let (l, (rows, cols)) = run_on_grid(py, &image, n_threads, |z, rows, cols| {
-        lacunarity_transform(z, rows, cols, window_size, &box_sizes, min_valid)
-    })?;
+    let (l, (rows, cols)) = on_float_image!(
+        py,
+        image,
+        n_threads,
+        lacunarity_transform,
+        window_size,
+        &box_sizes,
+        min_valid
+    );
     array3(py, (n, rows, cols), l)
 }
 

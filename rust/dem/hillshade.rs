@@ -142,25 +142,12 @@ pub struct ShadeParams {
     pub multidirectional: bool,
 }
 
-/// Hillshade of `z` (NaN = nodata) with a column spacing per row `dx[row]`
-/// (so geographic grids have their metres-per-degree at each latitude) and a
-/// row spacing `dy`, both positive. Returns the reflectance in [0, 1], NaN
-/// where the centre is nodata.
-pub fn hillshade(
-    z: ArrayView2<f64>,
-    dx: &[f64],
-    dy: f64,
-    p: &ShadeParams,
-) -> CoreResult<Array2<f32>> {
-    let (rows, cols) = z.dim();
+/// The checks both hillshades share: a non-empty grid, positive finite
+/// cell sizes (`dx` one per row or a single one), an altitude in degrees in
+/// [0, 90], and a finite azimuth and z factor.
+fn check_inputs(rows: usize, cols: usize, dx: &[f64], dy: f64, p: &ShadeParams) -> CoreResult<()> {
     if rows == 0 || cols == 0 {
         return Err(CoreError::invalid("dem", "empty grid"));
-    }
-    if dx.len() != rows {
-        return Err(CoreError::invalid(
-            "cell_size",
-            format!("need {rows} row spacings, got {}", dx.len()),
-        ));
     }
     if dx.iter().any(|v| !(v.is_finite() && *v > 0.0)) || !(dy.is_finite() && dy > 0.0) {
         return Err(CoreError::invalid(
@@ -184,6 +171,27 @@ pub fn hillshade(
         return Err(CoreError::invalid(
             "z_factor",
             format!("expected a finite number, got {}", p.z_factor),
+        ));
+    }
+    Ok(())
+}
+
+/// Hillshade of `z` (NaN = nodata) with a column spacing per row `dx[row]`
+/// (so geographic grids have their metres-per-degree at each latitude) and a
+/// row spacing `dy`, both positive. Returns the reflectance in [0, 1], NaN
+/// where the centre is nodata.
+pub fn hillshade(
+    z: ArrayView2<f64>,
+    dx: &[f64],
+    dy: f64,
+    p: &ShadeParams,
+) -> CoreResult<Array2<f32>> {
+    let (rows, cols) = z.dim();
+    check_inputs(rows, cols, dx, dy, p)?;
+    if dx.len() != rows {
+        return Err(CoreError::invalid(
+            "cell_size",
+            format!("need {rows} row spacings, got {}", dx.len()),
         ));
     }
     let alt = p.altitude.to_radians();
@@ -540,27 +548,7 @@ pub fn hillshade_gdal_byte(
     p: &ShadeParams,
 ) -> CoreResult<Array2<u8>> {
     let (rows, cols) = z.dim();
-    if rows == 0 || cols == 0 {
-        return Err(CoreError::invalid("dem", "empty grid"));
-    }
-    if !(dx.is_finite() && dx > 0.0 && dy.is_finite() && dy > 0.0) {
-        return Err(CoreError::invalid(
-            "cell_size",
-            "expected positive finite cell sizes",
-        ));
-    }
-    if !(p.altitude.is_finite() && (0.0..=90.0).contains(&p.altitude)) {
-        return Err(CoreError::invalid(
-            "altitude",
-            format!("expected degrees in [0, 90], got {}", p.altitude),
-        ));
-    }
-    if !(p.azimuth.is_finite() && p.z_factor.is_finite()) {
-        return Err(CoreError::invalid(
-            "azimuth",
-            "expected finite azimuth and z_factor",
-        ));
-    }
+    check_inputs(rows, cols, &[dx], dy, p)?;
     let d2r = std::f64::consts::PI / 180.0;
     // GDAL's geotransform: gt[1] = dx, gt[5] = -dy.
     let inv_ew = 1.0 / dx;
@@ -797,5 +785,51 @@ mod tests {
         let z = Array2::<f64>::zeros((3, 3));
         assert!(hillshade(z.view(), &[1.0, 0.0, 1.0], 1.0, &params(315.0)).is_err());
         assert!(hillshade(z.view(), &[1.0; 3], f64::NAN, &params(315.0)).is_err());
+    }
+
+    #[test]
+    fn both_hillshades_name_the_bad_parameter() {
+        let param = |r: CoreResult<()>| match r {
+            Err(CoreError::InvalidArgument { param, .. }) => param,
+            other => panic!("expected InvalidArgument, got {other:?}"),
+        };
+        let z = Array2::<f64>::zeros((3, 3));
+        let z32 = Array2::<f32>::zeros((3, 3));
+        let bad = [
+            (
+                "altitude",
+                ShadeParams {
+                    altitude: 91.0,
+                    ..params(315.0)
+                },
+            ),
+            ("azimuth", params(f64::NAN)),
+            (
+                "z_factor",
+                ShadeParams {
+                    z_factor: f64::INFINITY,
+                    ..params(315.0)
+                },
+            ),
+        ];
+        for (name, p) in bad {
+            assert_eq!(
+                param(hillshade(z.view(), &[1.0; 3], 1.0, &p).map(|_| ())),
+                name
+            );
+            assert_eq!(
+                param(hillshade_gdal_byte(z32.view(), 1.0, 1.0, &p).map(|_| ())),
+                name
+            );
+        }
+        let empty = Array2::<f32>::zeros((0, 3));
+        assert_eq!(
+            param(hillshade_gdal_byte(empty.view(), 1.0, 1.0, &params(315.0)).map(|_| ())),
+            "dem"
+        );
+        assert_eq!(
+            param(hillshade_gdal_byte(z32.view(), 0.0, 1.0, &params(315.0)).map(|_| ())),
+            "cell_size"
+        );
     }
 }

@@ -39,10 +39,11 @@
 //! area-support fine cell is NaN when its coarse cell is.
 //!
 //! Random numbers are keyed by `(seed, level, step, global fine index)`
-//! ([`crate::synth::rng`]), so a tile computed with its global origin and a
+//! ([`crate::rng`]), so a tile computed with its global origin and a
 //! halo of [`HALO`] input cells equals the same window of the whole.
 use crate::error::{CoreError, CoreResult};
-use crate::synth::rng::StreamKey;
+use crate::parallel::SharedMut;
+use crate::rng::StreamKey;
 use ndarray::{Array2, ArrayView2, ArrayView3, Axis};
 use rayon::prelude::*;
 use std::collections::{BTreeSet, HashMap};
@@ -527,20 +528,6 @@ impl<'a> Grid<'a> {
     }
 }
 
-struct Shared(*mut f64);
-// SAFETY: the pointer is shared by the rows of one parallel step only, and
-// no two rows write the same cell: a step writes only cells of one parity
-// and reads only cells of the other (see the loop), and the buffer outlives
-// the loop.
-unsafe impl Sync for Shared {}
-// SAFETY: as for Sync.
-unsafe impl Send for Shared {}
-impl Shared {
-    fn get(&self) -> *mut f64 {
-        self.0
-    }
-}
-
 /// Per-point parameter maps on the input grid (row-major), looked up by
 /// fine position; a 1 x 1 map is a constant.
 struct Maps<'a> {
@@ -779,7 +766,7 @@ fn level_point(
             .iter()
             .map(|&(dr, dc)| dr * fc as isize + dc)
             .collect();
-        let ptr = Shared(fine.as_mut_ptr());
+        let ptr = SharedMut::new(&mut fine);
         let len = fine.len();
         (0..fr).into_par_iter().for_each(|i| {
             let base = ptr.get();
@@ -1026,7 +1013,7 @@ fn level_area(
     });
     let mut fine = crate::buffers::try_zeroed(fr * fc, "factor")?;
     let len = fine.len();
-    let ptr = Shared(fine.as_mut_ptr());
+    let ptr = SharedMut::new(&mut fine);
     for ph in 0..4usize {
         let (pi, pj) = (ph / 2, ph % 2);
         let first_i = (pi + 2 - pi0) % 2;

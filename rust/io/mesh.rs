@@ -45,6 +45,37 @@ fn atomic<F: FnOnce(&mut BufWriter<File>) -> std::io::Result<()>>(
     })
 }
 
+/// A mesh file format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// Wavefront OBJ, text ([`write_obj`]).
+    Obj,
+    /// Binary little-endian PLY ([`write_ply`]).
+    Ply,
+}
+
+impl MeshFormat {
+    /// Parse `"obj"` or `"ply"` (errors name `format`).
+    pub fn parse(s: &str) -> CoreResult<Self> {
+        match s {
+            "obj" => Ok(MeshFormat::Obj),
+            "ply" => Ok(MeshFormat::Ply),
+            _ => Err(CoreError::invalid(
+                "format",
+                format!("expected 'obj' or 'ply', got {s:?}"),
+            )),
+        }
+    }
+}
+
+/// Write `mesh` to `path` as `format`, atomically.
+pub fn write_mesh(mesh: &Mesh, path: &Path, format: MeshFormat) -> CoreResult<()> {
+    match format {
+        MeshFormat::Obj => write_obj(mesh, path),
+        MeshFormat::Ply => write_ply(mesh, path),
+    }
+}
+
 /// Write `mesh` as Wavefront OBJ (1-based `f v/vt/vn` faces; branches and
 /// leaves in groups `branches` and `leaves`).
 pub fn write_obj(mesh: &Mesh, path: &Path) -> CoreResult<()> {
@@ -132,6 +163,16 @@ mod tests {
     use crate::lsystem::grammar::parse_module_string;
     use crate::lsystem::mesh::build_mesh;
     use crate::lsystem::turtle::TurtleParams;
+
+    #[test]
+    fn mesh_format_parses_and_names_the_parameter() {
+        assert_eq!(MeshFormat::parse("obj").unwrap(), MeshFormat::Obj);
+        assert_eq!(MeshFormat::parse("ply").unwrap(), MeshFormat::Ply);
+        match MeshFormat::parse("stl") {
+            Err(CoreError::InvalidArgument { param, .. }) => assert_eq!(param, "format"),
+            other => panic!("expected InvalidArgument, got {other:?}"),
+        }
+    }
 
     #[test]
     fn obj_and_ply_round_trip_counts() {

@@ -32,6 +32,7 @@ use super::sat::{band_rows, rect, sat};
 use crate::checks::positive_finite;
 use crate::dimension::blanket::{fmax, step_row};
 use crate::error::CoreResult;
+use crate::sample::Sample;
 
 /// Planes of `(rows + 2) x (cols + 2)` samples framed by one missing pixel:
 /// upper and lower blankets (missing: `-inf`, `+inf`), their next step, and
@@ -138,8 +139,8 @@ struct Grown {
 
 impl Grown {
     #[allow(clippy::too_many_arguments)]
-    fn new(
-        z: &[f64],
+    fn new<T: Sample>(
+        z: &[T],
         rows: usize,
         cols: usize,
         ri0: isize,
@@ -159,8 +160,10 @@ impl Grown {
             if r < 0 || r >= rows as isize || c1 <= c0 {
                 continue; // missing already
             }
-            buf[off..off + c1 - c0]
-                .copy_from_slice(&z[r as usize * cols + c0..r as usize * cols + c1]);
+            let src = &z[r as usize * cols + c0..r as usize * cols + c1];
+            for (d, &x) in buf[off..off + c1 - c0].iter_mut().zip(src) {
+                *d = x.to_f64();
+            }
             p.load_row(u, &buf, z_scale);
         }
         let pw = nc + 2;
@@ -315,8 +318,8 @@ pub struct BlanketMapOptions {
 /// (NaN where the window has fewer valid pixels than `min_valid * w * w`).
 /// Bands of output rows in parallel, tiles of columns in order, so the
 /// result does not depend on the thread count.
-pub fn blanket_transform(
-    z: &[f64],
+pub fn blanket_transform<T: Sample>(
+    z: &[T],
     rows: usize,
     cols: usize,
     opt: &BlanketMapOptions,

@@ -28,6 +28,7 @@ use super::sat::{band_rows, rect, sat};
 use super::sliding::rect_minmax;
 use crate::checks::{finite, positive_finite};
 use crate::error::CoreResult;
+use crate::sample::Sample;
 
 /// Options of [`dbc_transform`].
 #[derive(Debug, Clone)]
@@ -81,8 +82,8 @@ fn count_field(
 
 /// Local DBC dimension and r² maps (NaN where the window has fewer valid
 /// pixels than `min_valid * w * w`).
-pub fn dbc_transform(
-    z: &[f64],
+pub fn dbc_transform<T: Sample>(
+    z: &[T],
     rows: usize,
     cols: usize,
     opt: &DbcMapOptions,
@@ -133,6 +134,7 @@ pub fn dbc_transform(
                 let src = &z[r as usize * cols + c0..r as usize * cols + c1];
                 let base = u * nc + (c0 as isize - ci0) as usize;
                 for (c, &x) in src.iter().enumerate() {
+                    let x = x.to_f64();
                     if !x.is_nan() {
                         lo[base + c] = x;
                         hi[base + c] = x;

@@ -9,11 +9,12 @@
 use super::driver::Grid;
 use super::sat::{rect, sat};
 use crate::error::{CoreError, CoreResult};
+use crate::sample::Sample;
 
 /// Lacunarity maps, layout `[size][row][col]` (NaN where the window holds no
 /// complete valid box or fewer valid pixels than `min_valid * w * w`).
-pub fn lacunarity_transform(
-    z: &[f64],
+pub fn lacunarity_transform<T: Sample>(
+    z: &[T],
     rows: usize,
     cols: usize,
     window: usize,
@@ -36,11 +37,18 @@ pub fn lacunarity_transform(
         let sw = cols + 1;
         let zz: Vec<f64> = z[i0 * cols..i1 * cols]
             .iter()
-            .map(|&v| if v.is_nan() { 0.0 } else { v })
+            .map(|&v| {
+                let v = v.to_f64();
+                if v.is_nan() {
+                    0.0
+                } else {
+                    v
+                }
+            })
             .collect();
         let nan: Vec<f64> = z[i0 * cols..i1 * cols]
             .iter()
-            .map(|&v| v.is_nan() as u8 as f64)
+            .map(|&v| v.to_f64().is_nan() as u8 as f64)
             .collect();
         let (zs, ns) = (sat(&zz, nr, cols), sat(&nan, nr, cols));
         for (&r, plane_out) in box_sizes.iter().zip(outs.iter_mut()) {

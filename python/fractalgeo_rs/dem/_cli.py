@@ -93,9 +93,9 @@ def _run_resample(args: argparse.Namespace) -> int:
     from rasterio.windows import Window
 
     from fractalgeo_rs import _progress
-    from fractalgeo_rs._validation import MemoryLimitError, atomic_write_path, check_positive_int
+    from fractalgeo_rs._validation import (MemoryLimitError, atomic_write_path, check_positive_int, check_seed,
+                                           check_window)
     from fractalgeo_rs.dem import _resample as R
-    from fractalgeo_rs.synth._common import resolve_seed
     from fractalgeo_rs.io import read_raster
 
     if not str(args.output).lower().endswith((".tif", ".tiff")):
@@ -103,7 +103,7 @@ def _run_resample(args: argparse.Namespace) -> int:
     hurst = _number_or_local(args.hurst, "hurst")
     sigma = _number_or_local(args.sigma, "sigma")
     chunks = check_positive_int(args.chunks, "chunks")
-    levels = R._levels(args.factor)
+    levels = R.levels_of(args.factor)
     f = 1 << levels
     z, profile = read_raster(args.input, band=args.band)
     g = input_georef(args, profile, z.shape)
@@ -114,9 +114,9 @@ def _run_resample(args: argparse.Namespace) -> int:
     R._check_shape(z.shape)
     if not np.isfinite(z).any():
         raise ValueError("dem: every sample is NaN or nodata")
-    detail = R._detail(levels, cell, args.min_scale)
-    seed = resolve_seed(args.seed)
-    window = R._check_window(args.window)
+    detail = R.detail_levels(levels, cell, args.min_scale)
+    seed = check_seed(args.seed)
+    window = check_window(args.window, minimum=5, cover=True)
     da: Any
     try:
         import dask.array as da
@@ -147,7 +147,7 @@ def _run_resample(args: argparse.Namespace) -> int:
 
         an = R._maps(z, hurst, sigma, window, args.support, hurst == "local", sigma == "local",
                      min(1 << levels, 8), args.n_threads, levels=levels,
-                     model=R._check_model(None, hurst == "local", sigma == "local"))
+                     model=R.check_model(None, hurst == "local", sigma == "local"))
         out = run_dask(da.from_array(z, chunks=chunks), levels, an.level_hurst, an.level_sigma, window,
                        detail, args.support, None, seed, args.n_threads, False)
         prof.update(height=out.shape[0], width=out.shape[1])

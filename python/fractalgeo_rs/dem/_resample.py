@@ -9,10 +9,11 @@ from typing import Optional, Tuple
 import numpy as np
 
 from fractalgeo_rs import _core
+from fractalgeo_rs._backend import array_kind
 from fractalgeo_rs._compat import renamed_parameters
 from fractalgeo_rs._warn import user_stacklevel
 from fractalgeo_rs._validation import (as_array, check_choice, check_memory, check_n_threads, check_nodata,
-                                      check_positive_float)
+                                      check_positive_float, check_window)
 
 from fractalgeo_rs.dem._resample_grid import (  # noqa: F401  (re-exported for the other modules)
     H_TABLE,
@@ -162,17 +163,6 @@ def _analyse_padded(z, half, support, block=2, step=STEP, border=0, n_threads=No
     return _core.resample_local_maps(z, half, step, border, HURST_RANGE, table, n_threads)
 
 
-def _check_window(window, shape=None):
-    if isinstance(window, bool) or not isinstance(window, numbers.Integral):
-        raise TypeError(f"window_size: expected an odd int >= 5, got {window!r}")
-    if window < 5 or window % 2 == 0:
-        raise ValueError(f"window_size: expected an odd int >= 5, got {window}")
-    if shape is not None and window > 2 * max(shape) + 1:
-        raise ValueError(f"window_size: {window} is more than twice the DEM's side {max(shape)}; "
-                         f"a window of at most {2 * max(shape) + 1} already covers it")
-    return int(window)
-
-
 @renamed_parameters({"window": "window_size"}, since="0.2.0")
 def resample_analysis(dem, *, window_size=33, support="point", block=2, nodata=None, n_threads=None,
                       model="fbm", factor=2, cell_size=None):
@@ -239,10 +229,10 @@ def resample_analysis(dem, *, window_size=33, support="point", block=2, nodata=N
     check_choice(model, "model", ("fbm", "smooth"))
     n_threads = check_n_threads(n_threads)
     z = _as_float(dem, nodata)
-    window = _check_window(window_size, z.shape)
+    window = check_window(window_size, minimum=5, shape=z.shape, cover=True)
     if model == "smooth":
-        levels = _levels(factor)
-        cell = _cell_size(cell_size, dem)
+        levels = levels_of(factor)
+        cell = cell_size_of(cell_size, dem)
         _warn_window(window, z.shape)
         return _smooth_maps(z, window, support, block, levels, cell, True)
     half = window // 2
@@ -355,7 +345,7 @@ def _finish(hraw, var1):
 
 # ------------------------------------------------------------------- main --
 
-def _levels(factor):
+def levels_of(factor):
     if isinstance(factor, bool) or not isinstance(factor, numbers.Integral):
         raise TypeError(f"factor: expected a power of 2 >= 2, got {factor!r}")
     f = int(factor)
@@ -389,11 +379,11 @@ def _param_map(value, name, shape, lo, hi, lo_open, hi_open):
     return a if a.strides == (0, 0) else np.ascontiguousarray(a)
 
 
-def _cell_size(cell_size, dem):
+def cell_size_of(cell_size, dem):
     """``(dy, dx)`` ground size of an input cell: ``cell_size`` (a number or
     a pair), else from xarray coords, else None (unknown)."""
     if cell_size is None:
-        if _is_xarray(dem):
+        if array_kind(dem) == "xarray":
             return _coord_step(dem)
         return None
     if isinstance(cell_size, (tuple, list, np.ndarray)) and not isinstance(cell_size, str):
@@ -405,7 +395,7 @@ def _cell_size(cell_size, dem):
     return (c, c)
 
 
-def _detail(levels, cell, min_scale):
+def detail_levels(levels, cell, min_scale):
     """Detail flag per level: level ``l`` makes cells of ``cell / 2^(l+1)``;
     detail where the larger side of them is at least ``min_scale``.
     ``cell``: a number or a pair ``(dy, dx)``."""
@@ -423,7 +413,7 @@ def _detail(levels, cell, min_scale):
 _GEO_NAMES = ("lat", "lon", "latitude", "longitude")
 
 
-def _is_geographic_xarray(da):
+def is_geographic_xarray(da):
     """Whether a DataArray's coords look like degrees (names or units)."""
     for dim in da.dims[-2:]:
         if str(dim).lower() in _GEO_NAMES:
@@ -440,14 +430,6 @@ def _check_memory(shape, f):
     ``factor``): the output and the last level's input, in float64."""
     nbytes = 8.0 * shape[0] * shape[1] * f * f * 1.5
     check_memory(nbytes, "factor", what=f"a {f}x finer grid of {shape[0]} x {shape[1]} (use a dask array)")
-
-
-def _is_xarray(a):
-    return type(a).__module__.startswith("xarray")
-
-
-def _is_dask(a):
-    return type(a).__module__.startswith("dask")
 
 
 def _coord_step(da):
@@ -474,7 +456,7 @@ def run_numpy(dem, levels, hurst, sigma, window, detail, support, nodata, seed, 
     _check_memory(z.shape, 1 << levels)
     local_h = isinstance(hurst, str) and hurst == "local"
     local_s = isinstance(sigma, str) and sigma == "local"
-    model = _check_model(model, local_h, local_s)
+    model = check_model(model, local_h, local_s)
     an = _maps(z, hurst, sigma, window, support, local_h, local_s, min(1 << levels, 8), n_threads,
                levels=levels, model=model, cell=cell, warn=warn)
     h, s = an.level_hurst, an.level_sigma
@@ -621,7 +603,7 @@ def _smooth_maps(z, window, support, block, levels, cell, warn):
                             fraction_tapered=fr_t, cell_size=cell, notes=tuple(notes))
 
 
-def _check_model(model, local_h, local_s):
+def check_model(model, local_h, local_s):
     """``model``: None -> "smooth" when H and sigma are both estimated."""
     if model is None:
         return "smooth" if (local_h and local_s) else "fbm"

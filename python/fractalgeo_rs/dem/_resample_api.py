@@ -7,22 +7,19 @@ import numpy as np
 
 import numbers
 
+from fractalgeo_rs._backend import array_kind
 from fractalgeo_rs._compat import renamed_parameters
-from fractalgeo_rs._validation import check_choice, check_n_threads
+from fractalgeo_rs._validation import check_choice, check_n_threads, check_seed, check_window
 from fractalgeo_rs.dem._resample import (
-    _cell_size,
-    _check_model,
-    _check_window,
-    _detail,
-    _is_dask,
-    _is_geographic_xarray,
-    _is_xarray,
-    _levels,
+    cell_size_of,
+    check_model,
+    detail_levels,
     fine_coords,
+    is_geographic_xarray,
+    levels_of,
     run_numpy,
 )
 from fractalgeo_rs.dem._resample_dask import run_dask
-from fractalgeo_rs.synth._common import resolve_seed
 
 __all__ = ["fractal_resample"]
 
@@ -177,22 +174,22 @@ def fractal_resample(dem, factor=2, *, hurst="local", sigma="local", window_size
         raise TypeError(f"dem: expected an array (numpy, Dask or xarray), got {type(dem).__name__}")
     if np.ndim(dem) != 2:
         raise ValueError(f"dem: expected a 2D array, got shape {np.shape(dem)}")
-    levels = _levels(factor)
+    levels = levels_of(factor)
     f = 1 << levels
     check_choice(support, "support", ("point", "area"))
     n_threads = check_n_threads(n_threads)
-    seed = resolve_seed(seed)
+    seed = check_seed(seed)
     local_h = isinstance(hurst, str) and hurst == "local"
     local_s = isinstance(sigma, str) and sigma == "local"
-    model = _check_model(model, local_h, local_s)
+    model = check_model(model, local_h, local_s)
     if clip_min is not None:
         if isinstance(clip_min, bool) or not isinstance(clip_min, numbers.Real) or not np.isfinite(clip_min):
             raise TypeError(f"clip_min: expected a finite number or None, got {clip_min!r}")
         clip_min = float(clip_min)
-    cell = _cell_size(cell_size, dem)
+    cell = cell_size_of(cell_size, dem)
     if min_scale is not None:
-        _detail(levels, 1.0, min_scale)  # type and range first
-        if cell_size is None and _is_xarray(dem) and _is_geographic_xarray(dem):
+        detail_levels(levels, 1.0, min_scale)  # type and range first
+        if cell_size is None and array_kind(dem) == "xarray" and is_geographic_xarray(dem):
             raise ValueError("cell_size: the DataArray's coordinates are in degrees; min_scale is in "
                              "ground units: pass cell_size in metres (e.g. (dy, dx) from "
                              "fractalgeo_rs.dem.metres_per_degree)")
@@ -200,14 +197,14 @@ def fractal_resample(dem, factor=2, *, hurst="local", sigma="local", window_size
             raise ValueError("min_scale: a ground length needs the cell size: pass cell_size (a "
                              "number or (dy, dx), ground units of an input cell) or an xarray "
                              "DataArray with projected coordinates")
-    detail = _detail(levels, cell if cell is not None else 1.0, min_scale)
+    detail = detail_levels(levels, cell if cell is not None else 1.0, min_scale)
     window = window_size
     if local_h or local_s:
-        window = _check_window(window_size, np.shape(dem))
-    if _is_xarray(dem):
+        window = check_window(window_size, minimum=5, shape=np.shape(dem), cover=True)
+    if array_kind(dem) == "xarray":
         return _run_xarray(dem, f, levels, hurst, sigma, window, detail, support, cell, nodata,
                            seed, n_threads, return_analysis, model, clip_min)
-    if _is_dask(dem):
+    if array_kind(dem) == "dask":
         return run_dask(dem, levels, hurst, sigma, window, detail, support, nodata, seed,
                         n_threads, return_analysis, model, clip_min)
     out, an = run_numpy(dem, levels, hurst, sigma, window, detail, support, nodata, seed, n_threads,
@@ -222,7 +219,7 @@ def _run_xarray(da, f, levels, hurst, sigma, window, detail, support, cell, noda
     if da.ndim != 2:
         raise ValueError(f"dem: expected a 2D DataArray, got dims {da.dims}")
     data = da.data
-    if _is_dask(data):
+    if array_kind(data) == "dask":
         r = run_dask(data, levels, hurst, sigma, window, detail, support, nodata, seed,
                      n_threads, return_analysis, model, clip_min)
         out, an = (r if return_analysis else (r, None))

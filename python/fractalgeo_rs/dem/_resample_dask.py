@@ -92,7 +92,7 @@ def run_dask(dem, levels, hurst, sigma, window, detail, support, nodata, seed, n
     point = support == "point"
     local_h = isinstance(hurst, str) and hurst == "local"
     local_s = isinstance(sigma, str) and sigma == "local"
-    model = R._check_model(model, local_h, local_s)
+    model = R.check_model(model, local_h, local_s)
     if local_h or local_s:
         R._warn_window(window, dem.shape)
     h_map, s_map = _analysis_maps(dem, hurst, sigma, window, support, nodata, min(f, 8), n_threads,

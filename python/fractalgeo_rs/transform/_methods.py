@@ -221,8 +221,8 @@ METHODS: Dict[str, MapMethod] = {
     m.name: m
     for m in (
         MapMethod("mass", _configure_mass, _grid_mass, reads_float32=True, uses_z_scale=True),
-        MapMethod("dbc", _configure_dbc, _grid_dbc, uses_z_scale=True),
-        MapMethod("blanket", _configure_blanket, _grid_blanket, uses_z_scale=True),
+        MapMethod("dbc", _configure_dbc, _grid_dbc, reads_float32=True, uses_z_scale=True),
+        MapMethod("blanket", _configure_blanket, _grid_blanket, reads_float32=True, uses_z_scale=True),
         MapMethod("whittle", _configure_whittle, _grid_whittle, quality="standard_error",
                   pinned=_whittle_pinned),
         MapMethod("gls", _configure_gls, _grid_gls, reads_float32=True, quality="standard_error",
