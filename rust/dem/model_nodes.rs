@@ -63,27 +63,28 @@ fn increments(
             &mut s[li * n1..(li + 1) * n1],
             &mut c[li * n1..(li + 1) * n1],
         );
-        sl.fill(0.0);
-        cl.fill(0.0);
+        // branch-free (vectorised): an absent pair adds 0, which leaves a
+        // non-negative sum's bits unchanged
         if i + lag < n0 {
             let below = &z[(i + lag) * n1..(i + lag + 1) * n1];
-            for j in 0..n1 {
-                let (a, b) = (row[j], below[j]);
-                if a.is_finite() && b.is_finite() {
-                    let d = b - a;
-                    sl[j] = d * d;
-                    cl[j] = 1.0;
-                }
+            let pairs = row.iter().zip(below);
+            for ((s, c), (&a, &b)) in sl.iter_mut().zip(cl.iter_mut()).zip(pairs) {
+                let d = b - a;
+                let ok = a.is_finite() & b.is_finite();
+                *s = if ok { d * d } else { 0.0 };
+                *c = if ok { 1.0 } else { 0.0 };
             }
+        } else {
+            sl.fill(0.0);
+            cl.fill(0.0);
         }
         if lag < n1 {
-            for j in 0..n1 - lag {
-                let (a, b) = (row[j], row[j + lag]);
-                if a.is_finite() && b.is_finite() {
-                    let d = b - a;
-                    sl[j] += d * d;
-                    cl[j] += 1.0;
-                }
+            let pairs = row.iter().zip(&row[lag..]);
+            for ((s, c), (&a, &b)) in sl.iter_mut().zip(cl.iter_mut()).zip(pairs) {
+                let d = b - a;
+                let ok = a.is_finite() & b.is_finite();
+                *s += if ok { d * d } else { 0.0 };
+                *c += if ok { 1.0 } else { 0.0 };
             }
         }
     }
@@ -305,6 +306,8 @@ pub fn interp_nodes(
         .as_slice()
         .ok_or_else(|| CoreError::Internal("nodes not contiguous".into()))?;
     let sf = step as f64;
+    let ux: Vec<f64> = (0..step).map(|k| k as f64 / sf).collect();
+    let wx: Vec<f64> = ux.iter().map(|u| 1.0 - u).collect();
     out.par_chunks_mut(oc).enumerate().for_each_init(
         || vec![0.0; nc],
         |rbuf, (g, orow)| {
@@ -317,11 +320,14 @@ pub fn interp_nodes(
             for ((r, x0), x1) in rbuf.iter_mut().zip(n0).zip(n1) {
                 *r = x0 * w + x1 * u;
             }
-            for (xi, o) in orow.iter_mut().enumerate() {
-                let x = t + xi;
-                let b = x / step - k0c;
-                let u = (x % step) as f64 / sf;
-                *o = rbuf[b] * (1.0 - u) + rbuf[b + 1] * u;
+            // pixels in runs of `step` between two nodes (`t` is a multiple
+            // of `step`: every run starts on a node)
+            for (ci, run) in orow.chunks_mut(step).enumerate() {
+                let b = t / step + ci - k0c;
+                let (r0, r1) = (rbuf[b], rbuf[b + 1]);
+                for ((o, &u), &w) in run.iter_mut().zip(&ux).zip(&wx) {
+                    *o = r0 * w + r1 * u;
+                }
             }
         },
     );
