@@ -149,7 +149,7 @@ def node_variograms_reference(z, half, step=R.STEP):
     ``z`` (origin a multiple of ``step``): ``(sums, counts, k0r, k0c)``,
     arrays ``(len(LAGS), nodes_r, nodes_c)``, node ``(a, b)`` at pixel
     ``((k0r + a) step, (k0c + b) step)``. Each sum is formed in a fixed
-    order from its window only (``_resample.node_sums``), so any block of a
+    order from its window only (``_resample_grid.node_sums``), so any block of a
     larger array gives the same bits."""
     m = np.isfinite(z)
     zz = np.where(m, z, 0.0)
