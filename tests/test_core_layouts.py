@@ -93,6 +93,9 @@ CASES = {
         lambda a: _core.fractal_resample(IMG[:16, :12], a, np.full((2, 16, 12), 1.0), 2, False, 5,
                                          [True, True])),
     "resample_local_maps": (IMG, lambda a: _core.resample_local_maps(a, 4, 8, 16, (0.05, 0.95))),
+    "resample_node_variograms": (IMG, lambda a: _core.resample_node_variograms(a, 4, 8, [1, 2, 4, 8])),
+    "resample_interp_nodes": (IMG[:8, :4].reshape(2, 4, 4),
+                              lambda a: _core.resample_interp_nodes(a, 1, 1, (24, 24), 8, 8)),
     "tin_delaunay": (rng.random((60, 3)), lambda a: _core.tin_delaunay(a)),
     "tin_greedy": (IMG[:20, :17].copy(), lambda a: _core.tin_greedy(a, 0.5)),
     "tin_grid": (rng.random((60, 2)) * 10, lambda a: _core.tin_grid(

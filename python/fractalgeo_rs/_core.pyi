@@ -62,6 +62,8 @@ __all__ = [
     "write_png",
     "resample_stencil",
     "resample_local_maps",
+    "resample_node_variograms",
+    "resample_interp_nodes",
     "RESAMPLE_HALO",
     "tin_delaunay",
     "tin_greedy",
@@ -454,6 +456,22 @@ def resample_local_maps(
     ] = None,
     n_threads: Optional[int] = None,
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], int, int]: ...
+def resample_node_variograms(
+    dem: npt.NDArray[np.float64],
+    half: int,
+    step: int,
+    lags: list[int],
+    n_threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], int, int]: ...
+def resample_interp_nodes(
+    nodes: npt.NDArray[np.float64],
+    k0r: int,
+    k0c: int,
+    shape: Tuple[int, int],
+    t: int,
+    step: int,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...
 def tin_delaunay(
     points: npt.NDArray[np.float64],
     constraints: Optional[npt.NDArray[np.int64]] = None,

@@ -1,11 +1,15 @@
 //! Bindings of `crate::dem`: shaded relief, fractal resampling and its local analysis.
-use super::convert::{array2, c_order, run};
+use super::convert::{array2, array3, c_order, run};
 use crate::dem::analysis::{self, AnalysisParams, AreaTable};
 use crate::dem::hillshade::{self, ShadeParams};
+use crate::dem::model_nodes;
 use crate::dem::resample::{self, ResampleParams, Support};
 use crate::error::CoreError;
 use numpy::ndarray::{ArrayView3, ArrayViewD, Axis, Ix3};
-use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArrayDyn};
+use numpy::{
+    IntoPyArray, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
+    PyReadonlyArrayDyn,
+};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -202,6 +206,67 @@ fn resample_stencil(
     })
 }
 
+/// Node sums of squared increments and their counts at every lag of `lags`
+/// over the windows of half side `half` of a NaN-padded DEM block (the
+/// scale-aware model's analysis): `(sums, counts, k0r, k0c)`, the arrays
+/// `(lags, node rows, node cols)`, node `(a, b)` at pixel
+/// `((k0r + a) step, (k0c + b) step)`.
+#[pyfunction]
+#[pyo3(signature = (dem, half, step, lags, n_threads=None))]
+#[allow(clippy::type_complexity)]
+fn resample_node_variograms<'py>(
+    py: Python<'py>,
+    dem: PyReadonlyArray2<'py, f64>,
+    half: usize,
+    step: usize,
+    lags: Vec<usize>,
+    n_threads: Option<usize>,
+) -> PyResult<(
+    Bound<'py, PyArray3<f64>>,
+    Bound<'py, PyArray3<f64>>,
+    usize,
+    usize,
+)> {
+    let z = c_order(&dem);
+    let shape = z.rows_cols();
+    let nv = run(py, n_threads, || {
+        model_nodes::node_variograms(&z.data, shape, half, step, &lags)
+    })?;
+    let dims = (lags.len(), nv.rows, nv.cols);
+    Ok((
+        array3(py, dims, nv.sums)?,
+        array3(py, dims, nv.counts)?,
+        nv.k0r,
+        nv.k0c,
+    ))
+}
+
+/// Bilinear interpolation of node maps `(maps, node rows, node cols)` (node
+/// `(a, b)` at pixel `((k0r + a) step, (k0c + b) step)`) to the pixels of a
+/// block of `shape` without a border of `t` cells: `(maps, rows - 2t, cols -
+/// 2t)`.
+#[pyfunction]
+#[pyo3(signature = (nodes, k0r, k0c, shape, t, step, n_threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn resample_interp_nodes<'py>(
+    py: Python<'py>,
+    nodes: PyReadonlyArray3<'py, f64>,
+    k0r: usize,
+    k0c: usize,
+    shape: (usize, usize),
+    t: usize,
+    step: usize,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let v = nodes.as_array();
+    let m = v.dim().0;
+    let out = run(py, n_threads, || {
+        model_nodes::interp_nodes(v, (k0r, k0c), shape, t, step)
+    })?;
+    let (or, oc) = (shape.0.saturating_sub(2 * t), shape.1.saturating_sub(2 * t));
+    array3(py, (m, or, oc), out)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(hillshade_f64, m)?)?;
     m.add_function(wrap_pyfunction!(shade_to_byte, m)?)?;
@@ -209,6 +274,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fractal_resample, m)?)?;
     m.add_function(wrap_pyfunction!(resample_stencil, m)?)?;
     m.add_function(wrap_pyfunction!(resample_local_maps, m)?)?;
+    m.add_function(wrap_pyfunction!(resample_node_variograms, m)?)?;
+    m.add_function(wrap_pyfunction!(resample_interp_nodes, m)?)?;
     m.add("RESAMPLE_HALO", resample::HALO)?;
     Ok(())
 }

@@ -2,4 +2,5 @@
 //! live on the Python side with scikit-image.)
 pub mod analysis;
 pub mod hillshade;
+pub mod model_nodes;
 pub mod resample;

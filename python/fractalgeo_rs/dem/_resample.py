@@ -234,7 +234,7 @@ def resample_analysis(dem, *, window_size=33, support="point", block=2, nodata=N
         levels = levels_of(factor)
         cell = cell_size_of(cell_size, dem)
         _warn_window(window, z.shape)
-        return _smooth_maps(z, window, support, block, levels, cell, True)
+        return _smooth_maps(z, window, support, block, levels, cell, True, n_threads)
     half = window // 2
     hurst, sigma, n_clip, n_ok = _analyse_padded(z, half, support, block, border=_pad_width(half),
                                                  n_threads=n_threads)
@@ -489,7 +489,7 @@ def _maps(z, hurst, sigma, window, support, local_h, local_s, block=2, n_threads
     if warn and (local_h or local_s):
         _warn_window(window, z.shape)
     if model == "smooth":
-        return _smooth_maps(z, window, support, block, levels, cell, warn)
+        return _smooth_maps(z, window, support, block, levels, cell, warn, n_threads)
     frac = 0.0
     h_raw = None
     fr_s = fr_r = float("nan")
@@ -555,7 +555,7 @@ def _warn_window(window, shape):
                       RuntimeWarning, stacklevel=user_stacklevel())
 
 
-def _smooth_maps(z, window, support, block, levels, cell, warn):
+def _smooth_maps(z, window, support, block, levels, cell, warn, n_threads=None):
     """The scale-aware model (``_resample_model``): per-level maps from the
     fit at the analysis nodes, interpolated to the pixels."""
     from fractalgeo_rs.dem import _resample_model as M
@@ -565,7 +565,8 @@ def _smooth_maps(z, window, support, block, levels, cell, warn):
     mb = 0 if support == "point" else block
     f = 1 << levels
     zp = np.pad(z, t, constant_values=np.nan)
-    lh, ls, r_map, h_map, counts = M.analyse_padded(zp, half, mb, levels, M.INNER_SCALE_FLOOR / f)
+    lh, ls, r_map, h_map, counts = M.analyse_padded(zp, half, mb, levels, M.INNER_SCALE_FLOOR / f,
+                                                     n_threads=n_threads)
     n_ok, n_smooth, n_rough, n_taper, n_centre = counts
     r_glob, h_glob = M.global_fit(z, mb)
     fr_s = n_smooth / n_ok if n_ok else 0.0

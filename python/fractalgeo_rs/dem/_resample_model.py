@@ -130,14 +130,26 @@ def pad_width(half, step=R.STEP):
     return -(-(half + max(LAGS) + step) // step) * step
 
 
-def node_variograms(z, half, step=R.STEP):
+def node_variograms(z, half, step=R.STEP, n_threads=None):
     """Window sums of squared increments and their counts at every lag of
+    ``LAGS`` at the nodes of a ``step`` grid of the NaN-padded block ``z``:
+    the Rust kernel (``_core.resample_node_variograms``, the same bits as
+    :func:`node_variograms_reference` for any ``n_threads``):
+    ``(sums, counts, k0r, k0c)``."""
+    from fractalgeo_rs import _core
+
+    return _core.resample_node_variograms(np.asarray(z, dtype=np.float64), half, step, list(LAGS),
+                                          n_threads)
+
+
+def node_variograms_reference(z, half, step=R.STEP):
+    """numpy twin of :func:`node_variograms`: window sums of squared increments and their counts at every lag of
     ``LAGS`` (rows and columns pooled, each increment in the window of its
     first sample) at the nodes of a ``step`` grid of the NaN-padded block
     ``z`` (origin a multiple of ``step``): ``(sums, counts, k0r, k0c)``,
     arrays ``(len(LAGS), nodes_r, nodes_c)``, node ``(a, b)`` at pixel
     ``((k0r + a) step, (k0c + b) step)``. Each sum is formed in a fixed
-    order from its window only (``_resample.node_sums``), so any block of a
+    order from its window only (``_resample_grid.node_sums``), so any block of a
     larger array gives the same bits."""
     m = np.isfinite(z)
     zz = np.where(m, z, 0.0)
@@ -195,9 +207,22 @@ def node_variograms(z, half, step=R.STEP):
     return np.stack(sums), np.stack(counts), k0r, k0c
 
 
-def interp_to_pixels(v, k0r, k0c, shape, t, step=R.STEP):
+def interp_to_pixels(v, k0r, k0c, shape, t, step=R.STEP, n_threads=None):
     """Bilinear interpolation of node values ``v`` (``(..., nodes_r,
-    nodes_c)``) to the pixels of a block of ``shape`` trimmed by ``t``."""
+    nodes_c)``) to the pixels of a block of ``shape`` trimmed by ``t``: the
+    Rust kernel (``_core.resample_interp_nodes``, the same arithmetic as
+    :func:`interp_to_pixels_reference`)."""
+    from fractalgeo_rs import _core
+
+    lead = v.shape[:-2]
+    flat = np.ascontiguousarray(v, dtype=np.float64).reshape((-1,) + v.shape[-2:])
+    out = _core.resample_interp_nodes(flat, int(k0r), int(k0c), tuple(shape), int(t), step,
+                                      n_threads)
+    return out.reshape(lead + out.shape[1:])
+
+
+def interp_to_pixels_reference(v, k0r, k0c, shape, t, step=R.STEP):
+    """numpy twin of :func:`interp_to_pixels`."""
     lead = v.shape[:-2]
     flat = v.reshape((-1,) + v.shape[-2:])
     out = []
@@ -207,14 +232,14 @@ def interp_to_pixels(v, k0r, k0c, shape, t, step=R.STEP):
     return np.stack(out).reshape(lead + (shape[0] - 2 * t, shape[1] - 2 * t))
 
 
-def analyse_nodes(z, half, block, levels, r_floor=0.0, step=R.STEP):
+def analyse_nodes(z, half, block, levels, r_floor=0.0, step=R.STEP, n_threads=None):
     """The model fit at the nodes of a NaN-padded block (see
     :func:`node_variograms`). Returns a dict of node arrays: ``r``, ``H``
     (the fit, ``r`` at least ``r_floor``; ``r = 0`` and the lag-1/lag-2
     ``H`` where a lag has too few increments), ``h12`` (raw lag-1/lag-2 exponent, NaN where none),
     ``valid`` (the window has lag-1 increments), ``level_h``, ``level_s``
     (``levels`` stacks), and ``k0r``, ``k0c``."""
-    s, c, k0r, k0c = node_variograms(z, half, step)
+    s, c, k0r, k0c = node_variograms(z, half, step, n_threads)
     with np.errstate(divide="ignore", invalid="ignore"):
         d = s / c
         logd = np.log(np.moveaxis(d, 0, -1))
@@ -246,7 +271,7 @@ def analyse_nodes(z, half, block, levels, r_floor=0.0, step=R.STEP):
                 k0r=k0r, k0c=k0c)
 
 
-def analyse_padded(z, half, block, levels, r_floor, step=R.STEP):
+def analyse_padded(z, half, block, levels, r_floor, step=R.STEP, n_threads=None):
     """Pixel maps of a NaN-padded block trimmed by ``pad_width(half)``:
     ``(level_h, level_s, r, H)`` (``levels`` stacks, then the inner scale
     and the fitted H) and the counts of the nodes in the block's core
@@ -255,12 +280,13 @@ def analyse_padded(z, half, block, levels, r_floor, step=R.STEP):
     below ``HURST_RANGE``; tapered: inner scale above one output cell;
     centre: a finite centre pixel). ``r_floor``: the inner scale used is at least this
     (input cells)."""
-    nd = analyse_nodes(z, half, block, levels, r_floor, step)
+    nd = analyse_nodes(z, half, block, levels, r_floor, step, n_threads)
     t = pad_width(half, step)
     shape = z.shape
     k0r, k0c = nd["k0r"], nd["k0c"]
     maps = interp_to_pixels(np.concatenate([nd["level_h"], nd["level_s"], nd["r"][None],
-                                            nd["H"][None]]), k0r, k0c, shape, t, step)
+                                            nd["H"][None]]), k0r, k0c, shape, t, step,
+                                 n_threads)
     lv = nd["level_h"].shape[0]
     level_h, level_s, r_map, h_map = maps[:lv], maps[lv:2 * lv], maps[2 * lv], maps[2 * lv + 1]
     # H on the nodes of the kernel's tables (201 in [0.01, 0.99], steps of
@@ -290,6 +316,8 @@ def global_fit(z, block):
     lags = tuple(2**k for k in range(0, 16) if 2**k <= max(n // 4, 2))
     if len(lags) < 3:
         return float("nan"), float("nan")
+    # Without holes every increment counts (no NaN masks: dot products).
+    full = bool(np.isfinite(z).all())
     logd = []
     for k in lags:
         # Lag k from the pairs starting on every max(2, k)-th row (unbiased;
@@ -297,10 +325,15 @@ def global_fit(z, block):
         t = max(2, k)
         a = z[k::t] - z[:-k:t][: z[k::t].shape[0]]
         b = z[::t, k:] - z[::t, :-k]
-        cnt = int(np.count_nonzero(np.isfinite(a)) + np.count_nonzero(np.isfinite(b)))
+        if full:
+            cnt = a.size + b.size
+            a, b = a.ravel(), b.ravel()
+            v = float(np.einsum("i,i->", a, a) + np.einsum("i,i->", b, b))
+        else:
+            cnt = int(np.count_nonzero(np.isfinite(a)) + np.count_nonzero(np.isfinite(b)))
+            v = float(np.nansum(a * a) + np.nansum(b * b))
         if cnt == 0:
             return float("nan"), float("nan")
-        v = float(np.nansum(a * a) + np.nansum(b * b))
         logd.append(np.log(v / cnt) if v > 0 else np.nan)
     ld = np.array(logd)
     if not np.isfinite(ld).all():
