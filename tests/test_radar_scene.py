@@ -266,3 +266,38 @@ def test_dask_is_refused_with_the_reason():
     for dem in (d, xr.DataArray(d, dims=("y", "x"))):
         with pytest.raises(TypeError, match="tiling is not exact.*shadow"):
             fg.radar.simulate(dem, 1.0, look_azimuth=90, incidence=35, looks=None, **SURF)
+
+
+@pytest.mark.parametrize("look", [90, 180, 33.0])
+def test_fused_scene_equals_the_composed_kernels(look):
+    """simulate's fused per-line kernel gives exactly what geometry, projection, speckle and geocoding
+    give as separate whole-scene steps (those reached through the multilook-free slant path)."""
+    from fractalgeo_rs import _core
+
+    dem = fg.fbm_surface(40, 0.6, seed=5, sigma=4.0)
+    dem[7, 9] = np.nan
+    s = fg.radar.simulate(dem, 2.0, look_azimuth=look, incidence=30, looks=3, seed=9, **SURF)
+    sl = fg.radar.simulate(dem, 2.0, look_azimuth=look, incidence=30, looks=3, seed=9, ground_range=False,
+                           **SURF)
+    # the geocoding of the separate steps, on the range frame of the slant path
+    from fractalgeo_rs.radar import _scene
+
+    az, key = _scene._look(look)
+    frame = None
+    if key is None:
+        frame = _scene._rotated_grid(dem.shape, 2.0, 2.0, az)
+        zr = _scene._to_rotated(dem, 2.0, 2.0, frame)
+    else:
+        zr = np.ascontiguousarray(_scene._TO_RANGE[key](dem))
+    table = fg.radar.backscatter(np.arange(900) * 0.1, **SURF)
+    _, _, pos, flags, n_bins = _core.radar_geometry(zr, 2.0, 2.0, 30.0, list(table), 0.1)
+    count = _core.radar_project(_core.radar_geometry(zr, 2.0, 2.0, 30.0, list(table), 0.1)[1], pos, flags,
+                                n_bins)[1]
+    g_img, g_s0, g_lay = _core.radar_geocode(sl.image, sl.sigma0, count, pos, flags)
+    ref = _scene._to_ground(g_img, g_s0, g_lay.view(bool), (flags & 1).view(bool), sl.local_incidence, dem,
+                            dem, "numpy", key, frame, 2.0, 2.0, sl.slant_range_spacing)
+    for a, b in ((s.image, ref.image), (s.sigma0, ref.sigma0), (s.local_incidence, ref.local_incidence)):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(s.layover, ref.layover)
+    np.testing.assert_array_equal(s.shadow, ref.shadow)
+    assert np.isnan(s.image[7, 9]) and np.isfinite(s.image[20:, 20:]).all()

@@ -347,6 +347,7 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
                       f"{val.ranges[model]}; here k*sigma = {val.k_sigma:.3g}, k*l = {val.k_l:.3g}, "
                       f"rms slope = {val.rms_slope:.3g}", RadarValidityWarning, stacklevel=user_stacklevel())
     z64 = np.asarray(z, dtype=np.float64)
+    frame = None
     if look is not None:
         zr = np.ascontiguousarray(_TO_RANGE[look](z64))
         d_range, d_az = (dx, dy) if look in (90, 270) else (dy, dx)
@@ -354,6 +355,13 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
         frame = _rotated_grid(z.shape, dy, dx, azimuth)
         zr = _to_rotated(z64, dy, dx, frame)
         d_range = d_az = frame[4]
+    if ground_range and ml is None:
+        # fused per range line (the same values as the steps below, without whole-scene intermediates)
+        theta_l, g_img, g_s0, g_lay, g_shd = _core.radar_scene(zr, d_range, d_az, inc, table.tolist(), step,
+                                                               0 if looks is None else looks, seed, n_threads)
+        spacing = d_range * math.sin(math.radians(inc))
+        return _to_ground(g_img, g_s0, g_lay.view(bool), g_shd.view(bool), theta_l, z64, dem, kind, look,
+                          frame, dy, dx, spacing)
     theta_l, power, pos, flags, n_bins = _core.radar_geometry(zr, d_range, d_az, inc, table.tolist(), step,
                                                               n_threads)
     slant, count, nlit = _core.radar_project(power, pos, flags, n_bins, n_threads)
@@ -373,15 +381,20 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
     if not ground_range:
         return SARScene(speckled, slant, count > 1, (count > 0) & (nlit == 0), theta_l, spacing, "slant")
     g_img, g_s0, g_lay = _core.radar_geocode(speckled, slant, count, pos, flags, n_threads)
+    return _to_ground(g_img, g_s0, g_lay.view(bool), (flags & 1).view(bool), theta_l, z64, dem, kind, look,
+                      frame, dy, dx, spacing)
+
+
+def _to_ground(g_img, g_s0, g_lay, g_shd, theta_l, z64, dem, kind, look, frame, dy, dx, spacing):
+    """Range-frame images on the DEM's grid (DataArrays for a DataArray DEM)."""
     if look is not None:
         back = _FROM_RANGE[look]
-        out_img, out_s0, inc_map = (np.ascontiguousarray(back(a)) for a in (g_img, g_s0, theta_l))
-        lay = np.ascontiguousarray(back(g_lay.view(bool)))
-        shd = np.ascontiguousarray(back((flags & 1).view(bool)))
+        out_img, out_s0, inc_map, lay, shd = (np.ascontiguousarray(back(a))
+                                              for a in (g_img, g_s0, theta_l, g_lay, g_shd))
     else:
-        m, k = _from_rotated(z.shape, dy, dx, frame)
+        m, k = _from_rotated(z64.shape, dy, dx, frame)
         out_img, out_s0, inc_map = g_img[m, k], g_s0[m, k], theta_l[m, k]
-        lay, shd = g_lay.view(bool)[m, k], (flags & 1).view(bool)[m, k]
+        lay, shd = g_lay[m, k], g_shd[m, k]
         missing = ~np.isfinite(z64)
         if missing.any():
             for arr in (out_img, out_s0, inc_map):
