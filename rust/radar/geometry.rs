@@ -57,7 +57,7 @@ pub struct Geometry {
 #[inline]
 fn lookup(table: &[f64], step: f64, angle: f64) -> f64 {
     let x = (angle / step).max(0.0);
-    let i = x.floor() as usize;
+    let i = x as usize; // floor: x >= 0 (a cast, not a libm call)
     if i + 1 >= table.len() {
         return table[table.len() - 1];
     }
@@ -289,6 +289,21 @@ fn footprint(p: &[f64], j: usize) -> (f64, f64) {
     (l, r)
 }
 
+/// `max(ceil(a), 0)` as an index: casts truncate, so no libm `floor`/`ceil`
+/// calls in the inner loops (the baseline x86-64 target has no `roundsd`).
+#[inline]
+fn ceil_nonneg(a: f64) -> usize {
+    if a <= 0.0 {
+        return 0;
+    }
+    let t = a as usize;
+    if (t as f64) < a {
+        t + 1
+    } else {
+        t
+    }
+}
+
 /// Add `v` spread uniformly over the half-open slant interval between `e0`
 /// and `e1` (either order) to `img`, and count the bins whose centre it
 /// covers in `cnt` (and in `lt` when `lit`).
@@ -302,7 +317,7 @@ fn deposit(img: &mut [f64], cnt: &mut [u32], lt: &mut [u32], e0: f64, e1: f64, v
         return;
     }
     // bins whose centre k lies in [a, b)
-    let mut k = a.ceil().max(0.0) as usize;
+    let mut k = ceil_nonneg(a);
     while (k as f64) < b && k < n_bins {
         cnt[k] += 1;
         lt[k] += u32::from(lit);
@@ -313,11 +328,11 @@ fn deposit(img: &mut [f64], cnt: &mut [u32], lt: &mut [u32], e0: f64, e1: f64, v
     }
     let len = b - a;
     if len < 1e-12 {
-        let k = (a + 0.5).floor().clamp(0.0, n_bins as f64 - 1.0) as usize;
+        let k = ((a + 0.5).max(0.0) as usize).min(n_bins - 1);
         img[k] += v;
         return;
     }
-    let mut k = (a + 0.5).floor().max(0.0) as usize;
+    let mut k = (a + 0.5).max(0.0) as usize;
     while k < n_bins && (k as f64 - 0.5) < b {
         let lo = (k as f64 - 0.5).max(a);
         let hi = (k as f64 + 0.5).min(b);
@@ -350,7 +365,7 @@ fn project_row(p: &[f64], w: &[f64], l: &[u8], img: &mut [f64], cnt: &mut [u32],
     // pixels that fall in it (its geocoded value is defined)
     for j in 0..p.len() {
         if p[j].is_finite() {
-            let k = ((p[j] + 0.5).floor().max(0.0) as usize).min(img.len() - 1);
+            let k = ((p[j] + 0.5).max(0.0) as usize).min(img.len() - 1);
             if cnt[k] == 0 {
                 cnt[k] = 1;
                 lt[k] = u32::from(l[j] & SHADOW == 0);
@@ -434,7 +449,7 @@ pub fn geocode(
     if slants.iter().any(|s| s.len() != rows * n_bins) || n_bins == 0 {
         return Err(CoreError::invalid("slant", "expected rows x n_bins images"));
     }
-    let bin = |p: f64| ((p + 0.5).floor().max(0.0) as usize).min(n_bins - 1);
+    let bin = |p: f64| ((p + 0.5).max(0.0) as usize).min(n_bins - 1);
     let mut outs: Vec<Vec<f64>> = Vec::with_capacity(slants.len());
     for s in slants {
         let mut o = vec![0.0; n];
@@ -542,7 +557,7 @@ pub fn scene(
     let mut sigma0 = vec![0.0; n];
     let mut layover = vec![0u8; n];
     let mut shadow = vec![0u8; n];
-    let bin = |p: f64| ((p + 0.5).floor().max(0.0) as usize).min(n_bins - 1);
+    let bin = |p: f64| ((p + 0.5).max(0.0) as usize).min(n_bins - 1);
     theta
         .par_chunks_mut(cols)
         .zip(image.par_chunks_mut(cols))
