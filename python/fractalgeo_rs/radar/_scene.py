@@ -187,23 +187,32 @@ def _to_rotated(z, dy, dx, frame):
     from scipy import ndimage
 
     u, v, g0, a0, h, n_az, n_rg = frame
-    gg = g0 + h * np.arange(n_rg)[None, :]
-    aa = a0 + h * np.arange(n_az)[:, None]
-    east = gg * u[0] + aa * v[0]
-    north = gg * u[1] + aa * v[1]
+    gg = g0 + h * np.arange(n_rg)
+    aa = a0 + h * np.arange(n_az)
+    coords = np.empty((2, n_az, n_rg))
+    # DEM (fractional) row -north / dy and column east / dx, + 2 for the padding
+    np.add((-v[1] / dy) * aa[:, None], (-u[1] / dy) * gg[None, :] + 2.0, out=coords[0])
+    np.add((v[0] / dx) * aa[:, None], (u[0] / dx) * gg[None, :] + 2.0, out=coords[1])
     zp = np.pad(np.asarray(z, dtype=np.float64), 2, mode="edge")
-    return ndimage.map_coordinates(zp, [-north / dy + 2.0, east / dx + 2.0], order=1, mode="constant",
-                                   cval=np.nan, prefilter=False)
+    return ndimage.map_coordinates(zp, coords, order=1, mode="constant", cval=np.nan, prefilter=False)
 
 
 def _from_rotated(shape, dy, dx, frame):
-    """Index of the rotated-grid cell nearest to each DEM cell: (rows, cols) arrays of (m, k)."""
+    """Flat index ``m * n_rg + k`` of the rotated-grid cell nearest to each DEM cell."""
     u, v, g0, a0, h, n_az, n_rg = frame
-    i, j = np.mgrid[0:shape[0], 0:shape[1]]
-    east, north = j * dx, -i * dy
-    k = np.clip(np.rint((east * u[0] + north * u[1] - g0) / h), 0, n_rg - 1).astype(np.intp)
-    m = np.clip(np.rint((east * v[0] + north * v[1] - a0) / h), 0, n_az - 1).astype(np.intp)
-    return m, k
+    i, j = np.arange(shape[0]), np.arange(shape[1])
+    out = np.empty(shape, dtype=np.intp)
+    idx = np.empty(shape)
+    for unit, origin, n, scale in ((v, a0, n_az, n_rg), (u, g0, n_rg, 1)):
+        # (east u0 + north u1 - origin) / h with east = j dx, north = -i dy
+        np.add(((-i * dy * unit[1] - origin) / h)[:, None], (j * dx * unit[0] / h)[None, :], out=idx)
+        np.rint(idx, out=idx)
+        np.clip(idx, 0, n - 1, out=idx)
+        if scale == 1:
+            out += idx.astype(np.intp)
+        else:
+            np.multiply(idx.astype(np.intp), scale, out=out)
+    return out
 
 
 def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model="kirchhoff",
@@ -392,9 +401,8 @@ def _to_ground(g_img, g_s0, g_lay, g_shd, theta_l, z64, dem, kind, look, frame, 
         out_img, out_s0, inc_map, lay, shd = (np.ascontiguousarray(back(a))
                                               for a in (g_img, g_s0, theta_l, g_lay, g_shd))
     else:
-        m, k = _from_rotated(z64.shape, dy, dx, frame)
-        out_img, out_s0, inc_map = g_img[m, k], g_s0[m, k], theta_l[m, k]
-        lay, shd = g_lay[m, k], g_shd[m, k]
+        flat = _from_rotated(z64.shape, dy, dx, frame)
+        out_img, out_s0, inc_map, lay, shd = (np.take(a.ravel(), flat) for a in (g_img, g_s0, theta_l, g_lay, g_shd))
         missing = ~np.isfinite(z64)
         if missing.any():
             for arr in (out_img, out_s0, inc_map):
