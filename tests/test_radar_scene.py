@@ -133,7 +133,10 @@ def test_dataarray_keeps_coords_and_gives_cell_size():
 
 @pytest.mark.parametrize("kw, err, match", [
     (dict(cell_size=None), ValueError, "cell_size"),
-    (dict(look_azimuth=45), ValueError, "look_azimuth"),
+    (dict(look_azimuth=float("nan")), ValueError, "look_azimuth"),
+    (dict(look_azimuth="east"), TypeError, "look_azimuth"),
+    (dict(multilook=0), ValueError, "multilook"),
+    (dict(multilook=(2, 2.5)), TypeError, "multilook"),
     (dict(incidence=90), ValueError, "incidence"),
     (dict(incidence=0), ValueError, "incidence"),
     (dict(wavelength=0.0), ValueError, "wavelength"),
@@ -175,3 +178,126 @@ def test_validity_judged_at_the_scene_incidence():
         fg.radar.simulate(np.zeros((6, 6)), 1.0, look_azimuth=90, incidence=20, model="spm",
                           correlation="gaussian", looks=None, **kw)
     assert rec[0].filename == __file__
+
+
+def _tilted(shape, dy, dx, grad_east, grad_north):
+    i, j = np.mgrid[0:shape[0], 0:shape[1]]
+    return grad_east * j * dx - grad_north * i * dy  # row index grows southwards
+
+
+@pytest.mark.parametrize("look", [30.0, 137.5, 250.0, 341.0])
+def test_arbitrary_azimuth_plane_closed_form(look):
+    """A plane of gradient G seen from any azimuth: cos(theta_loc) = (cos theta + sin theta G.u) /
+    sqrt(1 + |G|^2) (u the look direction) and the image sigma0(theta_loc) sqrt(1 + |G|^2) sin theta /
+    (sin theta - G.u cos theta) (facet area over cell area times ground cells per slant bin); the
+    DEM is resampled bilinearly (exact for a plane) onto a grid rotated to the look direction."""
+    dy, dx, G = 3.0, 2.0, np.array([0.3, -0.2])
+    z = _tilted((40, 50), dy, dx, *G)
+    s = fg.radar.simulate(z, (dy, dx), look_azimuth=look, incidence=40, looks=None, **SURF)
+    t, a = math.radians(40.0), math.radians(look)
+    gu = G @ np.array([math.sin(a), math.cos(a)])
+    cos_loc = (math.cos(t) + math.sin(t) * gu) / math.sqrt(1 + G @ G)
+    want_inc = math.degrees(math.acos(cos_loc))
+    np.testing.assert_allclose(s.local_incidence[3:-3, 3:-3], want_inc, atol=1e-9)
+    want = _sigma0(want_inc) * math.sqrt(1 + G @ G) * math.sin(t) / (math.sin(t) - gu * math.cos(t))
+    np.testing.assert_allclose(s.sigma0[3:-3, 3:-3], want, rtol=2e-3)
+    assert not s.layover.any() and not s.shadow.any() and np.isfinite(s.image).all()
+
+
+@pytest.mark.parametrize("look", [30.0, 212.0])
+def test_arbitrary_azimuth_shadow_and_layover_onsets(look):
+    theta = 35.0
+    a = math.radians(look)
+    u = np.array([math.sin(a), math.cos(a)])
+
+    def run(slope):
+        g = math.tan(math.radians(slope)) * u  # rising away from the radar along the look direction
+        z = _tilted((30, 30), 1.0, 1.0, *g)
+        return fg.radar.simulate(z, 1.0, look_azimuth=look, incidence=theta, looks=None, **SURF)
+
+    inner = (slice(4, -4), slice(4, -4))
+    assert not run(-(90 - theta) + 0.1).shadow[inner].any()
+    assert run(-(90 - theta) - 0.1).shadow[inner].all()
+    assert not run(theta - 0.1).layover[inner].any()
+    assert run(theta + 0.1).layover[inner].all()
+
+
+def test_grid_azimuths_unchanged_by_the_rotated_path():
+    """0/90/180/270 take the exact grid path: 90 + 1e-12 is 90; the rotated path at 90 + 1e-6 agrees
+    with it on a smooth DEM (nearest-cell resampling of the rotated grid)."""
+    dem = fg.fbm_surface(64, 0.8, seed=2, sigma=1.0)
+    a = fg.radar.simulate(dem, 5.0, look_azimuth=90, incidence=35, looks=4, seed=3, **SURF)
+    b = fg.radar.simulate(dem, 5.0, look_azimuth=90 + 1e-12, incidence=35, looks=4, seed=3, **SURF)
+    np.testing.assert_array_equal(a.image, b.image)
+    c = fg.radar.simulate(dem, 5.0, look_azimuth=90 + 1e-6, incidence=35, looks=None, **SURF)
+    np.testing.assert_allclose(c.local_incidence[3:-3, 3:-3], a.local_incidence[3:-3, 3:-3], atol=1e-3)
+
+
+@pytest.mark.parametrize("looks, block", [(1, (3, 4)), (2, (2, 2)), (4, (1, 3))])
+def test_multilook_enl(looks, block):
+    """Block averaging n = az x rg independent L-look Gamma intensities gives Gamma(L n, sigma0 / (L n)):
+    ENL = L n (mean, variance within 3 standard errors; Kolmogorov-Smirnov)."""
+    st = pytest.importorskip("scipy.stats")
+    az, rg = block
+    n_eq = looks * az * rg
+    s = fg.radar.simulate(np.zeros((150 * az, 150 * rg)), 5.0, look_azimuth=90, incidence=35, looks=looks,
+                          seed=11, multilook=block, ground_range=False, **SURF)
+    s0 = _sigma0(35.0)
+    v = s.image.ravel()
+    assert s.image.shape == (150, 150) and s.slant_range_spacing == pytest.approx(rg * 5.0 * math.sin(
+        math.radians(35)))
+    np.testing.assert_allclose(s.sigma0, s0, rtol=1e-9)
+    n = v.size
+    assert abs(v.mean() - s0) < 3 * s0 / math.sqrt(n_eq * n)
+    var_se = s0 ** 2 / n_eq * math.sqrt((2 + 6 / n_eq) / n)
+    assert abs(v.var() - s0 ** 2 / n_eq) < 3 * var_se
+    assert st.kstest(v, st.gamma(n_eq, scale=s0 / n_eq).cdf).pvalue > 1e-3
+    # terrain-geocoded: every cell of a block carries the block's value (flat ground: column j -> bin j)
+    g = fg.radar.simulate(np.zeros((150 * az, 150 * rg)), 5.0, look_azimuth=90, incidence=35, looks=looks,
+                          seed=11, multilook=block, **SURF)
+    np.testing.assert_array_equal(g.image[::az, ::rg], s.image)
+    np.testing.assert_array_equal(g.image, np.repeat(np.repeat(s.image, az, 0), rg, 1))
+
+
+def test_dask_is_refused_with_the_reason():
+    da = pytest.importorskip("dask.array")
+    xr = pytest.importorskip("xarray")
+    d = da.zeros((16, 16), chunks=8)
+    for dem in (d, xr.DataArray(d, dims=("y", "x"))):
+        with pytest.raises(TypeError, match="tiling is not exact.*shadow"):
+            fg.radar.simulate(dem, 1.0, look_azimuth=90, incidence=35, looks=None, **SURF)
+
+
+@pytest.mark.parametrize("look", [90, 180, 33.0])
+def test_fused_scene_equals_the_composed_kernels(look):
+    """simulate's fused per-line kernel gives exactly what geometry, projection, speckle and geocoding
+    give as separate whole-scene steps (those reached through the multilook-free slant path)."""
+    from fractalgeo_rs import _core
+
+    dem = fg.fbm_surface(40, 0.6, seed=5, sigma=4.0)
+    dem[7, 9] = np.nan
+    s = fg.radar.simulate(dem, 2.0, look_azimuth=look, incidence=30, looks=3, seed=9, **SURF)
+    sl = fg.radar.simulate(dem, 2.0, look_azimuth=look, incidence=30, looks=3, seed=9, ground_range=False,
+                           **SURF)
+    # the geocoding of the separate steps, on the range frame of the slant path
+    from fractalgeo_rs.radar import _scene
+
+    az, key = _scene._look(look)
+    frame = None
+    if key is None:
+        frame = _scene._rotated_grid(dem.shape, 2.0, 2.0, az)
+        zr = _scene._to_rotated(dem, 2.0, 2.0, frame)
+    else:
+        zr = np.ascontiguousarray(_scene._TO_RANGE[key](dem))
+    table = fg.radar.backscatter(np.arange(900) * 0.1, **SURF)
+    _, _, pos, flags, n_bins = _core.radar_geometry(zr, 2.0, 2.0, 30.0, list(table), 0.1)
+    count = _core.radar_project(_core.radar_geometry(zr, 2.0, 2.0, 30.0, list(table), 0.1)[1], pos, flags,
+                                n_bins)[1]
+    g_img, g_s0, g_lay = _core.radar_geocode(sl.image, sl.sigma0, count, pos, flags)
+    ref = _scene._to_ground(g_img, g_s0, g_lay.view(bool), (flags & 1).view(bool), sl.local_incidence, dem,
+                            dem, "numpy", key, frame, 2.0, 2.0, sl.slant_range_spacing)
+    for a, b in ((s.image, ref.image), (s.sigma0, ref.sigma0), (s.local_incidence, ref.local_incidence)):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(s.layover, ref.layover)
+    np.testing.assert_array_equal(s.shadow, ref.shadow)
+    assert np.isnan(s.image[7, 9]) and np.isfinite(s.image[20:, 20:]).all()

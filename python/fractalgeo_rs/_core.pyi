@@ -72,6 +72,7 @@ __all__ = [
     "radar_geocode",
     "radar_geometry",
     "radar_project",
+    "radar_scene",
     "speckle_f64",
     "radiometry_albedo",
     "radiometry_brf",
@@ -537,7 +538,25 @@ def radar_geocode(
     flags: npt.NDArray[np.uint8],
     n_threads: Optional[int] = None,
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
+def radar_scene(
+    dem: npt.NDArray[np.float64],
+    dx: float,
+    dy: float,
+    incidence: float,
+    table: Sequence[float],
+    table_step: float,
+    looks: int,
+    seed: int,
+    n_threads: Optional[int] = None,
+) -> Tuple[
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.uint8],
+    npt.NDArray[np.uint8],
+]: ...
 # ---- radiometry ----
+
 def radiometry_brf(
     dem: npt.NDArray[np.float64],
     cell_size: Tuple[float, float],

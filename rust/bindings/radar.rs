@@ -156,10 +156,52 @@ fn radar_geocode<'py>(
     ))
 }
 
+/// Geometry, projection, speckle and terrain geocoding fused per range
+/// line: `(theta_local, image, sigma0, layover, shadow)` on the DEM's grid
+/// (`looks` 0: no speckle).
+#[pyfunction]
+#[pyo3(signature = (dem, dx, dy, incidence, table, table_step, looks, seed, n_threads=None))]
+#[allow(clippy::type_complexity, clippy::too_many_arguments)]
+fn radar_scene<'py>(
+    py: Python<'py>,
+    dem: PyReadonlyArray2<'py, f64>,
+    dx: f64,
+    dy: f64,
+    incidence: f64,
+    table: Vec<f64>,
+    table_step: f64,
+    looks: u32,
+    seed: u64,
+    n_threads: Option<usize>,
+) -> PyResult<(
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<u8>>,
+    Bound<'py, PyArray2<u8>>,
+)> {
+    let a = c_order(&dem);
+    let (rows, cols) = a.rows_cols();
+    let looks = (looks > 0).then_some(looks);
+    let s = run(py, n_threads, || {
+        geometry::scene(
+            &a.data, rows, cols, dx, dy, incidence, &table, table_step, looks, seed,
+        )
+    })?;
+    Ok((
+        array2(py, (rows, cols), s.theta_local)?,
+        array2(py, (rows, cols), s.image)?,
+        array2(py, (rows, cols), s.sigma0)?,
+        array2(py, (rows, cols), s.layover)?,
+        array2(py, (rows, cols), s.shadow)?,
+    ))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(speckle_f64, m)?)?;
     m.add_function(wrap_pyfunction!(radar_geometry, m)?)?;
     m.add_function(wrap_pyfunction!(radar_project, m)?)?;
     m.add_function(wrap_pyfunction!(radar_geocode, m)?)?;
+    m.add_function(wrap_pyfunction!(radar_scene, m)?)?;
     Ok(())
 }

@@ -57,7 +57,7 @@ pub struct Geometry {
 #[inline]
 fn lookup(table: &[f64], step: f64, angle: f64) -> f64 {
     let x = (angle / step).max(0.0);
-    let i = x.floor() as usize;
+    let i = x as usize; // floor: x >= 0 (a cast, not a libm call)
     if i + 1 >= table.len() {
         return table[table.len() - 1];
     }
@@ -101,6 +101,100 @@ fn deriv(v: impl Fn(usize) -> f64, i: usize, n: usize, h: f64) -> f64 {
     }
 }
 
+/// Constants of the geometry at one incidence.
+struct Params<'a> {
+    st: f64,
+    ct: f64,
+    cot: f64,
+    tan_t: f64,
+    dx: f64,
+    dy: f64,
+    table: &'a [f64],
+    step: f64,
+}
+
+impl<'a> Params<'a> {
+    fn new(dx: f64, dy: f64, incidence: f64, table: &'a [f64], step: f64) -> Self {
+        let (st, ct) = incidence.to_radians().sin_cos();
+        Params {
+            st,
+            ct,
+            cot: ct / st,
+            tan_t: st / ct,
+            dx,
+            dy,
+            table,
+            step,
+        }
+    }
+}
+
+/// The geometry of row `r` (see [`geometry`]); `ps` unshifted (column `j`
+/// of flat ground at bin `j`).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn geometry_row(
+    z: &[f64],
+    rows: usize,
+    cols: usize,
+    r: usize,
+    p: &Params,
+    th: &mut [f64],
+    pw: &mut [f64],
+    ps: &mut [f64],
+    fl: &mut [u8],
+) {
+    let (st, ct, cot, dx) = (p.st, p.ct, p.cot, p.dx);
+    let line = &z[r * cols..(r + 1) * cols];
+    let up = if r > 0 {
+        Some(&z[(r - 1) * cols..r * cols])
+    } else {
+        None
+    };
+    let down = if r + 1 < rows {
+        Some(&z[(r + 1) * cols..(r + 2) * cols])
+    } else {
+        None
+    };
+    // the derivative across range lines: central inside, one-sided at the edges
+    let (lo_line, hi_line, hy) = match (up, down) {
+        (Some(u), Some(d)) => (u, d, 2.0 * p.dy),
+        (None, Some(d)) => (line, d, p.dy),
+        (Some(u), None) => (u, line, p.dy),
+        (None, None) => (line, line, p.dy),
+    };
+    let mut umax = f64::NEG_INFINITY;
+    for j in 0..cols {
+        let zx = deriv(|i| line[i], j, cols, dx);
+        let zy = if rows < 2 {
+            0.0
+        } else {
+            (hi_line[j] - lo_line[j]) / hy
+        };
+        let norm = (1.0 + zx * zx + zy * zy).sqrt();
+        let c = ((ct + st * zx) / norm).clamp(-1.0, 1.0);
+        let angle = c.acos().to_degrees();
+        th[j] = if c.is_nan() { f64::NAN } else { angle };
+        ps[j] = j as f64 - line[j] * cot / dx;
+        let u = line[j] + j as f64 * dx * cot;
+        // relative tolerance: a plane exactly at grazing slope is lit
+        let tol = 1e-12 * (u.abs() + umax.abs().min(f64::MAX));
+        let cast = u.is_finite() && umax > u + tol;
+        let shadow = cast || c <= 0.0;
+        fl[j] = if shadow { SHADOW } else { 0 } | if zx > p.tan_t { ACTIVE_LAYOVER } else { 0 };
+        pw[j] = if !u.is_finite() || c.is_nan() {
+            f64::NAN
+        } else if shadow {
+            0.0
+        } else {
+            lookup(p.table, p.step, angle) * norm
+        };
+        if u > umax {
+            umax = u;
+        }
+    }
+}
+
 /// The geometry of the DEM `z` (`rows` x `cols`, NaN = missing) seen at
 /// `incidence` degrees from the vertical, with the facet backscatter
 /// `table[i]` = sigma0 at `i * table_step` degrees.
@@ -122,10 +216,7 @@ pub fn geometry(
             "expected a non-empty sigma0 table and a positive step",
         ));
     }
-    let t = incidence.to_radians();
-    let (st, ct) = t.sin_cos();
-    let cot = ct / st;
-    let tan_t = st / ct;
+    let prm = Params::new(dx, dy, incidence, table, table_step);
     let n = rows * cols;
     let mut theta = vec![0.0; n];
     let mut power = vec![0.0; n];
@@ -138,34 +229,7 @@ pub fn geometry(
         .zip(flags.par_chunks_mut(cols))
         .enumerate()
         .for_each(|(r, (((th, pw), ps), fl))| {
-            let line = &z[r * cols..(r + 1) * cols];
-            let mut umax = f64::NEG_INFINITY;
-            for j in 0..cols {
-                let zx = deriv(|i| line[i], j, cols, dx);
-                let zy = deriv(|i| z[i * cols + j], r, rows, dy);
-                let norm = (1.0 + zx * zx + zy * zy).sqrt();
-                let c = ((ct + st * zx) / norm).clamp(-1.0, 1.0);
-                let angle = c.acos().to_degrees();
-                th[j] = if c.is_nan() { f64::NAN } else { angle };
-                ps[j] = j as f64 - line[j] * cot / dx;
-                let u = line[j] + j as f64 * dx * cot;
-                // relative tolerance: a plane exactly at grazing slope is lit
-                let tol = 1e-12 * (u.abs() + umax.abs().min(f64::MAX));
-                let cast = u.is_finite() && umax > u + tol;
-                let shadow = cast || c <= 0.0;
-                fl[j] =
-                    if shadow { SHADOW } else { 0 } | if zx > tan_t { ACTIVE_LAYOVER } else { 0 };
-                pw[j] = if !u.is_finite() || c.is_nan() {
-                    f64::NAN
-                } else if shadow {
-                    0.0
-                } else {
-                    lookup(table, table_step, angle) * norm
-                };
-                if u > umax {
-                    umax = u;
-                }
-            }
+            geometry_row(z, rows, cols, r, &prm, th, pw, ps, fl);
         });
     let lo = pos
         .iter()
@@ -225,6 +289,21 @@ fn footprint(p: &[f64], j: usize) -> (f64, f64) {
     (l, r)
 }
 
+/// `max(ceil(a), 0)` as an index: casts truncate, so no libm `floor`/`ceil`
+/// calls in the inner loops (the baseline x86-64 target has no `roundsd`).
+#[inline]
+fn ceil_nonneg(a: f64) -> usize {
+    if a <= 0.0 {
+        return 0;
+    }
+    let t = a as usize;
+    if (t as f64) < a {
+        t + 1
+    } else {
+        t
+    }
+}
+
 /// Add `v` spread uniformly over the half-open slant interval between `e0`
 /// and `e1` (either order) to `img`, and count the bins whose centre it
 /// covers in `cnt` (and in `lt` when `lit`).
@@ -238,7 +317,7 @@ fn deposit(img: &mut [f64], cnt: &mut [u32], lt: &mut [u32], e0: f64, e1: f64, v
         return;
     }
     // bins whose centre k lies in [a, b)
-    let mut k = a.ceil().max(0.0) as usize;
+    let mut k = ceil_nonneg(a);
     while (k as f64) < b && k < n_bins {
         cnt[k] += 1;
         lt[k] += u32::from(lit);
@@ -249,11 +328,11 @@ fn deposit(img: &mut [f64], cnt: &mut [u32], lt: &mut [u32], e0: f64, e1: f64, v
     }
     let len = b - a;
     if len < 1e-12 {
-        let k = (a + 0.5).floor().clamp(0.0, n_bins as f64 - 1.0) as usize;
+        let k = ((a + 0.5).max(0.0) as usize).min(n_bins - 1);
         img[k] += v;
         return;
     }
-    let mut k = (a + 0.5).floor().max(0.0) as usize;
+    let mut k = (a + 0.5).max(0.0) as usize;
     while k < n_bins && (k as f64 - 0.5) < b {
         let lo = (k as f64 - 0.5).max(a);
         let hi = (k as f64 + 0.5).min(b);
@@ -261,6 +340,42 @@ fn deposit(img: &mut [f64], cnt: &mut [u32], lt: &mut [u32], e0: f64, e1: f64, v
             img[k] += v * (hi - lo) / len;
         }
         k += 1;
+    }
+}
+
+/// Project one line (positions `p`, power `w`, flags `l`) onto the zeroed
+/// slant line `img`, `cnt`, `lt`; bins no footprint reaches become NaN.
+#[inline]
+fn project_row(p: &[f64], w: &[f64], l: &[u8], img: &mut [f64], cnt: &mut [u32], lt: &mut [u32]) {
+    for j in 0..p.len() {
+        if !p[j].is_finite() {
+            continue;
+        }
+        // the two halves of the cell, from its centre to the midpoints to
+        // its neighbours, each with half the power: at a fold (a crest seen
+        // in layover) both land on one side
+        let (e0, e1) = footprint(p, j);
+        let lit = l[j] & SHADOW == 0;
+        let v = 0.5 * w[j];
+        deposit(img, cnt, lt, e0, p[j], v, lit);
+        deposit(img, cnt, lt, p[j], e1, v, lit);
+    }
+    // at a sharp fold both halves of a footprint may miss the centre of the
+    // pixel's own bin: a bin that no footprint covers is still seen by the
+    // pixels that fall in it (its geocoded value is defined)
+    for j in 0..p.len() {
+        if p[j].is_finite() {
+            let k = ((p[j] + 0.5).max(0.0) as usize).min(img.len() - 1);
+            if cnt[k] == 0 {
+                cnt[k] = 1;
+                lt[k] = u32::from(l[j] & SHADOW == 0);
+            }
+        }
+    }
+    for (v, &c) in img.iter_mut().zip(cnt.iter()) {
+        if c == 0 && *v == 0.0 {
+            *v = f64::NAN;
+        }
     }
 }
 
@@ -298,27 +413,14 @@ pub fn project(
         .zip(lit.par_chunks_mut(n_bins))
         .enumerate()
         .for_each(|(r, ((img, cnt), lt))| {
-            let p = &position[r * cols..(r + 1) * cols];
-            let w = &power[r * cols..(r + 1) * cols];
-            let l = &flags[r * cols..(r + 1) * cols];
-            for j in 0..cols {
-                if !p[j].is_finite() {
-                    continue;
-                }
-                // the two halves of the cell, from its centre to the
-                // midpoints to its neighbours, each with half the power: at a
-                // fold (a crest seen in layover) both land on one side
-                let (e0, e1) = footprint(p, j);
-                let lit = l[j] & SHADOW == 0;
-                let v = 0.5 * w[j];
-                deposit(img, cnt, lt, e0, p[j], v, lit);
-                deposit(img, cnt, lt, p[j], e1, v, lit);
-            }
-            for (v, &c) in img.iter_mut().zip(cnt.iter()) {
-                if c == 0 && *v == 0.0 {
-                    *v = f64::NAN;
-                }
-            }
+            project_row(
+                &position[r * cols..(r + 1) * cols],
+                &power[r * cols..(r + 1) * cols],
+                &flags[r * cols..(r + 1) * cols],
+                img,
+                cnt,
+                lt,
+            );
         });
     Ok(Slant { image, count, lit })
 }
@@ -347,7 +449,7 @@ pub fn geocode(
     if slants.iter().any(|s| s.len() != rows * n_bins) || n_bins == 0 {
         return Err(CoreError::invalid("slant", "expected rows x n_bins images"));
     }
-    let bin = |p: f64| ((p + 0.5).floor().max(0.0) as usize).min(n_bins - 1);
+    let bin = |p: f64| ((p + 0.5).max(0.0) as usize).min(n_bins - 1);
     let mut outs: Vec<Vec<f64>> = Vec::with_capacity(slants.len());
     for s in slants {
         let mut o = vec![0.0; n];
@@ -374,6 +476,154 @@ pub fn geocode(
         }
     });
     Ok((outs, lay))
+}
+
+/// A terrain-geocoded scene on the DEM's grid (see [`scene`]).
+#[derive(Debug, Clone)]
+pub struct Scene {
+    /// Local incidence, degrees (as [`Geometry::theta_local`]).
+    pub theta_local: Vec<f64>,
+    /// Intensity with speckle (sigma0 when no looks are asked).
+    pub image: Vec<f64>,
+    /// Intensity without speckle.
+    pub sigma0: Vec<f64>,
+    /// 1 in layover (as [`geocode`]).
+    pub layover: Vec<u8>,
+    /// 1 in radar shadow.
+    pub shadow: Vec<u8>,
+}
+
+/// [`geometry`], [`project`], speckle ([`crate::radar::speckle::speckle`]
+/// of the slant image, `rows x n_bins`, origin `(0, 0)`) and [`geocode`]
+/// fused per range line: the same values, without the intermediate
+/// whole-scene arrays (each line works in buffers of its thread). `looks`
+/// `None`: no speckle.
+#[allow(clippy::too_many_arguments)]
+pub fn scene(
+    z: &[f64],
+    rows: usize,
+    cols: usize,
+    dx: f64,
+    dy: f64,
+    incidence: f64,
+    table: &[f64],
+    table_step: f64,
+    looks: Option<u32>,
+    seed: u64,
+) -> CoreResult<Scene> {
+    check(z, rows, cols, dx, dy, incidence)?;
+    if table.is_empty() || !(table_step.is_finite() && table_step > 0.0) {
+        return Err(CoreError::invalid(
+            "table",
+            "expected a non-empty sigma0 table and a positive step",
+        ));
+    }
+    if looks == Some(0) {
+        return Err(CoreError::invalid("looks", "expected an integer >= 1"));
+    }
+    let prm = Params::new(dx, dy, incidence, table, table_step);
+    // the extent of the slant axis, as in `geometry`
+    let (lo, hi) = z
+        .par_chunks(cols)
+        .map(|line| {
+            let mut lo = f64::INFINITY;
+            let mut hi = f64::NEG_INFINITY;
+            for (j, &v) in line.iter().enumerate() {
+                let p = j as f64 - v * prm.cot / dx;
+                if p.is_finite() {
+                    lo = lo.min(p);
+                    hi = hi.max(p);
+                }
+            }
+            (lo, hi)
+        })
+        .reduce(
+            || (f64::INFINITY, f64::NEG_INFINITY),
+            |a, b| (a.0.min(b.0), a.1.max(b.1)),
+        );
+    let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (0.0, 0.0) };
+    let span = hi - lo;
+    if span > 1e9 {
+        return Err(CoreError::invalid(
+            "dem",
+            format!("the scene spans {span:.3e} slant-range bins: heights and cell_size in the same units?"),
+        ));
+    }
+    let n_bins = span.ceil() as usize + 1;
+    let key = crate::rng::StreamKey::new(seed, crate::radar::speckle::STREAM);
+    let n = rows * cols;
+    let mut theta = vec![0.0; n];
+    let mut image = vec![0.0; n];
+    let mut sigma0 = vec![0.0; n];
+    let mut layover = vec![0u8; n];
+    let mut shadow = vec![0u8; n];
+    let bin = |p: f64| ((p + 0.5).max(0.0) as usize).min(n_bins - 1);
+    theta
+        .par_chunks_mut(cols)
+        .zip(image.par_chunks_mut(cols))
+        .zip(sigma0.par_chunks_mut(cols))
+        .zip(layover.par_chunks_mut(cols))
+        .zip(shadow.par_chunks_mut(cols))
+        .enumerate()
+        .for_each_init(
+            || {
+                (
+                    vec![0.0; cols],
+                    vec![0.0; cols],
+                    vec![0u8; cols],
+                    vec![0.0; n_bins],
+                    vec![0u32; n_bins],
+                    vec![0u32; n_bins],
+                    vec![0.0; n_bins],
+                )
+            },
+            |(pw, ps, fl, img, cnt, lt, spk), (r, ((((th, im), s0), lay), shd))| {
+                geometry_row(z, rows, cols, r, &prm, th, pw, ps, fl);
+                ps.iter_mut().for_each(|p| *p -= lo);
+                img.fill(0.0);
+                cnt.fill(0);
+                lt.fill(0);
+                project_row(ps, pw, fl, img, cnt, lt);
+                match looks {
+                    Some(l) => {
+                        let start = (r as u64).wrapping_mul(n_bins as u64);
+                        for (k, (o, &v)) in spk.iter_mut().zip(img.iter()).enumerate() {
+                            *o = if v.is_nan() {
+                                f64::NAN
+                            } else {
+                                v * crate::radar::speckle::gamma_unit(
+                                    key,
+                                    start.wrapping_add(k as u64),
+                                    l,
+                                )
+                            };
+                        }
+                    }
+                    None => spk.copy_from_slice(img),
+                }
+                for j in 0..cols {
+                    let p = ps[j];
+                    if p.is_finite() {
+                        let k = bin(p);
+                        im[j] = spk[k];
+                        s0[j] = img[k];
+                        lay[j] = u8::from(cnt[k] > 1 || fl[j] & ACTIVE_LAYOVER != 0);
+                    } else {
+                        im[j] = f64::NAN;
+                        s0[j] = f64::NAN;
+                        lay[j] = 0;
+                    }
+                    shd[j] = fl[j] & SHADOW;
+                }
+            },
+        );
+    Ok(Scene {
+        theta_local: theta,
+        image,
+        sigma0,
+        layover,
+        shadow,
+    })
 }
 
 #[cfg(test)]
@@ -470,5 +720,67 @@ mod tests {
         }
         let total: f64 = s.image.iter().filter(|v| v.is_finite()).sum();
         assert!((total - cols as f64).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_sharp_spike_covers_its_own_bin() {
+        // pixel 2 at 3.6 (bin 4), in shadow: both halves of its footprint
+        // run back to the midpoint 2.3 and miss the centre of bin 4, which
+        // is still covered (0, not NaN: no footprint)
+        let p = [0.0, 1.0, 3.6, 1.0, 2.0];
+        let s = project(
+            &[1.0, 1.0, 0.0, 1.0, 1.0],
+            &p,
+            &[0, 0, SHADOW, 0, 0],
+            1,
+            5,
+            5,
+        )
+        .unwrap();
+        assert_eq!((s.count[4], s.lit[4]), (1, 0));
+        assert_eq!(s.image[4], 0.0);
+        let total: f64 = s.image.iter().filter(|v| v.is_finite()).sum();
+        assert!((total - 4.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn fused_scene_equals_the_composed_steps() {
+        let (rows, cols) = (9, 31);
+        let z: Vec<f64> = (0..rows * cols)
+            .map(|i| {
+                let (r, c) = ((i / cols) as f64, (i % cols) as f64);
+                12.0 * (0.3 * c).sin() * (0.2 * r).cos() + if i == 40 { f64::NAN } else { 0.0 }
+            })
+            .collect();
+        let table: Vec<f64> = (0..900).map(|i| (-(i as f64) / 300.0).exp()).collect();
+        let sc = scene(&z, rows, cols, 1.5, 2.0, 35.0, &table, 0.1, Some(3), 7).unwrap();
+        let g = geometry(&z, rows, cols, 1.5, 2.0, 35.0, &table, 0.1).unwrap();
+        let s = project(&g.power, &g.position, &g.flags, rows, cols, g.n_bins).unwrap();
+        let place = crate::radar::speckle::Placement {
+            origin: (0, 0),
+            global_cols: g.n_bins as u64,
+        };
+        let spk = crate::radar::speckle::speckle(&s.image, g.n_bins, 3, 7, place).unwrap();
+        let (outs, lay) = geocode(
+            &[&spk, &s.image],
+            &s.count,
+            &g.position,
+            &g.flags,
+            rows,
+            cols,
+            g.n_bins,
+        )
+        .unwrap();
+        let same = |a: &[f64], b: &[f64]| {
+            a.iter()
+                .zip(b)
+                .all(|(x, y)| x.to_bits() == y.to_bits() || x.is_nan() && y.is_nan())
+        };
+        assert!(same(&sc.theta_local, &g.theta_local));
+        assert!(same(&sc.image, &outs[0]));
+        assert!(same(&sc.sigma0, &outs[1]));
+        assert_eq!(sc.layover, lay);
+        let shd: Vec<u8> = g.flags.iter().map(|f| f & SHADOW).collect();
+        assert_eq!(sc.shadow, shd);
     }
 }

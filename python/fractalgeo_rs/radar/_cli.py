@@ -21,7 +21,7 @@ def add_parsers(sub) -> None:
     add_raster_io(p, input="dem", output_help="output .tif (or .npy)", cell_size=True)
     p.add_argument("--incidence", type=float, required=True, help="incidence angle, degrees in (0, 90)")
     p.add_argument("--look-azimuth", type=float, default=90.0,
-                   help="direction the radar looks, degrees clockwise from north: 0, 90, 180 or 270")
+                   help="direction the radar looks, degrees clockwise from north (any; 0/90/180/270 follow the grid)")
     p.add_argument("--wavelength", type=float, default=0.056, help="radar wavelength, metres (C band 0.056)")
     p.add_argument("--model", default="kirchhoff", choices=("kirchhoff", "geometric_optics", "spm"),
                    help="facet backscatter model")

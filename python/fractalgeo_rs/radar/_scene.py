@@ -37,6 +37,15 @@ _FROM_RANGE = {
 }
 
 
+_DASK_REFUSAL = (
+    "dem: simulate does not take Dask arrays: tiling is not exact. A radar shadow reaches "
+    "relief * tan(incidence) and layover relief * cot(incidence) along a range line (unbounded by the "
+    "chunk), the slant-range bins of a line start at its nearest point, and speckle is seeded by the "
+    "global slant bin, so a chunk's result depends on the whole range line. Pass a numpy array (or "
+    "dem.compute()), or split the scene into strips along azimuth yourself; fractalgeo_rs.radar.speckle "
+    "takes Dask arrays.")
+
+
 @dataclass(frozen=True)
 class SARScene:
     """A simulated SAR scene (the output of :func:`~fractalgeo_rs.radar.simulate`).
@@ -104,20 +113,111 @@ def _cell_pair(cell_size, dem):
 
 
 def _look(look_azimuth):
+    """The look azimuth in [0, 360) and, when it is a multiple of 90 degrees, that multiple (range lines
+    follow the grid) else None (the DEM is resampled onto a grid rotated to the look direction)."""
     if isinstance(look_azimuth, bool) or not isinstance(look_azimuth, numbers.Real):
-        raise TypeError(f"look_azimuth: expected degrees, got {look_azimuth!r}")
-    a = float(look_azimuth) % 360
+        raise TypeError(f"look_azimuth: expected degrees clockwise from north, got {look_azimuth!r}")
+    a = float(look_azimuth)
+    if not math.isfinite(a):
+        raise ValueError(f"look_azimuth: expected finite degrees, got {look_azimuth!r}")
+    a %= 360.0
     key = int(round(a))
-    if key % 90 != 0 or abs(a - key) > 1e-9:
-        raise ValueError(f"look_azimuth: range lines follow the grid; expected 0, 90, 180 or 270 degrees "
-                         f"(the direction the radar looks, clockwise from north), got {look_azimuth!r}; "
-                         f"rotate the DEM for other headings")
-    return key % 360
+    if key % 90 == 0 and abs(a - key) <= 1e-9:
+        return a, key % 360
+    return a, None
+
+
+def _multilook(multilook):
+    if multilook is None:
+        return None
+    if isinstance(multilook, numbers.Integral) and not isinstance(multilook, bool):
+        pair = (int(multilook), int(multilook))
+    else:
+        try:
+            pair = tuple(int(v) if isinstance(v, numbers.Integral) and not isinstance(v, bool) else None
+                         for v in multilook)
+        except TypeError:
+            raise TypeError(f"multilook: expected an int or (azimuth, range) ints, got {multilook!r}") from None
+        if len(pair) != 2 or None in pair:
+            raise TypeError(f"multilook: expected an int or (azimuth, range) ints, got {multilook!r}")
+    if min(pair) < 1:
+        raise ValueError(f"multilook: expected block sizes >= 1, got {multilook!r}")
+    return None if pair == (1, 1) else pair
+
+
+def _block_sums(a, az, rg):
+    """Sums and counts of the finite values of ``a`` over (az, rg) blocks from (0, 0); the last blocks
+    are partial (padded with NaN)."""
+    r, c = a.shape
+    pr, pc = -r % az, -c % rg
+    b = np.pad(a, ((0, pr), (0, pc)), constant_values=np.nan).reshape((r + pr) // az, az, (c + pc) // rg, rg)
+    fin = np.isfinite(b)
+    return np.where(fin, b, 0.0).sum(axis=(1, 3)), fin.sum(axis=(1, 3))
+
+
+def _block_mean(a, az, rg):
+    s, n = _block_sums(a, az, rg)
+    return np.divide(s, n, out=np.full(s.shape, np.nan), where=n > 0)
+
+
+def _rotated_grid(shape, dy, dx, azimuth):
+    """The grid rotated so that its columns step along the look direction (ground range away from the
+    radar) and its rows along the azimuth, spacing ``h = min(dy, dx)``, covering the DEM padded by 2
+    cells. Returns ``(u, v, g0, a0, h, n_az, n_rg)``: unit vectors (east, north) of range and azimuth and
+    the grid's origin in those coordinates."""
+    rows, cols = shape
+    t = math.radians(azimuth)
+    u = (math.sin(t), math.cos(t))            # look direction
+    v = (math.cos(t), -math.sin(t))           # u turned 90 degrees clockwise
+    h = min(dy, dx)
+    east = np.array([-2.0, cols + 1.0]) * dx  # DEM cell (i, j) at east = j dx, north = -i dy
+    north = -np.array([-2.0, rows + 1.0]) * dy
+    e, n = np.meshgrid(east, north)
+    g = e * u[0] + n * u[1]
+    a = e * v[0] + n * v[1]
+    g0, a0 = float(g.min()), float(a.min())
+    n_rg = int(math.floor((g.max() - g0) / h + 1e-9)) + 1
+    n_az = int(math.floor((a.max() - a0) / h + 1e-9)) + 1
+    return u, v, g0, a0, h, n_az, n_rg
+
+
+def _to_rotated(z, dy, dx, frame):
+    """Bilinear resampling of the DEM (edge-padded by 2 cells, NaN beyond) onto the rotated grid (exact
+    for a plane)."""
+    from scipy import ndimage
+
+    u, v, g0, a0, h, n_az, n_rg = frame
+    gg = g0 + h * np.arange(n_rg)
+    aa = a0 + h * np.arange(n_az)
+    coords = np.empty((2, n_az, n_rg))
+    # DEM (fractional) row -north / dy and column east / dx, + 2 for the padding
+    np.add((-v[1] / dy) * aa[:, None], (-u[1] / dy) * gg[None, :] + 2.0, out=coords[0])
+    np.add((v[0] / dx) * aa[:, None], (u[0] / dx) * gg[None, :] + 2.0, out=coords[1])
+    zp = np.pad(np.asarray(z, dtype=np.float64), 2, mode="edge")
+    return ndimage.map_coordinates(zp, coords, order=1, mode="constant", cval=np.nan, prefilter=False)
+
+
+def _from_rotated(shape, dy, dx, frame):
+    """Flat index ``m * n_rg + k`` of the rotated-grid cell nearest to each DEM cell."""
+    u, v, g0, a0, h, n_az, n_rg = frame
+    i, j = np.arange(shape[0]), np.arange(shape[1])
+    out = np.empty(shape, dtype=np.intp)
+    idx = np.empty(shape)
+    for unit, origin, n, scale in ((v, a0, n_az, n_rg), (u, g0, n_rg, 1)):
+        # (east u0 + north u1 - origin) / h with east = j dx, north = -i dy
+        np.add(((-i * dy * unit[1] - origin) / h)[:, None], (j * dx * unit[0] / h)[None, :], out=idx)
+        np.rint(idx, out=idx)
+        np.clip(idx, 0, n - 1, out=idx)
+        if scale == 1:
+            out += idx.astype(np.intp)
+        else:
+            np.multiply(idx.astype(np.intp), scale, out=out)
+    return out
 
 
 def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model="kirchhoff",
              permittivity=5 + 0.5j, rms_height=0.01, correlation_length=0.1, correlation="exponential",
-             hurst=None, topothesy=None, polarization="vv", looks=1, seed=None, ground_range=True,
+             hurst=None, topothesy=None, polarization="vv", looks=1, seed=None, multilook=None, ground_range=True,
              n_threads=None):
     r"""Synthetic SAR intensity image of a DEM, with layover, shadow and speckle.
 
@@ -140,7 +240,8 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
        ``theta``);
     5. speckle on the slant-range image (:func:`~fractalgeo_rs.radar.speckle`, ``looks``-look
        Gamma intensity; ``looks=None`` for none);
-    6. ``ground_range=True``: each DEM cell takes the value of the slant bin
+    6. optional spatial multilooking (``multilook``, block averages);
+    7. ``ground_range=True``: each DEM cell takes the value of the slant bin
        it falls in (terrain-geocoded, so cells in layover share the summed
        power of their bin); else the slant-range image itself.
 
@@ -153,9 +254,14 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
     cell_size : float, (float, float) or None
         Cell size (or (row, column) spacing) in metres; ``None`` reads it
         from a DataArray's coords, else a ValueError.
-    look_azimuth : {0, 90, 180, 270}
+    look_azimuth : float
         Direction the radar looks, degrees clockwise from north (90: the radar
         is west of the scene looking east, range increases with the column).
+        0, 90, 180 and 270 trace range lines along the grid; any other azimuth
+        resamples the DEM bilinearly (exact for a plane) onto a grid rotated so
+        that its columns follow the look direction, spacing ``min(cell_size)``,
+        edge-padded by 2 cells, and takes each DEM cell's values back from the
+        nearest rotated cell (so speckle stays unsmoothed).
     incidence : float
         Incidence angle at the scene in degrees, in (0, 90).
     wavelength : float
@@ -166,6 +272,15 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
         Looks of the speckle (1: single look); ``None``: no speckle.
     seed : int or None
         Speckle seed; ``None`` draws one.
+    multilook : int, (int, int) or None
+        Spatial multilooking: the speckled slant-range image (and ``sigma0``)
+        averaged over blocks of (azimuth lines, slant-range bins) from the
+        first line and bin. With uncorrelated speckle a block of ``n`` bins
+        has ENL ``looks * n`` (Gamma(``looks n``)). ``ground_range=False``
+        returns the block image (``slant_range_spacing`` times the range
+        block; layover where any bin of the block is, shadow where every
+        covered bin is); ``ground_range=True`` gives each DEM cell its
+        block's value.
     ground_range : bool
         Output on the DEM's grid (True) or in slant range (False; rows along
         azimuth in the range frame, columns slant-range bins from near range).
@@ -201,18 +316,18 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
     """
     kind = array_kind(dem)
     if kind == "dask":
-        raise TypeError("dem: a Dask array is not supported by simulate yet; pass a numpy array or "
-                        "an in-memory DataArray")
+        raise TypeError(_DASK_REFUSAL)
     data = dem.data if kind == "xarray" else dem
     if array_kind(data) == "dask":
-        data = data.compute()
+        raise TypeError(_DASK_REFUSAL)
     z = check_real_array(data, "dem")
     if z.ndim != 2 or min(z.shape) < 2:
         raise ValueError(f"dem: expected a 2D array of at least 2 x 2, got shape {z.shape}")
     if z.dtype.kind not in "iuf":
         raise TypeError(f"dem: expected a numeric array, got dtype {z.dtype}")
     dy, dx = _cell_pair(cell_size, dem)
-    look = _look(look_azimuth)
+    azimuth, look = _look(look_azimuth)
+    ml = _multilook(multilook)
     if isinstance(incidence, bool) or not isinstance(incidence, numbers.Real):
         raise TypeError(f"incidence: expected degrees, got {incidence!r}")
     inc = float(incidence)
@@ -240,20 +355,60 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
         warnings.warn(f"simulate: model={model!r} is outside its range of validity at incidence {inc:g}: "
                       f"{val.ranges[model]}; here k*sigma = {val.k_sigma:.3g}, k*l = {val.k_l:.3g}, "
                       f"rms slope = {val.rms_slope:.3g}", RadarValidityWarning, stacklevel=user_stacklevel())
-    zr = np.ascontiguousarray(_TO_RANGE[look](np.asarray(z, dtype=np.float64)))
-    d_range, d_az = (dx, dy) if look in (90, 270) else (dy, dx)
+    z64 = np.asarray(z, dtype=np.float64)
+    frame = None
+    if look is not None:
+        zr = np.ascontiguousarray(_TO_RANGE[look](z64))
+        d_range, d_az = (dx, dy) if look in (90, 270) else (dy, dx)
+    else:
+        frame = _rotated_grid(z.shape, dy, dx, azimuth)
+        zr = _to_rotated(z64, dy, dx, frame)
+        d_range = d_az = frame[4]
+    if ground_range and ml is None:
+        # fused per range line (the same values as the steps below, without whole-scene intermediates)
+        theta_l, g_img, g_s0, g_lay, g_shd = _core.radar_scene(zr, d_range, d_az, inc, table.tolist(), step,
+                                                               0 if looks is None else looks, seed, n_threads)
+        spacing = d_range * math.sin(math.radians(inc))
+        return _to_ground(g_img, g_s0, g_lay.view(bool), g_shd.view(bool), theta_l, z64, dem, kind, look,
+                          frame, dy, dx, spacing)
     theta_l, power, pos, flags, n_bins = _core.radar_geometry(zr, d_range, d_az, inc, table.tolist(), step,
                                                               n_threads)
     slant, count, nlit = _core.radar_project(power, pos, flags, n_bins, n_threads)
     speckled = slant if looks is None else _core.speckle_f64(slant, looks, seed, (0, 0), 0, n_threads)
     spacing = d_range * math.sin(math.radians(inc))
+    if ml is not None:
+        az, rg = ml
+        ml_img, ml_s0 = _block_mean(speckled, az, rg), _block_mean(slant, az, rg)
+        if not ground_range:
+            lay_n, _ = _block_sums((count > 1).astype(np.float64), az, rg)
+            shd_n, cov_n = _block_sums(np.where(count > 0, (nlit == 0).astype(np.float64), np.nan), az, rg)
+            return SARScene(ml_img, ml_s0, lay_n > 0, (cov_n > 0) & (shd_n == cov_n), theta_l, spacing * rg,
+                            "slant")
+        r, c = slant.shape
+        speckled = np.ascontiguousarray(np.repeat(np.repeat(ml_img, az, axis=0), rg, axis=1)[:r, :c])
+        slant = np.ascontiguousarray(np.repeat(np.repeat(ml_s0, az, axis=0), rg, axis=1)[:r, :c])
     if not ground_range:
         return SARScene(speckled, slant, count > 1, (count > 0) & (nlit == 0), theta_l, spacing, "slant")
     g_img, g_s0, g_lay = _core.radar_geocode(speckled, slant, count, pos, flags, n_threads)
-    back = _FROM_RANGE[look]
-    out_img, out_s0, inc_map = (np.ascontiguousarray(back(a)) for a in (g_img, g_s0, theta_l))
-    lay = np.ascontiguousarray(back(g_lay.view(bool)))
-    shd = np.ascontiguousarray(back((flags & 1).view(bool)))
+    return _to_ground(g_img, g_s0, g_lay.view(bool), (flags & 1).view(bool), theta_l, z64, dem, kind, look,
+                      frame, dy, dx, spacing)
+
+
+def _to_ground(g_img, g_s0, g_lay, g_shd, theta_l, z64, dem, kind, look, frame, dy, dx, spacing):
+    """Range-frame images on the DEM's grid (DataArrays for a DataArray DEM)."""
+    if look is not None:
+        back = _FROM_RANGE[look]
+        out_img, out_s0, inc_map, lay, shd = (np.ascontiguousarray(back(a))
+                                              for a in (g_img, g_s0, theta_l, g_lay, g_shd))
+    else:
+        flat = _from_rotated(z64.shape, dy, dx, frame)
+        out_img, out_s0, inc_map, lay, shd = (np.take(a.ravel(), flat) for a in (g_img, g_s0, theta_l, g_lay, g_shd))
+        missing = ~np.isfinite(z64)
+        if missing.any():
+            for arr in (out_img, out_s0, inc_map):
+                arr[missing] = np.nan
+            lay[missing] = False
+            shd[missing] = False
     if kind == "xarray":
         out_img = dem.copy(data=out_img).rename("sar_intensity")
         out_s0 = dem.copy(data=out_s0).rename("sigma0")
