@@ -611,13 +611,16 @@ fn local(zen: f64, az: f64) -> DVec3 {
     DVec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
 }
 
+/// (zenith, azimuth) in degrees.
+type Angles = (f64, f64);
+
 #[test]
 fn hapke_matches_eradiate_reference_values() {
     // eradiate-mitsuba 0.5.0 `hapke` BSDF, scalar_mono_double, measured
     // (docs RADIOMETRY_REFERENCES.md 4.1): ((sun), (view), BRF)
     let a = material::from_name("hapke", &[0.5, 0.2, 0.4, 15.0, 1.0, 0.05]).unwrap();
     let b = material::from_name("hapke", &[0.8, 0.3, 0.6, 25.0, 0.0, 0.0]).unwrap();
-    let cases: [(&dyn Bsdf, (f64, f64), (f64, f64), f64); 9] = [
+    let cases: [(&dyn Bsdf, Angles, Angles, f64); 9] = [
         (&*a, (30.0, 0.0), (0.0, 0.0), 0.113820),
         (&*a, (30.0, 0.0), (30.0, 0.0), 0.192827),
         (&*a, (30.0, 0.0), (30.0, 180.0), 0.107831),

@@ -3,6 +3,7 @@ experiment on a DEM file."""
 from __future__ import annotations
 
 import argparse
+from typing import Tuple, Union
 
 from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads, add_progress, add_raster_io, is_geographic
 
@@ -128,6 +129,7 @@ def _scene(args: argparse.Namespace):
 def _run_render(args: argparse.Namespace) -> int:
     from fractalgeo_rs._progress import resolve
 
+    view: Union[str, Tuple[float, float]]
     if args.view == ["nadir"]:
         view = "nadir"
     elif len(args.view) == 2:
