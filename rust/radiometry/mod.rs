@@ -5,7 +5,7 @@
 //! * [`heightfield`]: a DEM as two facets per cell and its ray caster
 //!   (cell stepping with wrap-around for periodic tiles).
 //! * [`material`]: the reflectance-model trait, with [`lambertian`],
-//!   [`oren_nayar`], [`phong`] and [`hapke`].
+//!   [`oren_nayar`], [`phong`], [`hapke`] and [`specular`].
 //! * [`integrator`]: path tracing with next-event estimation to the sun,
 //!   and the BRF, albedo and image estimators.
 //!
@@ -24,6 +24,7 @@ pub mod lambertian;
 pub mod material;
 pub mod oren_nayar;
 pub mod phong;
+pub mod specular;
 
 #[cfg(test)]
 mod tests;

@@ -751,3 +751,45 @@ fn hapke_sampler_passes_chi_square_and_its_weight_is_the_albedo() {
         "{mean} +- {se} vs {alb}"
     );
 }
+
+#[test]
+fn specular_mirror_reflects_the_fresnel_fraction() {
+    // Fresnel at normal incidence: ((n - 1)^2 + k^2) / ((n + 1)^2 + k^2)
+    for (n, k) in [(1.5, 0.0), (1.33, 0.0), (0.2, 3.5)] {
+        let m = super::specular::Specular::new(n, k).unwrap();
+        let want = ((n - 1.0f64).powi(2) + k * k) / ((n + 1.0f64).powi(2) + k * k);
+        assert!((m.fresnel(1.0) - want).abs() < 1e-14, "{n} {k}");
+        assert!((m.fresnel(0.0) - 1.0).abs() < 1e-14); // grazing
+    }
+    // dielectric at Brewster's angle: r_p = 0, so F = r_s / 2 with
+    // r_s = ((n^2 - 1) / (n^2 + 1))^2
+    let n = 1.5f64;
+    let m = super::specular::Specular::new(n, 0.0).unwrap();
+    let cb = (1.0 / (1.0 + n * n)).sqrt();
+    let rs = ((n * n - 1.0) / (n * n + 1.0)).powi(2);
+    assert!((m.fresnel(cb) - 0.5 * rs).abs() < 1e-14);
+    // sampling: the mirror direction with weight F; eval and pdf are 0
+    let wo = local(40.0, 30.0);
+    let s = m.sample(wo, [0.3, 0.7]).unwrap();
+    assert!((s.wi - DVec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-15);
+    assert!((s.weight - m.fresnel(wo.z)).abs() < 1e-15 && m.eval(s.wi, wo) == 0.0);
+    // a flat mirror: albedo = F(cos sun zenith) exactly, BRF 0 (a delta)
+    let z = vec![0.0; 16];
+    let sc = scene(&z, 4, 4, true, "specular", &[1.5, 0.0]);
+    let brewster = n.atan().to_degrees();
+    for (zen, want) in [(0.0, 0.04), (brewster, 0.5 * rs)] {
+        let a = sc.albedo(dir(20.0, zen), 100, 10, 0).unwrap();
+        assert!(
+            (a.value - want).abs() < 1e-12 && a.se < 1e-8,
+            "{zen}: {a:?} {want}"
+        );
+        assert_eq!(
+            sc.brf(dir(20.0, zen), dir(200.0, zen), 100, 10, 0)
+                .unwrap()
+                .value,
+            0.0
+        );
+    }
+    assert!(material::from_name("specular", &[0.0, 0.0]).is_err());
+    assert!(material::from_name("specular", &[1.5, -1.0]).is_err());
+}
