@@ -460,3 +460,20 @@ def test_cli_render_and_brf(tmp_path, capsys):
     assert cli.main(["render", str(tmp_path / "dem.npy"), str(out), "--sun", "0", "30", "--cell-size", "1",
                      "--material", "hapke:2"]) == 1
     assert "--material" in capsys.readouterr().err
+
+
+def test_specular_flat_mirror_reflects_the_fresnel_fraction():
+    """Normal incidence ((n - 1)/(n + 1))^2 and Brewster's angle (r_p = 0,
+    F = ((n^2 - 1)/(n^2 + 1))^2 / 2); BRF of a flat mirror is 0 (a delta)."""
+    from fractalgeo_rs.radiometry import Specular
+
+    n = 1.5
+    s = Scene.from_dem(np.zeros((4, 4)), material=Specular(n))
+    assert abs(s.albedo(sun=(0, 0), spp=10).value - ((n - 1) / (n + 1)) ** 2) < 1e-12
+    brewster = np.degrees(np.arctan(n))
+    assert abs(s.albedo(sun=(30, brewster), spp=10).value - 0.5 * ((n * n - 1) / (n * n + 1)) ** 2) < 1e-12
+    assert s.brf(sun=(0, 30), view=(180, 30), spp=10).value == 0.0
+    with pytest.raises(ValueError, match="^eta: "):
+        Specular(0.0)
+    with pytest.raises(ValueError, match="^k: "):
+        Specular(1.5, k=-1.0)

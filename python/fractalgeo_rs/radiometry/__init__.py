@@ -25,6 +25,7 @@ from fractalgeo_rs.radiometry._scene import (
     OrenNayar,
     Phong,
     Scene,
+    Specular,
 )
 
-__all__ = ["BrfSweep", "Estimate", "Hapke", "Lambertian", "OrenNayar", "PAPER_SUN_ZENITHS", "Phong", "Scene"]
+__all__ = ["BrfSweep", "Estimate", "Hapke", "Lambertian", "OrenNayar", "PAPER_SUN_ZENITHS", "Phong", "Scene", "Specular"]

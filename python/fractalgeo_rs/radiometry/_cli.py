@@ -13,9 +13,10 @@ _MATERIALS = {
     "oren-nayar": ("rho", "sigma"),
     "phong": ("kd", "ks", "exponent"),
     "hapke": ("w", "b", "c", "theta_bar", "B0", "h"),
+    "specular": ("eta", "k"),
 }
 MATERIAL_HELP = ("reflectance model of every facet, NAME:P1,P2,...: lambertian:RHO, oren-nayar:RHO,SIGMA "
-                 "(radians), phong:KD,KS,EXPONENT, hapke:W,B,C,THETA_BAR(degrees),B0,H")
+                 "(radians), phong:KD,KS,EXPONENT, hapke:W,B,C,THETA_BAR(degrees),B0,H, specular:ETA,K")
 
 
 def _common(p: argparse.ArgumentParser) -> None:
@@ -84,7 +85,7 @@ def _parse_material(text: str):
     if len(values) != len(want):
         raise ValueError(f"material: {name} takes {len(want)} parameter(s) ({', '.join(want)}), got {len(values)}")
     cls = {"lambertian": radiometry.Lambertian, "oren-nayar": radiometry.OrenNayar, "phong": radiometry.Phong,
-           "hapke": radiometry.Hapke}[name]
+           "hapke": radiometry.Hapke, "specular": radiometry.Specular}[name]
     return cls(*values)
 
 

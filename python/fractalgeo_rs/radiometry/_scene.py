@@ -22,7 +22,7 @@ from fractalgeo_rs._validation import (
 )
 from fractalgeo_rs._warn import user_stacklevel
 
-__all__ = ["BrfSweep", "Estimate", "Hapke", "Lambertian", "OrenNayar", "Phong", "Scene"]
+__all__ = ["BrfSweep", "Estimate", "Hapke", "Lambertian", "OrenNayar", "Phong", "Scene", "Specular"]
 
 #: Sun zeniths (degrees) of the paper's incidence series (figure 9), 0 to 90 in steps of 15, the
 #: grazing 90 taken as 89 (at 90 the horizontal irradiance and the BRF's denominator are 0).
@@ -254,7 +254,57 @@ class Hapke:
         return "hapke", [self.w, self.b, self.c, self.theta_bar, self.B0, self.h]
 
 
-Material = Union[Lambertian, OrenNayar, Phong, Hapke]
+@dataclass(frozen=True)
+class Specular:
+    """A smooth mirror facet with unpolarised Fresnel reflectance.
+
+    Light leaves only along the mirror direction, with the fraction
+    ``F(cos theta)`` of a medium of complex relative refractive index
+    ``eta + i k`` (``k = 0``: a dielectric such as water, 1.33; ``k > 0``: a
+    conductor). The BRDF is a Dirac delta: the directional sun reaches the
+    sensor from a mirror facet only after another scattering event, and a
+    flat mirror's BRF is 0 (its albedo is ``F``). Reciprocal and
+    energy-bounded (``F <= 1``).
+
+    Parameters
+    ----------
+    eta : float
+        Real part of the relative refractive index (> 0).
+    k : float
+        Extinction coefficient (>= 0).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fractalgeo_rs.radiometry import Scene, Specular
+    >>> s = Scene.from_dem(np.zeros((4, 4)), material=Specular(1.5))
+    >>> round(s.albedo(sun=(0.0, 0.0), spp=10).value, 9)  # ((1.5 - 1) / (1.5 + 1))**2
+    0.04
+
+    References
+    ----------
+    M. Born and E. Wolf, *Principles of Optics*, 7th ed., Cambridge
+    University Press, 1999, section 1.5 (Fresnel formulae).
+    """
+
+    eta: float
+    k: float = 0.0
+
+    def __post_init__(self):
+        for name, lo_open in (("eta", True), ("k", False)):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, numbers.Real):
+                raise TypeError(f"{name}: expected a number, got {v!r}")
+            v = float(v)
+            if not math.isfinite(v) or (v <= 0.0 if lo_open else v < 0.0):
+                raise ValueError(f"{name}: expected a finite number {'> 0' if lo_open else '>= 0'}, got {v}")
+            object.__setattr__(self, name, v)
+
+    def _spec(self) -> Tuple[str, List[float]]:
+        return "specular", [self.eta, self.k]
+
+
+Material = Union[Lambertian, OrenNayar, Phong, Hapke, Specular]
 
 
 @dataclass(frozen=True)
@@ -414,7 +464,7 @@ class Scene:
         the heights.
     periodic : bool
         Whether the DEM is one tile of an infinite periodic surface.
-    material : Lambertian, OrenNayar, Phong or Hapke
+    material : Lambertian, OrenNayar, Phong, Hapke or Specular
         The reflectance model of every facet.
     split : str
         The diagonal that splits each cell: ``"ne-sw"`` or ``"nw-se"``.
@@ -484,7 +534,7 @@ class Scene:
             ``np.block([[z, z[:, ::-1]], [z[::-1], z[::-1, ::-1]]])``.
             False: a finite patch of ``(rows - 1) x (cols - 1)`` cells; rays
             that leave it escape.
-        material : Lambertian, OrenNayar, Phong or Hapke, optional
+        material : Lambertian, OrenNayar, Phong, Hapke or Specular, optional
             Reflectance model of every facet; default ``Lambertian(0.5)``.
         split : {"ne-sw", "nw-se"}
             The diagonal splitting each cell.
@@ -528,8 +578,8 @@ class Scene:
         cell_size = _cell_size(cell_size)
         if material is None:
             material = Lambertian(0.5)
-        if not isinstance(material, (Lambertian, OrenNayar, Phong, Hapke)):
-            raise TypeError("material: expected Lambertian(...), OrenNayar(...), Phong(...) or Hapke(...), "
+        if not isinstance(material, (Lambertian, OrenNayar, Phong, Hapke, Specular)):
+            raise TypeError("material: expected Lambertian(...), OrenNayar(...), Phong(...), Hapke(...) or Specular(...), "
                             f"got {material!r}")
         split = check_choice(split, "split", ("ne-sw", "nw-se"))
         if periodic:
