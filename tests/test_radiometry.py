@@ -325,3 +325,155 @@ def test_real_dem_warns_raw_and_conserves_energy_mirrored():
     for zen in (0.0, 60.0):
         a = white.albedo(sun=(135.0, zen), spp=20_000, max_depth=1000)
         assert abs(a.value - 1.0) < 1e-3, a
+
+
+# ---- Hapke, BRF sweeps, image files, CLI (second round) ----
+
+#: Eradiate 0.5.0 ``hapke`` BSDF (scalar_mono_double, flat), measured
+#: (RADIOMETRY_REFERENCES.md 4.1): (sun (zenith, azimuth), view, BRF).
+ERADIATE_HAPKE = [
+    ((0.5, 0.2, 0.4, 15.0, 1.0, 0.05), [
+        ((30, 0), (0, 0), 0.113820), ((30, 0), (30, 0), 0.192827), ((30, 0), (30, 180), 0.107831),
+        ((60, 0), (45, 180), 0.139896), ((60, 0), (20, 90), 0.122498), ((30, 0), (28, 0), 0.171040)]),
+    ((0.8, 0.3, 0.6, 25.0, 0.0, 0.0), [
+        ((30, 0), (0, 0), 0.288117), ((30, 0), (30, 180), 0.251600), ((60, 0), (45, 180), 0.215051)]),
+]
+
+
+@pytest.mark.parametrize("params,cases", ERADIATE_HAPKE)
+def test_hapke_on_a_flat_plane_matches_eradiate(params, cases):
+    """A flat plane's BRF is the facet's BRF: Eradiate's reference values to
+    1e-5, through the whole path tracer, and reciprocal."""
+    from fractalgeo_rs.radiometry import Hapke
+
+    s = Scene.from_dem(np.zeros((4, 4)), material=Hapke(*params))
+    for (zs, azs), (zv, azv), want in cases:
+        for depth in (1, 4):
+            e = s.brf(sun=(azs, zs), view=(azv, zv), spp=50, max_depth=depth)
+            assert abs(e.value - want) < 1e-5, (zs, azs, zv, azv, e)
+        back = s.brf(sun=(azv, zv), view=(azs, zs), spp=50).value
+        assert abs(back - want) < 1e-5
+
+
+def test_hapke_is_finite_at_exact_backscatter_with_h_zero():
+    from fractalgeo_rs.radiometry import Hapke
+
+    for b0 in (1.0, 0.0):
+        s = Scene.from_dem(np.zeros((4, 4)), material=Hapke(0.8, 0.3, 0.6, 25.0, b0, 0.0))
+        v = s.brf(sun=(0, 30), view=(0, 30), spp=10).value
+        assert np.isfinite(v) and v > 0
+    # without a surge the model is continuous there (Eradiate: NaN)
+    near = s.brf(sun=(0, 30), view=(0, 30.001), spp=10).value
+    assert abs(near - v) < 1e-4
+
+
+def test_hapke_rough_surface_is_reciprocal_and_rejects_unphysical_parameters():
+    from fractalgeo_rs.radiometry import Hapke
+
+    z = fg.fbm_surface((16, 16), 0.7, method="spectral", periodic=True, seed=6, sigma=2.0)
+    s = Scene.from_dem(z, material=Hapke(0.6, 0.3, 0.6, 20.0, 0.8, 0.06))
+    for a, b in [((0, 35), (180, 55)), ((70, 60), (300, 15))]:
+        f = s.brf(sun=a, view=b, spp=100_000, max_depth=4, seed=1)
+        g = s.brf(sun=b, view=a, spp=100_000, max_depth=4, seed=2)
+        assert abs(f.value - g.value) < 3 * np.hypot(f.se, g.se), (a, b, f, g)
+    with pytest.raises(ValueError, match="^w: .*> 1"):
+        Scene.from_dem(z, material=Hapke(1.0, 0.7, 1.0, 0.0, 1.0, 0.3)).brf(sun=(0, 30), spp=10)
+    for kw, bad in [("w", 1.5), ("b", 1.0), ("c", -0.1), ("theta_bar", 90.0), ("B0", 2.0), ("h", float("nan"))]:
+        p = dict(w=0.5, b=0.2, c=0.4, theta_bar=15.0, B0=1.0, h=0.05)
+        p[kw] = bad
+        with pytest.raises(ValueError, match=f"^{kw}: "):
+            Hapke(**p)
+
+
+def test_brf_sweep_matches_single_brf_calls_and_vgroove_closed_form():
+    s = Scene.from_dem(grooves(30.0), material=Lambertian(1.0))
+    sw = s.brf_sweep(sun_azimuth=90.0, spp=20_000, max_depth=1, seed=3)
+    assert sw.value.shape == sw.se.shape == (7, 1)
+    assert sw.sun_zenith.tolist() == [0, 15, 30, 45, 60, 75, 89]
+    # single scattering, nadir view: rho cos(s) for every sun (V-grooves)
+    assert np.all(np.abs(sw.value[:, 0] - np.cos(np.radians(30))) < 4 * sw.se[:, 0] + 1e-12)
+    one = s.brf(sun=(90.0, 45.0), spp=20_000, max_depth=1, seed=3)
+    assert (sw.value[3, 0], sw.se[3, 0]) == (one.value, one.se)
+    two = s.brf_sweep(sun_zenith=[10, 50], view_zenith=[0, 20, 40], spp=100, max_depth=2)
+    assert two.value.shape == (2, 3) and np.all(two.se >= 0)
+    with pytest.raises(ValueError, match="^sun_zenith: .*90"):
+        s.brf_sweep(sun_zenith=[0, 90])
+    with pytest.raises(ValueError, match="^view_zenith: "):
+        s.brf_sweep(view_zenith=[])
+
+
+def test_render_progress_does_not_change_the_image():
+    z = periodic_surface(8)
+    s = Scene.from_dem(z, material=Lambertian(0.7))
+    a = s.render(sun=(135, 30), spp=4, progress=False)
+    b = s.render(sun=(135, 30), spp=4, progress=True)
+    np.testing.assert_array_equal(a, b)
+
+
+def test_images_are_written_whole_with_georeferencing(tmp_path):
+    rasterio = pytest.importorskip("rasterio")
+    from affine import Affine
+
+    z = periodic_surface(8)
+    t = Affine(30.0, 0.0, 500000.0, 0.0, -30.0, 4000000.0)
+    s = Scene.from_dem(z, cell_size=30.0, material=Lambertian(0.5),
+                       profile={"crs": rasterio.crs.CRS.from_epsg(32633), "transform": t})
+    img = s.render(sun=(135, 30), shape=(4, 8), spp=4)
+    s.save_image(tmp_path / "a.exr", img)
+    back, _ = fg.read_raster(tmp_path / "a.exr")
+    np.testing.assert_array_equal(back, img)
+    s.save_image(tmp_path / "a.tif", img)
+    with rasterio.open(tmp_path / "a.tif") as src:
+        np.testing.assert_array_equal(src.read(1), img)
+        assert src.crs.to_epsg() == 32633
+        # vertices at pixel centres; 8 x 8 cells over 4 x 8 pixels: 60 m rows, 30 m columns
+        assert tuple(src.transform)[:6] == (30.0, 0.0, 500015.0, 0.0, -60.0, 3999985.0)
+    s.save_image(tmp_path / "a.png", img)
+    png, _ = fg.read_raster(tmp_path / "a.png")
+    np.testing.assert_array_equal(png, np.clip(np.round(img.astype(np.float64) * np.pi * 255), 0, 255))
+    assert (tmp_path / "a.pgw").exists() and (tmp_path / "a.prj").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.exr", "a.pgw", "a.png", "a.prj", "a.tif"]
+    with pytest.raises(ValueError, match="^path: "):
+        s.save_image(tmp_path / "a.jpg", img)
+
+
+def test_cli_render_and_brf(tmp_path, capsys):
+    from fractalgeo_rs import cli
+
+    z = np.zeros((6, 6))
+    np.save(tmp_path / "dem.npy", z)
+    out = tmp_path / "out.exr"
+    assert cli.main(["render", str(tmp_path / "dem.npy"), str(out), "--sun", "135", "30", "--view", "nadir",
+                     "--spp", "4", "--cell-size", "1", "--material", "lambertian:0.4", "--no-progress"]) == 0
+    img, _ = fg.read_raster(out)
+    assert img.shape == (6, 6) and np.allclose(img, 0.4 * np.cos(np.radians(30)) / np.pi, rtol=1e-6)
+    csv = tmp_path / "brf.csv"
+    assert cli.main(["brf", str(tmp_path / "dem.npy"), "--sun-zenith", "0,15,30,45,60,75,89", "--csv", str(csv),
+                     "--spp", "10", "--cell-size", "1", "--material", "hapke:0.5,0.2,0.4,15,1,0.05",
+                     "--view-zenith", "30", "--view-azimuth", "180"]) == 0
+    rows = np.genfromtxt(csv, delimiter=",", names=True)
+    assert rows["sun_zenith"].tolist() == [0, 15, 30, 45, 60, 75, 89]
+    assert abs(rows["brf"][2] - 0.107831) < 1e-5  # Eradiate's (30, 0) -> (30, 180)
+    capsys.readouterr()
+    assert cli.main(["brf", str(tmp_path / "dem.npy"), "--sun-zenith", "0,95", "--cell-size", "1"]) == 1
+    assert "--sun-zenith" in capsys.readouterr().err
+    assert cli.main(["render", str(tmp_path / "dem.npy"), str(out), "--sun", "0", "30", "--cell-size", "1",
+                     "--material", "hapke:2"]) == 1
+    assert "--material" in capsys.readouterr().err
+
+
+def test_specular_flat_mirror_reflects_the_fresnel_fraction():
+    """Normal incidence ((n - 1)/(n + 1))^2 and Brewster's angle (r_p = 0,
+    F = ((n^2 - 1)/(n^2 + 1))^2 / 2); BRF of a flat mirror is 0 (a delta)."""
+    from fractalgeo_rs.radiometry import Specular
+
+    n = 1.5
+    s = Scene.from_dem(np.zeros((4, 4)), material=Specular(n))
+    assert abs(s.albedo(sun=(0, 0), spp=10).value - ((n - 1) / (n + 1)) ** 2) < 1e-12
+    brewster = np.degrees(np.arctan(n))
+    assert abs(s.albedo(sun=(30, brewster), spp=10).value - 0.5 * ((n * n - 1) / (n * n + 1)) ** 2) < 1e-12
+    assert s.brf(sun=(0, 30), view=(180, 30), spp=10).value == 0.0
+    with pytest.raises(ValueError, match="^eta: "):
+        Specular(0.0)
+    with pytest.raises(ValueError, match="^k: "):
+        Specular(1.5, k=-1.0)

@@ -598,4 +598,5 @@ def radiometry_render(
     max_depth: int,
     seed: int,
     n_threads: Optional[int] = None,
+    progress: Optional[ProgressCounter] = None,
 ) -> npt.NDArray[np.float32]: ...

@@ -27,6 +27,7 @@ _DOMAIN_CLIS = (
     "fractalgeo_rs.demo",
     "fractalgeo_rs.lsystem._cli",
     "fractalgeo_rs.radar._cli",
+    "fractalgeo_rs.radiometry._cli",
     "fractalgeo_rs.synth._cli",
     "fractalgeo_rs.transform._cli",
     "fractalgeo_rs.tin._cli",
@@ -45,6 +46,10 @@ _COMMANDS = {
                   "map of local fractal dimension (moving window) as a float32 GeoTIFF"),
     "tin": ("fractalgeo_rs.tin._cli", "error-bounded triangulated mesh (TIN) of a DEM as PLY or OBJ"),
     "sar": ("fractalgeo_rs.radar._cli", "synthetic SAR intensity image of a DEM (layover, shadow, speckle)"),
+    "render": ("fractalgeo_rs.radiometry._cli",
+               "radiance image of a DEM lit by the sun (virtual radiometric experiment)"),
+    "brf": ("fractalgeo_rs.radiometry._cli",
+            "BRF of a DEM over sun zenith angles (virtual radiometric experiment), as CSV"),
 }
 
 

@@ -3,6 +3,7 @@
 //! The scene is rebuilt from the DEM on every call (linear in the cells,
 //! negligible beside the rays), so nothing is kept between calls.
 use super::convert::{array2, c_order, run};
+use super::progress::{counter, ProgressCounter};
 use crate::error::{CoreError, CoreResult};
 use crate::radiometry::{direction, material, Heightfield, Scene, Split};
 use numpy::{PyArray2, PyReadonlyArray2};
@@ -110,7 +111,7 @@ fn radiometry_albedo(
 
 /// A float32 radiance image of shape `shape` of a DEM scene (orthographic sensor).
 #[pyfunction]
-#[pyo3(signature = (dem, cell_size, periodic, split, material, params, sun, view, shape, spp, max_depth, seed, n_threads=None))]
+#[pyo3(signature = (dem, cell_size, periodic, split, material, params, sun, view, shape, spp, max_depth, seed, n_threads=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn radiometry_render<'py>(
     py: Python<'py>,
@@ -127,8 +128,10 @@ fn radiometry_render<'py>(
     max_depth: u32,
     seed: u64,
     n_threads: Option<usize>,
+    progress: Option<&Bound<'py, ProgressCounter>>,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let z = c_order(&dem);
+    let pr = counter(progress);
     let img = run(py, n_threads, || {
         let s = build(
             &z.data,
@@ -139,13 +142,14 @@ fn radiometry_render<'py>(
             material,
             &params,
         )?;
-        s.render(
+        s.render_progress(
             direction(sun, "sun")?,
             direction(view, "view")?,
             shape,
             spp,
             max_depth,
             seed,
+            pr.as_deref(),
         )
     })?;
     array2(py, shape, img)

@@ -289,6 +289,22 @@ impl Scene {
         max_depth: u32,
         seed: u64,
     ) -> CoreResult<Vec<f32>> {
+        self.render_progress(sun, view, shape, spp, max_depth, seed, None)
+    }
+
+    /// [`Scene::render`], ticking `progress` once per image row (the image
+    /// does not depend on it).
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_progress(
+        &self,
+        sun: DVec3,
+        view: DVec3,
+        shape: (usize, usize),
+        spp: u64,
+        max_depth: u32,
+        seed: u64,
+        progress: Option<&crate::progress::Progress>,
+    ) -> CoreResult<Vec<f32>> {
         check_spp(spp)?;
         check_depth(max_depth)?;
         let (rows, cols) = shape;
@@ -306,6 +322,9 @@ impl Scene {
             });
         }
         let mut img: Vec<f32> = crate::buffers::try_filled(rows * cols, 0.0f32, "shape")?;
+        if let Some(p) = progress {
+            p.add_total(rows as u64);
+        }
         let (w, h) = self.hf.extent();
         let (pw, ph) = (w / cols as f64, h / rows as f64);
         img.par_chunks_mut(cols).enumerate().for_each(|(i, line)| {
@@ -321,6 +340,9 @@ impl Scene {
                     s += self.radiance(o, view, sun, max_depth, key, 2);
                 }
                 *px = (s / spp as f64) as f32;
+            }
+            if let Some(p) = progress {
+                p.tick(1);
             }
         });
         Ok(img)

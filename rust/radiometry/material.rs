@@ -92,6 +92,8 @@ pub fn basis(n: DVec3) -> (DVec3, DVec3) {
 /// | `lambertian` | `rho` in [0, 1] |
 /// | `oren-nayar` | `rho` in [0, 1], `sigma` (slope standard deviation, radians) >= 0 |
 /// | `phong` | `kd`, `ks` in [0, 1] with `kd + ks <= 1`, exponent >= 0 |
+/// | `hapke` | `w`, `b`, `c`, `theta_bar` (degrees), `B0`, `h` |
+/// | `specular` | `eta` > 0, `k` >= 0 (complex relative refractive index) |
 pub fn from_name(name: &str, params: &[f64]) -> CoreResult<Box<dyn Bsdf>> {
     let want = |n: usize, what: &str| -> CoreResult<()> {
         if params.len() == n {
@@ -123,9 +125,23 @@ pub fn from_name(name: &str, params: &[f64]) -> CoreResult<Box<dyn Bsdf>> {
                 params[0], params[1], params[2],
             )?))
         }
+        "hapke" => {
+            want(6, "w, b, c, theta_bar, B0, h")?;
+            Ok(Box::new(super::hapke::Hapke::new(
+                params[0], params[1], params[2], params[3], params[4], params[5],
+            )?))
+        }
+        "specular" => {
+            want(2, "eta, k")?;
+            Ok(Box::new(super::specular::Specular::new(
+                params[0], params[1],
+            )?))
+        }
         _ => Err(CoreError::invalid(
             "material",
-            format!("expected one of 'lambertian', 'oren-nayar', 'phong', got {name:?}"),
+            format!(
+                "expected one of 'lambertian', 'oren-nayar', 'phong', 'hapke', 'specular', got {name:?}"
+            ),
         )),
     }
 }

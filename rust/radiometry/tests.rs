@@ -603,3 +603,193 @@ fn rectangular_cells_give_world_normals_and_exact_nadir_brf() {
         assert!((e.value - 0.6 * n.z).abs() < 1e-9, "{e:?}");
     }
 }
+
+/// A local-frame direction from (zenith, azimuth) in degrees, as in
+/// Eradiate's test vectors.
+fn local(zen: f64, az: f64) -> DVec3 {
+    let (t, p) = (zen.to_radians(), az.to_radians());
+    DVec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
+}
+
+/// (zenith, azimuth) in degrees.
+type Angles = (f64, f64);
+
+#[test]
+fn hapke_matches_eradiate_reference_values() {
+    // eradiate-mitsuba 0.5.0 `hapke` BSDF, scalar_mono_double, measured
+    // (docs RADIOMETRY_REFERENCES.md 4.1): ((sun), (view), BRF)
+    let a = material::from_name("hapke", &[0.5, 0.2, 0.4, 15.0, 1.0, 0.05]).unwrap();
+    let b = material::from_name("hapke", &[0.8, 0.3, 0.6, 25.0, 0.0, 0.0]).unwrap();
+    let cases: [(&dyn Bsdf, Angles, Angles, f64); 9] = [
+        (&*a, (30.0, 0.0), (0.0, 0.0), 0.113820),
+        (&*a, (30.0, 0.0), (30.0, 0.0), 0.192827),
+        (&*a, (30.0, 0.0), (30.0, 180.0), 0.107831),
+        (&*a, (60.0, 0.0), (45.0, 180.0), 0.139896),
+        (&*a, (45.0, 180.0), (60.0, 0.0), 0.139896),
+        (&*a, (60.0, 0.0), (20.0, 90.0), 0.122498),
+        (&*a, (30.0, 0.0), (28.0, 0.0), 0.171040),
+        (&*b, (30.0, 0.0), (0.0, 0.0), 0.288117),
+        (&*b, (30.0, 0.0), (30.0, 180.0), 0.251600),
+    ];
+    for (m, s, v, want) in cases {
+        let got = std::f64::consts::PI * m.eval(local(s.0, s.1), local(v.0, v.1));
+        assert!((got - want).abs() < 1e-5, "{s:?} {v:?}: {got} vs {want}");
+    }
+    // (60, 0) -> (45, 180) of the second set, 0.215051
+    let got = std::f64::consts::PI * b.eval(local(60.0, 0.0), local(45.0, 180.0));
+    assert!((got - 0.215051).abs() < 1e-5, "{got}");
+}
+
+#[test]
+fn hapke_is_finite_at_exact_backscatter_with_h_zero() {
+    // Eradiate gives NaN here (0/0 in the opposition term)
+    for b0 in [0.0, 1.0] {
+        let m = material::from_name("hapke", &[0.8, 0.3, 0.6, 25.0, b0, 0.0]).unwrap();
+        for (zen, az) in [(30.0, 0.0), (0.0, 0.0), (89.0, 45.0), (60.0, 270.0)] {
+            let w = local(zen, az);
+            let v = m.eval(w, w);
+            assert!(v.is_finite() && v > 0.0, "{zen} {az}: {v}");
+        }
+        // continuous away from the surge (B0 = 0): the limit of nearby directions
+        if b0 == 0.0 {
+            let at = m.eval(local(30.0, 0.0), local(30.0, 0.0));
+            let near = m.eval(local(30.0, 0.0), local(30.0 + 1e-6, 0.0));
+            assert!((at - near).abs() < 1e-6, "{at} {near}");
+        }
+    }
+}
+
+#[test]
+fn hapke_isotropic_smooth_case_is_chandrasekhar_form() {
+    // theta_bar = 0, B0 = 0, b = 0 (P = 1): BRF = w/4 H(mu0) H(mu) / (mu0 + mu)
+    // with Hapke's (2002) H(x) = 1 / (1 - w x (r0 + (1 - 2 r0 x)/2 ln((1+x)/x)))
+    let w = 0.7f64;
+    let m = material::from_name("hapke", &[w, 0.0, 0.5, 0.0, 0.0, 0.1]).unwrap();
+    let r0 = (1.0 - (1.0 - w).sqrt()) / (1.0 + (1.0 - w).sqrt());
+    let h = |x: f64| 1.0 / (1.0 - w * x * (r0 + (1.0 - 2.0 * r0 * x) / 2.0 * ((1.0 + x) / x).ln()));
+    for (i, e, p) in [(10.0, 20.0, 30.0), (60.0, 5.0, 170.0), (45.0, 45.0, 90.0)] {
+        let (wi, wo) = (local(i, 0.0), local(e, p));
+        let want = w / 4.0 * h(wi.z) * h(wo.z) / (wi.z + wo.z);
+        let got = std::f64::consts::PI * m.eval(wi, wo);
+        assert!((got - want).abs() < 1e-12, "{got} {want}");
+    }
+}
+
+#[test]
+fn hapke_is_reciprocal_and_energy_bounded() {
+    let key = StreamKey::new(7, 3);
+    let params = [
+        [0.5, 0.2, 0.4, 15.0, 1.0, 0.05],
+        [0.8, 0.3, 0.6, 25.0, 0.0, 0.0],
+        [0.95, 0.6, 0.1, 40.0, 0.5, 0.01],
+        [0.3, 0.0, 1.0, 0.0, 1.0, 0.0],
+    ];
+    for p in params {
+        let m = material::from_name("hapke", &p).unwrap();
+        for i in 0..2000u64 {
+            let wi = local(89.0 * key.uniform(4 * i), 360.0 * key.uniform(4 * i + 1));
+            let wo = local(
+                89.0 * key.uniform(4 * i + 2),
+                360.0 * key.uniform(4 * i + 3),
+            );
+            let (a, b) = (m.eval(wi, wo), m.eval(wo, wi));
+            assert!(a.is_finite() && a >= 0.0);
+            assert!((a - b).abs() <= 1e-12 * a.max(1e-300), "{p:?}: {a} {b}");
+        }
+        for zen in (0..90).step_by(3) {
+            let alb = m.albedo(local(zen as f64, 0.0));
+            assert!(alb <= 1.0, "{p:?} at {zen}: {alb}");
+        }
+    }
+    // Hapke's model exceeds 1 for bright back-scattering surfaces: rejected
+    let err = material::from_name("hapke", &[1.0, 0.7, 1.0, 0.0, 1.0, 0.3]).unwrap_err();
+    assert!(
+        matches!(err, CoreError::InvalidArgument { ref param, .. } if param == "w"),
+        "{err}"
+    );
+    for (k, bad) in [
+        (0, 1.5),
+        (1, 1.0),
+        (2, -0.1),
+        (3, 90.0),
+        (4, f64::NAN),
+        (5, 2.0),
+    ] {
+        let mut p = [0.5, 0.2, 0.4, 15.0, 1.0, 0.05];
+        p[k] = bad;
+        assert!(material::from_name("hapke", &p).is_err(), "{k} {bad}");
+    }
+}
+
+#[test]
+fn hapke_sampler_passes_chi_square_and_its_weight_is_the_albedo() {
+    let m = material::from_name("hapke", &[0.6, 0.3, 0.7, 20.0, 1.0, 0.05]).unwrap();
+    let key = StreamKey::new(3, 9);
+    let wo = local(40.0, 30.0);
+    let (bins, n) = (20usize, 200_000u64);
+    let mut count = vec![0u64; bins];
+    let (mut s1, mut s2) = (0.0, 0.0);
+    for i in 0..n {
+        let s = m
+            .sample(wo, [key.uniform(2 * i), key.uniform(2 * i + 1)])
+            .unwrap();
+        assert!((s.pdf - m.pdf(s.wi, wo)).abs() < 1e-15);
+        let want = m.eval(s.wi, wo) * s.wi.z / s.pdf;
+        assert!((s.weight - want).abs() <= 1e-12 * want.max(1.0));
+        s1 += s.weight;
+        s2 += s.weight * s.weight;
+        count[((s.wi.z * s.wi.z * bins as f64) as usize).min(bins - 1)] += 1;
+    }
+    let e = n as f64 / bins as f64;
+    let chi2: f64 = count.iter().map(|&c| (c as f64 - e).powi(2) / e).sum();
+    assert!(chi2 < 43.8, "{chi2}"); // 19 dof, p = 0.001
+    let mean = s1 / n as f64;
+    let se = ((s2 / n as f64 - mean * mean) / n as f64).sqrt();
+    let alb = m.albedo(wo);
+    assert!(
+        (mean - alb).abs() < 4.0 * se + 1e-4,
+        "{mean} +- {se} vs {alb}"
+    );
+}
+
+#[test]
+fn specular_mirror_reflects_the_fresnel_fraction() {
+    // Fresnel at normal incidence: ((n - 1)^2 + k^2) / ((n + 1)^2 + k^2)
+    for (n, k) in [(1.5, 0.0), (1.33, 0.0), (0.2, 3.5)] {
+        let m = super::specular::Specular::new(n, k).unwrap();
+        let want = ((n - 1.0f64).powi(2) + k * k) / ((n + 1.0f64).powi(2) + k * k);
+        assert!((m.fresnel(1.0) - want).abs() < 1e-14, "{n} {k}");
+        assert!((m.fresnel(0.0) - 1.0).abs() < 1e-14); // grazing
+    }
+    // dielectric at Brewster's angle: r_p = 0, so F = r_s / 2 with
+    // r_s = ((n^2 - 1) / (n^2 + 1))^2
+    let n = 1.5f64;
+    let m = super::specular::Specular::new(n, 0.0).unwrap();
+    let cb = (1.0 / (1.0 + n * n)).sqrt();
+    let rs = ((n * n - 1.0) / (n * n + 1.0)).powi(2);
+    assert!((m.fresnel(cb) - 0.5 * rs).abs() < 1e-14);
+    // sampling: the mirror direction with weight F; eval and pdf are 0
+    let wo = local(40.0, 30.0);
+    let s = m.sample(wo, [0.3, 0.7]).unwrap();
+    assert!((s.wi - DVec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-15);
+    assert!((s.weight - m.fresnel(wo.z)).abs() < 1e-15 && m.eval(s.wi, wo) == 0.0);
+    // a flat mirror: albedo = F(cos sun zenith) exactly, BRF 0 (a delta)
+    let z = vec![0.0; 16];
+    let sc = scene(&z, 4, 4, true, "specular", &[1.5, 0.0]);
+    let brewster = n.atan().to_degrees();
+    for (zen, want) in [(0.0, 0.04), (brewster, 0.5 * rs)] {
+        let a = sc.albedo(dir(20.0, zen), 100, 10, 0).unwrap();
+        assert!(
+            (a.value - want).abs() < 1e-12 && a.se < 1e-8,
+            "{zen}: {a:?} {want}"
+        );
+        assert_eq!(
+            sc.brf(dir(20.0, zen), dir(200.0, zen), 100, 10, 0)
+                .unwrap()
+                .value,
+            0.0
+        );
+    }
+    assert!(material::from_name("specular", &[0.0, 0.0]).is_err());
+    assert!(material::from_name("specular", &[1.5, -1.0]).is_err());
+}

@@ -16,6 +16,16 @@ Examples
 >>> round(scene.brf(sun=(135.0, 30.0), spp=1000).value, 6)  # a flat plane: rho
 0.3
 """
-from fractalgeo_rs.radiometry._scene import Estimate, Lambertian, OrenNayar, Phong, Scene
+from fractalgeo_rs.radiometry._scene import (
+    PAPER_SUN_ZENITHS,
+    BrfSweep,
+    Estimate,
+    Hapke,
+    Lambertian,
+    OrenNayar,
+    Phong,
+    Scene,
+    Specular,
+)
 
-__all__ = ["Estimate", "Lambertian", "OrenNayar", "Phong", "Scene"]
+__all__ = ["BrfSweep", "Estimate", "Hapke", "Lambertian", "OrenNayar", "PAPER_SUN_ZENITHS", "Phong", "Scene", "Specular"]

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
 import warnings
 from dataclasses import dataclass
 from typing import List, Optional, Tuple, Union
@@ -21,7 +22,11 @@ from fractalgeo_rs._validation import (
 )
 from fractalgeo_rs._warn import user_stacklevel
 
-__all__ = ["Estimate", "Lambertian", "OrenNayar", "Phong", "Scene"]
+__all__ = ["BrfSweep", "Estimate", "Hapke", "Lambertian", "OrenNayar", "Phong", "Scene", "Specular"]
+
+#: Sun zeniths (degrees) of the paper's incidence series (figure 9), 0 to 90 in steps of 15, the
+#: grazing 90 taken as 89 (at 90 the horizontal irradiance and the BRF's denominator are 0).
+PAPER_SUN_ZENITHS = (0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 89.0)
 
 #: The largest ``max_depth`` the kernel accepts.
 MAX_DEPTH = 100_000
@@ -161,7 +166,145 @@ class Phong:
         return "phong", [self.kd, self.ks, self.exponent]
 
 
-Material = Union[Lambertian, OrenNayar, Phong]
+def _unit_param(value, name: str, upper_open: bool = False) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name}: expected a number in [0, 1{')' if upper_open else ']'}, got {value!r}")
+    v = float(value)
+    if not (0.0 <= v < 1.0 if upper_open else 0.0 <= v <= 1.0):
+        raise ValueError(f"{name}: expected a number in [0, 1{')' if upper_open else ']'}, got {v}")
+    return v
+
+
+@dataclass(frozen=True)
+class Hapke:
+    """Hapke's model of a particulate, rough surface (the parametrisation of
+    Eradiate's ``hapke`` BSDF).
+
+    ``BRF = w/4 mu0e/(mu0e + mue)/mu0 [P(g)(1 + B(g)) + H(mu0e) H(mue) - 1] S``
+    with ``P = (1 - c) HG(-b) + c HG(b)`` (double Henyey-Greenstein, ``c`` the
+    back-scattered fraction, ``g`` the phase angle), ``B = B0/(1 + tan(g/2)/h)``
+    (the shadow-hiding opposition surge), Hapke's (2002) approximation of the
+    H-function, and the roughness correction (``mu0e``, ``mue``, ``S``) of
+    Hapke (1984) for a mean facet slope ``theta_bar``. The BRDF is
+    ``BRF / pi``.
+
+    Finite everywhere: with ``h = 0`` the surge is ``B0`` at exact
+    backscatter (its limit there for every ``h > 0``) and 0 elsewhere
+    (Eradiate returns NaN there). Reciprocal. Hapke's model does not
+    conserve energy for bright back-scattering surfaces (``w = 1, b = 0.7,
+    c = 1`` reflects up to 1.46 times the incident flux), so parameters whose
+    directional albedo exceeds 1 at some sun zenith raise ``ValueError``
+    (naming ``w``) when a scene uses them. Sampled cosine-weighted.
+
+    Agrees with Eradiate 0.5.0's ``hapke`` BSDF to 5e-7 at its reference
+    directions (tested).
+
+    Parameters
+    ----------
+    w : float
+        Single-scattering albedo in [0, 1].
+    b : float
+        Henyey-Greenstein asymmetry in [0, 1).
+    c : float
+        Back-scattered fraction of the phase function in [0, 1].
+    theta_bar : float
+        Mean slope angle of the macroscopic roughness, degrees in [0, 90).
+    B0 : float
+        Amplitude of the opposition surge in [0, 1].
+    h : float
+        Angular width of the opposition surge in [0, 1].
+
+    Examples
+    --------
+    >>> from fractalgeo_rs.radiometry import Hapke
+    >>> Hapke(w=0.5, b=0.2, c=0.4, theta_bar=15.0, B0=1.0, h=0.05)
+    Hapke(w=0.5, b=0.2, c=0.4, theta_bar=15.0, B0=1.0, h=0.05)
+
+    References
+    ----------
+    B. Hapke, "Bidirectional reflectance spectroscopy 3. Correction for
+    macroscopic roughness", *Icarus* 59, 41-59, 1984,
+    doi:10.1016/0019-1035(84)90054-X (equations 45-58).
+    B. Hapke, "Bidirectional reflectance spectroscopy 5. The coherent
+    backscatter opposition effect and anisotropic scattering", *Icarus* 157,
+    523-534, 2002, doi:10.1006/icar.2002.6853 (equation 13).
+    Eradiate, ``hapke`` BSDF, https://eradiate.readthedocs.io.
+    """
+
+    w: float
+    b: float
+    c: float
+    theta_bar: float
+    B0: float
+    h: float
+
+    def __post_init__(self):
+        object.__setattr__(self, "w", _unit_param(self.w, "w"))
+        object.__setattr__(self, "b", _unit_param(self.b, "b", upper_open=True))
+        object.__setattr__(self, "c", _unit_param(self.c, "c"))
+        object.__setattr__(self, "B0", _unit_param(self.B0, "B0"))
+        object.__setattr__(self, "h", _unit_param(self.h, "h"))
+        t = self.theta_bar
+        if isinstance(t, bool) or not isinstance(t, numbers.Real) or not (math.isfinite(float(t))
+                                                                         and 0.0 <= float(t) < 90.0):
+            raise ValueError(f"theta_bar: expected a mean slope angle in [0, 90) degrees, got {t!r}")
+        object.__setattr__(self, "theta_bar", float(t))
+
+    def _spec(self) -> Tuple[str, List[float]]:
+        return "hapke", [self.w, self.b, self.c, self.theta_bar, self.B0, self.h]
+
+
+@dataclass(frozen=True)
+class Specular:
+    """A smooth mirror facet with unpolarised Fresnel reflectance.
+
+    Light leaves only along the mirror direction, with the fraction
+    ``F(cos theta)`` of a medium of complex relative refractive index
+    ``eta + i k`` (``k = 0``: a dielectric such as water, 1.33; ``k > 0``: a
+    conductor). The BRDF is a Dirac delta: the directional sun reaches the
+    sensor from a mirror facet only after another scattering event, and a
+    flat mirror's BRF is 0 (its albedo is ``F``). Reciprocal and
+    energy-bounded (``F <= 1``).
+
+    Parameters
+    ----------
+    eta : float
+        Real part of the relative refractive index (> 0).
+    k : float
+        Extinction coefficient (>= 0).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fractalgeo_rs.radiometry import Scene, Specular
+    >>> s = Scene.from_dem(np.zeros((4, 4)), material=Specular(1.5))
+    >>> round(s.albedo(sun=(0.0, 0.0), spp=10).value, 9)  # ((1.5 - 1) / (1.5 + 1))**2
+    0.04
+
+    References
+    ----------
+    M. Born and E. Wolf, *Principles of Optics*, 7th ed., Cambridge
+    University Press, 1999, section 1.5 (Fresnel formulae).
+    """
+
+    eta: float
+    k: float = 0.0
+
+    def __post_init__(self):
+        for name, lo_open in (("eta", True), ("k", False)):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, numbers.Real):
+                raise TypeError(f"{name}: expected a number, got {v!r}")
+            v = float(v)
+            if not math.isfinite(v) or (v <= 0.0 if lo_open else v < 0.0):
+                raise ValueError(f"{name}: expected a finite number {'> 0' if lo_open else '>= 0'}, got {v}")
+            object.__setattr__(self, name, v)
+
+    def _spec(self) -> Tuple[str, List[float]]:
+        return "specular", [self.eta, self.k]
+
+
+Material = Union[Lambertian, OrenNayar, Phong, Hapke, Specular]
 
 
 @dataclass(frozen=True)
@@ -194,6 +337,50 @@ class Estimate:
 
     value: float
     se: float
+    n: int
+
+
+@dataclass(frozen=True)
+class BrfSweep:
+    """BRFs over a grid of sun and view zenith angles (``Scene.brf_sweep``).
+
+    Attributes
+    ----------
+    sun_zenith : numpy.ndarray, shape (n_sun,)
+        Sun zenith angles, degrees.
+    view_zenith : numpy.ndarray, shape (n_view,)
+        View zenith angles, degrees.
+    sun_azimuth, view_azimuth : float
+        The azimuths (degrees clockwise from north) of every sun and view
+        direction.
+    value : numpy.ndarray, shape (n_sun, n_view)
+        BRF estimates; ``value[i, j]`` for ``sun_zenith[i]``,
+        ``view_zenith[j]``.
+    se : numpy.ndarray, shape (n_sun, n_view)
+        Their Monte Carlo standard errors.
+    n : int
+        Paths per estimate.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fractalgeo_rs.radiometry import Lambertian, Scene
+    >>> sw = Scene.from_dem(np.zeros((4, 4)), material=Lambertian(0.3)).brf_sweep(
+    ...     sun_zenith=[0, 45], view_zenith=[0, 30], spp=100)
+    >>> sw.value.shape, bool(np.allclose(sw.value, 0.3))
+    ((2, 2), True)
+
+    References
+    ----------
+    F. E. Nicodemus et al., NBS Monograph 160, 1977 (see ``Scene.brf``).
+    """
+
+    sun_zenith: np.ndarray
+    view_zenith: np.ndarray
+    sun_azimuth: float
+    view_azimuth: float
+    value: np.ndarray
+    se: np.ndarray
     n: int
 
 
@@ -277,10 +464,13 @@ class Scene:
         the heights.
     periodic : bool
         Whether the DEM is one tile of an infinite periodic surface.
-    material : Lambertian, OrenNayar or Phong
+    material : Lambertian, OrenNayar, Phong, Hapke or Specular
         The reflectance model of every facet.
     split : str
         The diagonal that splits each cell: ``"ne-sw"`` or ``"nw-se"``.
+    profile : dict or None
+        The DEM's georeferencing (a rasterio profile with ``crs`` and
+        ``transform``), kept for ``save_image``.
 
     Examples
     --------
@@ -303,7 +493,8 @@ class Scene:
     """
 
     def __init__(self, dem: np.ndarray, cell_size: Tuple[float, float], periodic: bool, material: Material,
-                 split: str):
+                 split: str, profile: Optional[dict] = None):
+        self.profile = profile
         self.dem = dem
         self.cell_size = cell_size
         self.periodic = periodic
@@ -316,7 +507,8 @@ class Scene:
 
     @classmethod
     def from_dem(cls, dem, cell_size: Union[float, Tuple[float, float]] = 1.0, periodic: bool = True,
-                 material: Optional[Material] = None, split: str = "ne-sw") -> "Scene":
+                 material: Optional[Material] = None, split: str = "ne-sw",
+                 profile: Optional[dict] = None) -> "Scene":
         """A scene of two triangular facets per DEM cell.
 
         Vertex ``(r, c)`` sits at ``x = c * dx`` east, ``y = -r * dy``
@@ -342,10 +534,14 @@ class Scene:
             ``np.block([[z, z[:, ::-1]], [z[::-1], z[::-1, ::-1]]])``.
             False: a finite patch of ``(rows - 1) x (cols - 1)`` cells; rays
             that leave it escape.
-        material : Lambertian, OrenNayar or Phong, optional
+        material : Lambertian, OrenNayar, Phong, Hapke or Specular, optional
             Reflectance model of every facet; default ``Lambertian(0.5)``.
         split : {"ne-sw", "nw-se"}
             The diagonal splitting each cell.
+        profile : dict, optional
+            Georeferencing of the DEM as :func:`fractalgeo_rs.read_raster`
+            returns it (``crs``, ``transform``: heights at pixel centres);
+            ``save_image`` then writes georeferenced GeoTIFF and PNG.
 
         Returns
         -------
@@ -382,8 +578,9 @@ class Scene:
         cell_size = _cell_size(cell_size)
         if material is None:
             material = Lambertian(0.5)
-        if not isinstance(material, (Lambertian, OrenNayar, Phong)):
-            raise TypeError(f"material: expected Lambertian(...), OrenNayar(...) or Phong(...), got {material!r}")
+        if not isinstance(material, (Lambertian, OrenNayar, Phong, Hapke, Specular)):
+            raise TypeError("material: expected Lambertian(...), OrenNayar(...), Phong(...), Hapke(...) or Specular(...), "
+                            f"got {material!r}")
         split = check_choice(split, "split", ("ne-sw", "nw-se"))
         if periodic:
             mismatch = _edge_mismatch(z)
@@ -391,8 +588,10 @@ class Scene:
                 warnings.warn(f"dem: periodic=True but opposite edges do not match ({mismatch}); the "
                               "wrap adds a cliff. Mirror the DEM to make it tileable, or pass periodic=False",
                               UserWarning, stacklevel=user_stacklevel())
+        if profile is not None and not isinstance(profile, dict):
+            raise TypeError(f"profile: expected a dict (a rasterio profile) or None, got {type(profile).__name__}")
         z.setflags(write=False)
-        return cls(z, cell_size, periodic, material, split)
+        return cls(z, cell_size, periodic, material, split, profile=dict(profile) if profile else None)
 
     def _args(self) -> Tuple[np.ndarray, Tuple[float, float], bool, str, str, List[float]]:
         name, params = self.material._spec()
@@ -502,7 +701,7 @@ class Scene:
 
     def render(self, sun, view="nadir", shape: Optional[Tuple[int, int]] = None, spp: int = 16,
                max_depth: int = 10, seed: int = 0, n_threads: Optional[int] = None,
-               max_memory=None) -> np.ndarray:
+               max_memory=None, progress: Optional[bool] = None) -> np.ndarray:
         """Radiance image seen by an orthographic sensor.
 
         The tile's horizontal extent is divided into ``shape`` pixels; pixel
@@ -531,6 +730,9 @@ class Scene:
         max_memory : int, optional
             Limit in bytes for the image (default: the package's limit);
             a larger image raises ``MemoryError`` before allocating.
+        progress : bool, optional
+            A progress bar over the image rows on stderr (needs tqdm); the
+            image does not depend on it.
 
         Returns
         -------
@@ -559,6 +761,195 @@ class Scene:
             raise TypeError(f"shape: expected (rows, cols), got {shape!r}") from None
         rows, cols = check_positive_int(rows, "shape"), check_positive_int(cols, "shape")
         check_memory(rows * cols * 4, "shape", max_memory=max_memory, what=f"a {rows} x {cols} float32 image")
-        return _core.radiometry_render(*self._args(), _direction(sun, "sun"), _direction(view, "view"),
-                                       (rows, cols), check_positive_int(spp, "spp"), _depth(max_depth),
-                                       _seed(seed), check_n_threads(n_threads))
+        from fractalgeo_rs import _progress
+
+        args = (*self._args(), _direction(sun, "sun"), _direction(view, "view"), (rows, cols),
+                check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed), check_n_threads(n_threads))
+        with _progress.Steps(rows, "render", _progress.resolve(progress)) as steps:
+            return steps.counted(lambda counter: _core.radiometry_render(*args, progress=counter), rows)
+
+    def brf_sweep(self, sun_zenith=PAPER_SUN_ZENITHS, view_zenith=(0.0,), sun_azimuth: float = 0.0,
+                  view_azimuth: float = 0.0, spp: int = 65536, max_depth: int = 10, seed: int = 0,
+                  n_threads: Optional[int] = None, progress: Optional[bool] = None) -> BrfSweep:
+        """BRF over every pair of sun and view zenith angles.
+
+        One ``brf`` per pair (each with the same ``seed``: common random
+        numbers, so differences between angles are smoother than their
+        standard errors suggest).
+
+        Parameters
+        ----------
+        sun_zenith : sequence of float
+            Sun zenith angles, degrees in [0, 90); default the paper's
+            incidence series 0, 15, ..., 75 and 89 (:data:`PAPER_SUN_ZENITHS`;
+            at 90 the BRF is 0/0).
+        view_zenith : sequence of float
+            View zenith angles, degrees in [0, 90); default nadir.
+        sun_azimuth, view_azimuth : float
+            Azimuths, degrees clockwise from north (equal: the view on the
+            sun's side of the principal plane).
+        spp, max_depth, seed, n_threads
+            As in ``brf``.
+        progress : bool, optional
+            A progress bar over the angle pairs on stderr (needs tqdm).
+
+        Returns
+        -------
+        BrfSweep
+            ``value`` and ``se`` of shape ``(len(sun_zenith), len(view_zenith))``.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from fractalgeo_rs.radiometry import Lambertian, Scene
+        >>> s = Scene.from_dem(np.zeros((4, 4)), material=Lambertian(0.2))
+        >>> s.brf_sweep(spp=50).value[:, 0].round(6).tolist()
+        [0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2]
+
+        References
+        ----------
+        M. Datcu and K. Seidel, 1995 (see ``Scene``; figure 9's incidence series).
+        """
+        from fractalgeo_rs import _progress
+
+        suns = _angles(sun_zenith, "sun_zenith")
+        views = _angles(view_zenith, "view_zenith")
+        az_s = _azimuth(sun_azimuth, "sun_azimuth")
+        az_v = _azimuth(view_azimuth, "view_azimuth")
+        spp = check_positive_int(spp, "spp")
+        depth, seed, n_threads = _depth(max_depth), _seed(seed), check_n_threads(n_threads)
+        value = np.empty((suns.size, views.size))
+        se = np.empty_like(value)
+        args = self._args()
+        with _progress.bar(suns.size * views.size, "brf", _progress.resolve(progress)) as bar:
+            for i, zs in enumerate(suns):
+                for j, zv in enumerate(views):
+                    value[i, j], se[i, j], _ = _core.radiometry_brf(
+                        *args, (az_s, float(zs)), (az_v, float(zv)), spp, depth, seed, n_threads)
+                    bar.update(1)
+        return BrfSweep(suns, views, az_s, az_v, value, se, spp)
+
+    def image_transform(self, shape: Tuple[int, int]):
+        """The affine transform (rasterio ``Affine``) of an image of
+        ``shape`` rendered over this scene, or None without georeferencing.
+
+        The scene's vertices are the DEM's pixel centres; an image covers the
+        tile (``rows x cols`` cells when periodic, ``(rows - 1) x (cols -
+        1)`` otherwise) from the first centre, so its transform is the
+        DEM's shifted by half a pixel and scaled by cells per image pixel.
+
+        Parameters
+        ----------
+        shape : (int, int)
+            ``(rows, cols)`` of the image.
+
+        Returns
+        -------
+        affine.Affine or None
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from affine import Affine
+        >>> from fractalgeo_rs.radiometry import Scene
+        >>> s = Scene.from_dem(np.zeros((4, 4)), profile={"transform": Affine(30, 0, 500, 0, -30, 900)})
+        >>> tuple(s.image_transform((2, 2)))[:6]
+        (60.0, 0.0, 515.0, 0.0, -60.0, 885.0)
+
+        References
+        ----------
+        GDAL data model, https://gdal.org/user/raster_data_model.html (affine geotransform).
+        """
+        t = (self.profile or {}).get("transform")
+        if t is None:
+            return None
+        from affine import Affine
+
+        if not isinstance(t, Affine):
+            t = Affine(*tuple(t)[:6])
+        rows, cols = shape
+        cells = self.dem.shape if self.periodic else (self.dem.shape[0] - 1, self.dem.shape[1] - 1)
+        return t * Affine.translation(0.5, 0.5) * Affine.scale(cells[1] / cols, cells[0] / rows)
+
+    def save_image(self, path, image, white: float = 1.0 / math.pi) -> None:
+        """Write a rendered image, atomically (temporary file and rename).
+
+        The format follows the extension: ``.exr`` (float32 radiance, through
+        the ``exr`` crate), ``.tif``/``.tiff`` (float32 GeoTIFF through
+        rasterio, with the scene's CRS and ``image_transform`` when the scene
+        has a ``profile``), ``.png`` (8-bit, ``255 * min(1, image / white)``;
+        with a world file and ``.prj`` beside it when georeferenced), or
+        ``.npy``.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            Output file.
+        image : numpy.ndarray, shape (rows, cols)
+            Radiance from ``render``.
+        white : float
+            PNG only: the radiance shown as 255 (> 0). The default ``1 / pi``
+            is a white Lambertian plane with the sun at zenith, so a series
+            of sun zeniths keeps one scale.
+
+        Returns
+        -------
+        None
+
+        Examples
+        --------
+        >>> import os, tempfile
+        >>> import numpy as np
+        >>> from fractalgeo_rs import read_raster
+        >>> from fractalgeo_rs.radiometry import Scene
+        >>> s = Scene.from_dem(np.zeros((4, 4)))
+        >>> path = os.path.join(tempfile.mkdtemp(), "img.exr")
+        >>> s.save_image(path, s.render(sun=(0.0, 30.0), spp=2))
+        >>> read_raster(path)[0].shape
+        (4, 4)
+
+        References
+        ----------
+        OpenEXR file layout, https://openexr.com/en/latest/OpenEXRFileLayout.html.
+        """
+        from fractalgeo_rs.io import write_raster
+
+        img = np.asarray(image)
+        if img.ndim != 2:
+            raise ValueError(f"image: expected a 2D radiance image, got shape {img.shape}")
+        if img.dtype.kind not in "iuf":
+            raise TypeError(f"image: expected real radiances, got dtype {img.dtype}")
+        ext = os.path.splitext(os.fspath(path))[1].lower()
+        t = self.image_transform(img.shape)
+        crs = (self.profile or {}).get("crs")
+        if ext == ".png":
+            w = check_positive_float(white, "white")
+            with np.errstate(invalid="ignore"):
+                b = np.clip(np.nan_to_num(img.astype(np.float64) / w) * 255.0 + 0.5, 0, 255).astype(np.uint8)
+            write_raster(path, b, crs=crs, transform=t)
+        elif ext in (".tif", ".tiff"):
+            write_raster(path, img.astype(np.float32), crs=crs, transform=t)
+        elif ext in (".exr", ".npy"):
+            write_raster(path, img.astype(np.float32))
+        else:
+            raise ValueError(f"path: expected a .exr, .tif, .png or .npy file name, got {os.fspath(path)!r}")
+
+
+def _angles(value, name: str) -> np.ndarray:
+    try:
+        a = np.atleast_1d(np.asarray(value, dtype=np.float64))
+    except (TypeError, ValueError):
+        raise TypeError(f"{name}: expected a sequence of zenith angles in degrees, got {value!r}") from None
+    if a.ndim != 1 or a.size == 0:
+        raise ValueError(f"{name}: expected a non-empty 1D sequence of zenith angles, got shape {a.shape}")
+    bad = ~((a >= 0.0) & (a < 90.0))
+    if bad.any():
+        raise ValueError(f"{name}: zenith angles must be in [0, 90) degrees (above the horizon), got "
+                         f"{a[bad][0]:g}")
+    return a
+
+
+def _azimuth(value, name: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(float(value)):
+        raise ValueError(f"{name}: expected a finite azimuth in degrees, got {value!r}")
+    return float(value)
