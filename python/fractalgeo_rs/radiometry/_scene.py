@@ -781,7 +781,7 @@ class Scene:
         ----------
         sun_zenith : sequence of float
             Sun zenith angles, degrees in [0, 90); default the paper's
-            incidence series 0, 15, ..., 75 and 89 (:data:`PAPER_SUN_ZENITHS`;
+            incidence series 0, 15, ..., 75 and 89 (``PAPER_SUN_ZENITHS``;
             at 90 the BRF is 0/0).
         view_zenith : sequence of float
             View zenith angles, degrees in [0, 90); default nadir.
