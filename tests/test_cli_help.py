@@ -136,3 +136,22 @@ def test_subpackages_import_on_attribute_access_and_odd_names_do_not():
             "assert getattr(fg, '_nope', None) is None and getattr(fg, 'nope', None) is None\n")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
+
+
+def test_api_names_are_spelled_as_options(tmp_path, capsys):
+    # transform's window_size is the CLI's --window; a required option shows no default
+    import numpy as np
+
+    from fractalgeo_rs.cli import build_parser, main
+
+    src = tmp_path / "z.npy"
+    np.save(src, np.random.default_rng(1).normal(size=(32, 32)))
+    assert main(["transform", str(src), str(tmp_path / "m.tif"), "--window", "16"]) == 1
+    err = capsys.readouterr().err
+    assert "--window: expected an odd int" in err and "window_size" not in err
+    from fractalgeo_rs._cli_common import HelpFormatter
+
+    synth = build_parser("synth")._subparsers._group_actions[0].choices["synth"]
+    hurst = next(a for a in synth._actions if "--hurst" in a.option_strings)
+    assert hurst.required
+    assert "%(default)" not in HelpFormatter("x")._get_help_string(hurst)

@@ -13,11 +13,12 @@ from typing import NamedTuple
 class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
     """Shows ``(default: ...)`` after every option that has help text,
     once: a help text that already states its default (it contains the
-    word "default") is shown as written."""
+    word "default") and a required option (it has no default) are shown
+    as written."""
 
     def _get_help_string(self, action):
         text = action.help or ""
-        if "default" in text.lower():
+        if "default" in text.lower() or getattr(action, "required", False):
             return text
         return super()._get_help_string(action)
 

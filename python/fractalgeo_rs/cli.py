@@ -108,13 +108,21 @@ def _subparser(parser: argparse.ArgumentParser, command: str) -> Optional[argpar
     return None
 
 
+#: API parameters whose CLI option has another name: {API name: option dest}
+_API_NAMES = {"window_size": "window"}
+
+
 def option_names(sub: Optional[argparse.ArgumentParser]) -> dict:
-    """``{dest: "--option"}`` of a subcommand's options (the long spelling)."""
+    """``{dest: "--option"}`` of a subcommand's options (the long spelling),
+    and the API names of :data:`_API_NAMES` spelled as their options."""
     names: dict = {}
     for action in (sub._actions if sub is not None else ()):
         longs = [o for o in action.option_strings if o.startswith("--")]
         if longs and action.dest not in names:
             names[action.dest] = longs[0]
+    for api, dest in _API_NAMES.items():
+        if dest in names and api not in names:
+            names[api] = names[dest]
     return names
 
 
@@ -180,6 +188,8 @@ def _one_line_warning(command):
 
     def show(message, category, filename, lineno, file=None, line=None):
         text = " ".join(str(message).split())
+        if command in ("render", "brf"):  # the CLI's spelling of a finite patch
+            text = text.replace("pass periodic=False", "pass --finite")
         print(f"fractalgeo {command}: warning: {text}", file=sys.stderr if file is None else file)
 
     return show

@@ -50,7 +50,7 @@ def add_parsers(sub) -> None:
             "transect madogram (the median of the row and column profile dimensions, plus 1) and a profile "
             "the variogram, the estimators the accuracy tables of the documentation find accurate "
             "(DBC, blanket and self-affine boxes are biased by 0.1-0.8 on fBm). Prints the dimension, its "
-            "95 %% interval, the scales fitted, and a warning with the reason when the answer is outside "
+            "95 % interval, the scales fitted, and a warning with the reason when the answer is outside "
             "the valid domain."
         ),
     )
