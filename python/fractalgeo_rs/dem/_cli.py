@@ -197,3 +197,22 @@ def _run_hillshade(args: argparse.Namespace) -> int:
     print(f"hillshade: {z.shape[0]} x {z.shape[1]} DEM, cell {cs[0]:g} x {cs[1]:g}, azimuth {args.azimuth:g}, "
           f"altitude {args.altitude:g}, {int((s == 0).sum())} nodata pixels -> {args.output}")
     return 0
+
+
+def ground_cell_size(prof, rows):
+    """``(dy, dx)``, the cell of a raster read by ``read_raster`` in metres
+    (map units of a projected grid; metres at the grid's middle latitude for
+    a geographic one): the pixel sides of its transform, rotated grids
+    included (:func:`~fractalgeo_rs._cli_common.pixel_size`); ``None``
+    without a transform."""
+    from fractalgeo_rs._cli_common import is_geographic, pixel_size
+    from fractalgeo_rs.dem import metres_per_degree
+
+    t = prof.get("transform") if prof else None
+    if t is None:
+        return None
+    dx, dy = pixel_size(t)
+    if is_geographic(prof.get("crs")):
+        m_lat, m_lon = metres_per_degree(t.f + t.e * rows / 2)
+        dy, dx = dy * float(m_lat), dx * float(m_lon)
+    return dy, dx

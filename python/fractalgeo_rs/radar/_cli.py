@@ -5,7 +5,7 @@ import argparse
 
 import numpy as np
 
-from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads, add_raster_io, is_geographic
+from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads, add_raster_io
 
 
 def add_parsers(sub) -> None:
@@ -33,7 +33,7 @@ def add_parsers(sub) -> None:
 
 
 def _run_sar(args: argparse.Namespace) -> int:
-    from fractalgeo_rs.dem import metres_per_degree
+    from fractalgeo_rs.dem._cli import ground_cell_size
     from fractalgeo_rs.io import read_raster, write_raster
     from fractalgeo_rs.radar import simulate, to_db
 
@@ -44,14 +44,7 @@ def _run_sar(args: argparse.Namespace) -> int:
         nodata = prof.get("nodata")
         if nodata is not None:
             z = np.where(z == nodata, np.nan, z)
-        t = prof.get("transform")
-        if t is not None:
-            dy, dx = abs(t.e), abs(t.a)
-            if is_geographic(prof.get("crs")):
-                lat = t.f + t.e * z.shape[0] / 2
-                m_lat, m_lon = metres_per_degree(lat)
-                dy, dx = dy * float(m_lat), dx * float(m_lon)
-            cell = (dy, dx)
+        cell = ground_cell_size(prof, z.shape[0])
     if args.cell_size is not None:
         cell = args.cell_size
     if cell is None:

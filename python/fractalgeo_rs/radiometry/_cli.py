@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import Tuple, Union
 
-from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads, add_progress, add_raster_io, is_geographic
+from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads, add_progress, add_raster_io
 
 #: Parameters of each --material name, in order.
 _MATERIALS = {
@@ -99,7 +99,7 @@ def _angle_list(text: str, name: str):
 def _scene(args: argparse.Namespace):
     import numpy as np
 
-    from fractalgeo_rs.dem import metres_per_degree
+    from fractalgeo_rs.dem._cli import ground_cell_size
     from fractalgeo_rs.io import read_raster
     from fractalgeo_rs.radiometry import Scene
 
@@ -111,14 +111,8 @@ def _scene(args: argparse.Namespace):
         if nodata is not None and np.any(z == nodata):
             raise ValueError(f"dem: {int(np.sum(z == nodata))} nodata cell(s); fill them first "
                              "(e.g. fractalgeo_rs.dem.fill_nodata)")
-        t = prof.get("transform")
-        if t is not None:
-            dy, dx = abs(t.e), abs(t.a)
-            if is_geographic(prof.get("crs")):
-                lat = t.f + t.e * z.shape[0] / 2
-                m_lat, m_lon = metres_per_degree(lat)
-                dy, dx = dy * float(m_lat), dx * float(m_lon)
-            cell = (dx, dy)
+        ground = ground_cell_size(prof, z.shape[0])
+        cell = None if ground is None else (ground[1], ground[0])
     if args.cell_size is not None:
         cell = args.cell_size
     if cell is None:
