@@ -34,8 +34,9 @@ def add_parsers(sub) -> None:
         help="synthesise fBm (1D), a fractal surface or a synthetic DEM in metres (2D)",
         description="Synthesise fractional Brownian motion (1D, --size N) or a fractional Brownian "
         "surface (2D, --size ROWS COLS) and write it (.npy, .exr, .tif; 1D: .npy only). With --relief "
-        "the surface is a DEM in metres (fractalgeo_rs.synthetic_dem): heights of that standard deviation "
-        "(or that std of height differences at --relief-lag metres) around --mean-elevation. A GeoTIFF gets "
+        "the surface is a DEM in metres (fractalgeo_rs.synthetic_dem): heights whose expected standard deviation "
+        "over the grid is that value (one draw's std scatters around it), or that std of height differences "
+        "at --relief-lag metres, around --mean-elevation. A GeoTIFF gets "
         "a transform of --cell-size square cells (upper-left corner at (0, ROWS * cell size)), the --crs "
         "if given, and the tags CELL_SIZE, HURST, METHOD, SEED (the seed used, also printed: pass it "
         "back with --seed to repeat the run). Time and peak memory are printed. A progress bar is drawn "
@@ -53,8 +54,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--sigma", type=float, default=1.0,
                    help="increment std at unit distance (ignored with --relief)")
     p.add_argument("--relief", type=float, default=None,
-                   help="2D: a DEM in metres with this height std, or this std of height differences at "
-                   "--relief-lag metres (None: an fBm surface of --sigma)")
+                   help="2D: a DEM in metres with this expected height std over the grid, or this std of height "
+                   "differences at --relief-lag metres (None: an fBm surface of --sigma)")
     p.add_argument("--relief-lag", type=float, default=None,
                    help="with --relief: lag in metres of the relief (None: the std over the grid)")
     p.add_argument("--mean-elevation", type=float, default=None,
