@@ -77,6 +77,9 @@ __all__ = [
     "radiometry_albedo",
     "radiometry_brf",
     "radiometry_render",
+    "radiometry_bhr",
+    "radiometry_brf_sky",
+    "radiometry_render_psf",
 ]
 
 # ---- geometry ----
@@ -597,6 +600,53 @@ def radiometry_render(
     spp: int,
     max_depth: int,
     seed: int,
+    n_threads: Optional[int] = None,
+    progress: Optional[ProgressCounter] = None,
+) -> npt.NDArray[np.float32]: ...
+def radiometry_brf_sky(
+    dem: npt.NDArray[np.float64],
+    cell_size: Tuple[float, float],
+    periodic: bool,
+    split: str,
+    material: str,
+    params: Sequence[float],
+    sun: Tuple[float, float],
+    view: Tuple[float, float],
+    sky: float,
+    spp: int,
+    max_depth: int,
+    seed: int,
+    n_threads: Optional[int] = None,
+) -> Tuple[float, float, int]: ...
+def radiometry_bhr(
+    dem: npt.NDArray[np.float64],
+    cell_size: Tuple[float, float],
+    periodic: bool,
+    split: str,
+    material: str,
+    params: Sequence[float],
+    spp: int,
+    max_depth: int,
+    seed: int,
+    n_threads: Optional[int] = None,
+) -> Tuple[float, float, int]: ...
+def radiometry_render_psf(
+    dem: npt.NDArray[np.float64],
+    cell_size: Tuple[float, float],
+    periodic: bool,
+    split: str,
+    material: str,
+    params: Sequence[float],
+    sun: Tuple[float, float],
+    view: Tuple[float, float],
+    sky: float,
+    shape: Tuple[int, int],
+    spp: int,
+    max_depth: int,
+    seed: int,
+    psf: str,
+    psf_params: Sequence[float],
+    psf_table: Optional[npt.NDArray[np.float64]] = None,
     n_threads: Optional[int] = None,
     progress: Optional[ProgressCounter] = None,
 ) -> npt.NDArray[np.float32]: ...

@@ -400,6 +400,37 @@ def _direction(value, name: str) -> Tuple[float, float]:
     return (az, zen)
 
 
+def _sky(value) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"sky: expected a horizontal sky irradiance >= 0 (a number), got {value!r}")
+    v = float(value)
+    if not (math.isfinite(v) and v >= 0.0):
+        raise ValueError(f"sky: expected a finite sky irradiance >= 0, got {v}")
+    return v
+
+
+def _psf(value, step) -> Tuple[str, List[float], Optional[np.ndarray]]:
+    """``(kind, params, table)`` for the kernel from the ``psf`` argument."""
+    if isinstance(value, str):
+        if value != "box":
+            raise ValueError(f"psf: expected 'box', ('gaussian', sigma) or an array of weights, got {value!r}")
+        return "box", [], None
+    if isinstance(value, tuple) and value and isinstance(value[0], str):
+        if value[0] != "gaussian" or len(value) not in (2, 3):
+            raise ValueError(f"psf: expected ('gaussian', sigma) or ('gaussian', sigma, truncate), got {value!r}")
+        sigma = check_positive_float(value[1], "psf")
+        truncate = check_positive_float(value[2], "psf") if len(value) == 3 else 4.0
+        return "gaussian", [sigma, truncate], None
+    w = as_array(value, "psf")
+    if w.ndim != 2 or w.size == 0 or w.dtype.kind not in "iuf":
+        raise ValueError(f"psf: expected 'box', ('gaussian', sigma) or a non-empty 2D array of weights, "
+                         f"got {value!r}")
+    w = np.array(w, dtype=np.float64)
+    if not np.all(np.isfinite(w)) or (w < 0).any() or w.sum() <= 0:
+        raise ValueError("psf: expected finite weights >= 0 with a positive sum")
+    return "table", [check_positive_float(step, "psf_step")], w
+
+
 def _depth(value) -> int:
     d = check_positive_int(value, "max_depth")
     if d > MAX_DEPTH:
@@ -598,7 +629,7 @@ class Scene:
         return (self.dem, self.cell_size, self.periodic, self.split, name, params)
 
     def brf(self, sun, view="nadir", spp: int = 65536, max_depth: int = 10, seed: int = 0,
-            n_threads: Optional[int] = None) -> Estimate:
+            n_threads: Optional[int] = None, sky: float = 0.0) -> Estimate:
         """Bidirectional reflectance factor of the whole tile.
 
         ``BRF = pi L / cos(sun zenith)``, with ``L`` the radiance towards
@@ -626,6 +657,14 @@ class Scene:
             for any ``n_threads``.
         n_threads : int, optional
             Threads (default: all cores).
+        sky : float
+            Irradiance of a uniform (isotropic) sky on a horizontal plane,
+            relative to the sun's irradiance normal to the beam (>= 0;
+            default 0: the sun only). With ``sky > 0`` the result is the
+            hemispherical-directional reflectance factor ``pi L / (cos(sun
+            zenith) + sky)``, ``L`` including the sky light scattered up to
+            ``max_depth`` times; a flat Lambertian plane still gives
+            ``rho``.
 
         Returns
         -------
@@ -646,9 +685,63 @@ class Scene:
         for Reflectance*, NBS Monograph 160, 1977 (reflectance factor).
         """
         args = self._args()
+        sky = _sky(sky)
+        if sky > 0.0:
+            v, se, n = _core.radiometry_brf_sky(*args, _direction(sun, "sun"), _direction(view, "view"), sky,
+                                                check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed),
+                                                check_n_threads(n_threads))
+            return Estimate(v, se, n)
         v, se, n = _core.radiometry_brf(*args, _direction(sun, "sun"), _direction(view, "view"),
                                         check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed),
                                         check_n_threads(n_threads))
+        return Estimate(v, se, n)
+
+    def bhr(self, spp: int = 65536, max_depth: int = 100, seed: int = 0,
+            n_threads: Optional[int] = None) -> Estimate:
+        """Bi-hemispherical reflectance (white-sky albedo).
+
+        The fraction of the flux of a uniform sky on the tile's horizontal
+        area that leaves it upwards: ``(2 / pi) * integral of albedo(theta,
+        phi) cos(theta) sin(theta) dtheta dphi`` over the upper hemisphere,
+        ``albedo`` the directional-hemispherical reflectance of ``albedo``.
+        Each path draws its sun direction cosine-weighted (the distribution
+        of a uniform sky's light on a horizontal plane), then follows the
+        light as ``albedo`` does, so one estimate integrates over sun
+        directions and positions at once.
+
+        Parameters
+        ----------
+        spp : int
+            Number of rays (> 0).
+        max_depth : int
+            Largest number of scattering events per ray.
+        seed : int
+            Seed of the counter-based random numbers.
+        n_threads : int, optional
+            Threads (default: all cores); the result does not depend on it.
+
+        Returns
+        -------
+        Estimate
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from fractalgeo_rs.radiometry import Lambertian, Scene
+        >>> s = Scene.from_dem(np.zeros((4, 4)), material=Lambertian(0.35))
+        >>> round(s.bhr(spp=500).value, 9)
+        0.35
+
+        References
+        ----------
+        C. B. Schaaf et al., "First operational BRDF, albedo nadir
+        reflectance products from MODIS", *Remote Sensing of Environment*
+        83, 135-148, 2002, doi:10.1016/S0034-4257(02)00091-3 (white-sky
+        albedo). F. E. Nicodemus et al., NBS Monograph 160, 1977
+        (bi-hemispherical reflectance).
+        """
+        v, se, n = _core.radiometry_bhr(*self._args(), check_positive_int(spp, "spp"), _depth(max_depth),
+                                        _seed(seed), check_n_threads(n_threads))
         return Estimate(v, se, n)
 
     def albedo(self, sun, spp: int = 65536, max_depth: int = 100, seed: int = 0,
@@ -701,7 +794,8 @@ class Scene:
 
     def render(self, sun, view="nadir", shape: Optional[Tuple[int, int]] = None, spp: int = 16,
                max_depth: int = 10, seed: int = 0, n_threads: Optional[int] = None,
-               max_memory=None, progress: Optional[bool] = None) -> np.ndarray:
+               max_memory=None, progress: Optional[bool] = None, sky: float = 0.0, psf="box",
+               psf_step: float = 1.0) -> np.ndarray:
         """Radiance image seen by an orthographic sensor.
 
         The tile's horizontal extent is divided into ``shape`` pixels; pixel
@@ -733,6 +827,25 @@ class Scene:
         progress : bool, optional
             A progress bar over the image rows on stderr (needs tqdm); the
             image does not depend on it.
+        sky : float
+            Irradiance of a uniform sky on a horizontal plane relative to
+            the sun's irradiance normal to the beam (>= 0, default 0). A
+            flat Lambertian plane then has ``L = rho (cos(sun zenith) + sky)
+            / pi``.
+        psf : "box", ("gaussian", sigma[, truncate]) or array_like
+            The sensor's point-spread function, over the reference plane
+            around the pixel's centre, in image pixels: ``"box"`` (uniform
+            over the pixel, the default); an isotropic Gaussian of standard
+            deviation ``sigma`` pixels truncated to the disc of radius
+            ``truncate * sigma`` (default ``truncate=4``); or a 2D array of
+            non-negative weights, piecewise constant on cells ``psf_step``
+            pixels wide centred on the pixel's centre (row 0 north). Each
+            path's footprint point is drawn from the PSF, so a pixel
+            estimates exactly the PSF-weighted mean radiance (footprints
+            may overlap neighbouring pixels; outside a finite patch nothing
+            is seen).
+        psf_step : float
+            Cell size of an array ``psf``, pixels (> 0).
 
         Returns
         -------
@@ -763,10 +876,17 @@ class Scene:
         check_memory(rows * cols * 4, "shape", max_memory=max_memory, what=f"a {rows} x {cols} float32 image")
         from fractalgeo_rs import _progress
 
-        args = (*self._args(), _direction(sun, "sun"), _direction(view, "view"), (rows, cols),
-                check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed), check_n_threads(n_threads))
+        sky = _sky(sky)
+        kind, pparams, table = _psf(psf, psf_step)
+        sd = (_direction(sun, "sun"), _direction(view, "view"))
+        rest = (check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed))
+        nt = check_n_threads(n_threads)
         with _progress.Steps(rows, "render", _progress.resolve(progress)) as steps:
-            return steps.counted(lambda counter: _core.radiometry_render(*args, progress=counter), rows)
+            if sky == 0.0 and kind == "box":
+                return steps.counted(lambda counter: _core.radiometry_render(
+                    *self._args(), *sd, (rows, cols), *rest, nt, progress=counter), rows)
+            return steps.counted(lambda counter: _core.radiometry_render_psf(
+                *self._args(), *sd, sky, (rows, cols), *rest, kind, pparams, table, nt, progress=counter), rows)
 
     def brf_sweep(self, sun_zenith=PAPER_SUN_ZENITHS, view_zenith=(0.0,), sun_azimuth: float = 0.0,
                   view_azimuth: float = 0.0, spp: int = 65536, max_depth: int = 10, seed: int = 0,
