@@ -37,7 +37,7 @@ from fractalgeo_rs.radiometry import PAPER_SUN_ZENITHS, Lambertian, Scene, plot_
 t0 = time.perf_counter()
 N, H, SIGMA, RHO = 32, 0.7, 0.5, 0.5
 SUN_AZ = 90.0  # sun in the east
-SPP = 16384
+SPP = 65536
 z = fg.fbm_surface((N, N), H, method="spectral", periodic=True, seed=1, sigma=SIGMA)
 scene = Scene.from_dem(z, material=Lambertian(RHO))
 
@@ -50,7 +50,7 @@ scene = Scene.from_dem(z, material=Lambertian(RHO))
 # surface.
 fig = plt.figure(figsize=(12, 5.6))
 axes = [fig.add_subplot(2, 4, k + 1) for k in range(7)]
-plot_incidence_series(scene, sun_zenith=PAPER_SUN_ZENITHS, sun_azimuth=SUN_AZ, shape=(128, 128), spp=4,
+plot_incidence_series(scene, sun_zenith=PAPER_SUN_ZENITHS, sun_azimuth=SUN_AZ, shape=(128, 128), spp=8,
                       axes=axes)
 ax3 = fig.add_subplot(2, 4, 8, projection="3d")
 img = scene.render(sun=(SUN_AZ, 45.0), shape=(N, N), spp=64)
@@ -58,7 +58,7 @@ zc = np.pad(z, ((0, 1), (0, 1)), mode="wrap")  # the tile's 33 x 33 corners
 cols = plt.cm.gray(np.pad(img, ((0, 1), (0, 1)), mode="wrap") / img.max())
 y, x = np.mgrid[0:N + 1, 0:N + 1]
 ax3.plot_surface(x, -y, zc, facecolors=cols, rstride=1, cstride=1, linewidth=0, shade=False)
-ax3.set_box_aspect((1, 1, 0.35))
+ax3.set_box_aspect((1, 1, 0.35), zoom=1.5)
 ax3.view_init(elev=35, azim=-60)
 ax3.set_axis_off()
 ax3.set_title("3D, sun zenith 45", fontsize=9)

@@ -799,9 +799,10 @@ class Scene:
         """Radiance image seen by an orthographic sensor.
 
         The tile's horizontal extent is divided into ``shape`` pixels; pixel
-        ``(i, j)`` (row 0 north) averages ``spp`` paths through uniform
-        points of its box footprint on the reference plane (the DEM's mean
-        height), traced as in ``brf``. Values are radiances for unit sun
+        ``(i, j)`` (row 0 north) averages ``spp`` paths through points of
+        the reference plane (the DEM's mean height) drawn from its
+        point-spread function ``psf`` (default: uniform over its box
+        footprint), traced as in ``brf``. Values are radiances for unit sun
         irradiance normal to the beam: ``pi * image.mean() / cos(sun
         zenith)`` estimates the BRF.
 
