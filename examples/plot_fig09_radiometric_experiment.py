@@ -10,8 +10,9 @@ example repeats the experiment with :mod:`fractalgeo_rs.radiometry`:
 
 1. a periodic 32 x 32 fBm tile (``H = 0.7``), Lambertian facets
    (``rho = 0.5``), nadir sensor, sun in the east at zenith 0, 15, ..., 75
-   and 89 degrees: the images of figure 9 and a perspective view (the last
-   scene of the figure), drawn with matplotlib from a rendered image;
+   and 89 degrees: the images of figure 9 and a perspective view of the
+   (infinite, periodic) surface, the last scene of the figure
+   (:meth:`~fractalgeo_rs.radiometry.Scene.render_perspective`);
 2. the BRF of the same tile and of the tile after
    :func:`~fractalgeo_rs.fractal_resample` x2 and x4 (fBm detail added
    below the cell: steeper facets, more shadow);
@@ -46,22 +47,20 @@ scene = Scene.from_dem(z, material=Lambertian(RHO))
 # ----------------------------------------------------------------------
 # Radiance images (unit sun irradiance normal to the beam) on one grey
 # scale: the tile darkens as ``cos(zenith)`` and the shadows lengthen
-# towards the west. The last panel drapes the image for zenith 45 over the
-# surface.
+# towards the west. The last panel is a pinhole camera's view from the
+# south-south-west, 55 degrees from the zenith, of the tile repeated
+# without end.
 fig = plt.figure(figsize=(12, 5.6))
 axes = [fig.add_subplot(2, 4, k + 1) for k in range(7)]
 plot_incidence_series(scene, sun_zenith=PAPER_SUN_ZENITHS, sun_azimuth=SUN_AZ, shape=(128, 128), spp=8,
                       axes=axes)
-ax3 = fig.add_subplot(2, 4, 8, projection="3d")
-img = scene.render(sun=(SUN_AZ, 45.0), shape=(N, N), spp=64)
-zc = np.pad(z, ((0, 1), (0, 1)), mode="wrap")  # the tile's 33 x 33 corners
-cols = plt.cm.gray(np.pad(img, ((0, 1), (0, 1)), mode="wrap") / img.max())
-y, x = np.mgrid[0:N + 1, 0:N + 1]
-ax3.plot_surface(x, -y, zc, facecolors=cols, rstride=1, cstride=1, linewidth=0, shade=False)
-ax3.set_box_aspect((1, 1, 0.35), zoom=1.5)
-ax3.view_init(elev=35, azim=-60)
-ax3.set_axis_off()
-ax3.set_title("3D, sun zenith 45", fontsize=9)
+ax3 = fig.add_subplot(2, 4, 8)
+persp = scene.render_perspective(sun=(SUN_AZ, 45.0), view=(200.0, 55.0), distance=40.0, fov=50.0,
+                                 shape=(150, 150), spp=16)
+ax3.imshow(persp, cmap="gray", vmin=0.0)
+ax3.set_title("3D view, sun zenith 45", fontsize=9)
+ax3.set_xticks([])
+ax3.set_yticks([])
 fig.tight_layout()
 
 # %%

@@ -248,3 +248,91 @@ def test_plot_incidence_series_data(plt):
         plot_incidence_series(np.zeros((4, 4)))
     with pytest.raises(ValueError, match="axes"):
         plot_incidence_series(scene, sun_zenith=[0, 45], spp=1, axes=[axes[0]])
+
+
+# ---- the full Oren-Nayar model ----
+
+def _oren_nayar_full(rho, sigma, ti, to, dphi):
+    """Oren & Nayar (1994), equations 27-29 and the interreflection term
+    (section 4.4), transcribed from the paper in angles: the BRDF
+    ``(L1 + L2) / (E0 cos(theta_i))``."""
+    s2 = sigma ** 2
+    alpha, beta = max(ti, to), min(ti, to)
+    cd = math.cos(dphi)
+    c1 = 1 - 0.5 * s2 / (s2 + 0.33)
+    if cd >= 0:
+        c2 = 0.45 * s2 / (s2 + 0.09) * math.sin(alpha)
+    else:
+        c2 = 0.45 * s2 / (s2 + 0.09) * (math.sin(alpha) - (2 * beta / math.pi) ** 3)
+    c3 = 0.125 * (s2 / (s2 + 0.09)) * (4 * alpha * beta / math.pi ** 2) ** 2
+    l1 = rho / math.pi * (c1 + cd * c2 * math.tan(beta) + (1 - abs(cd)) * c3 * math.tan((alpha + beta) / 2))
+    l2 = 0.17 * rho ** 2 / math.pi * s2 / (s2 + 0.13) * (1 - cd * (2 * beta / math.pi) ** 2)
+    return l1 + l2
+
+
+@pytest.mark.parametrize("rho,sigma", [(0.5, 0.3), (0.9, 0.8), (0.3, 1.5)])
+def test_full_oren_nayar_matches_the_paper(rho, sigma):
+    # a flat plane, single scattering: BRF = pi f(sun, view) exactly
+    from fractalgeo_rs.radiometry import OrenNayar
+
+    s = Scene.from_dem(np.zeros((4, 4)), material=OrenNayar(rho, sigma, full=True))
+    q = Scene.from_dem(np.zeros((4, 4)), material=OrenNayar(rho, sigma))
+    for (az_s, zs), (az_v, zv) in [((0.0, 30.0), (0.0, 60.0)), ((0.0, 30.0), (180.0, 60.0)),
+                                   ((40.0, 70.0), (130.0, 20.0)), ((10.0, 80.0), (300.0, 75.0)),
+                                   ((0.0, 45.0), (0.0, 0.0)), ((200.0, 15.0), (90.0, 85.0))]:
+        got = s.brf(sun=(az_s, zs), view=(az_v, zv), spp=64, max_depth=1).value
+        want = math.pi * _oren_nayar_full(rho, sigma, math.radians(zs), math.radians(zv), math.radians(az_v - az_s))
+        assert abs(got - want) <= 1e-12 * want, (got, want)
+        assert abs(q.brf(sun=(az_s, zs), view=(az_v, zv), spp=64, max_depth=1).value - got) > 1e-4  # not the qualitative one
+
+
+def test_full_oren_nayar_energy_and_input():
+    from fractalgeo_rs.radiometry import OrenNayar
+
+    with pytest.raises(ValueError, match="rho"):
+        Scene.from_dem(np.zeros((4, 4)), material=OrenNayar(1.0, 0.3, full=True)).brf(sun=(0.0, 30.0), spp=10)
+    with pytest.raises(TypeError, match="full"):
+        OrenNayar(0.5, 0.3, full="yes")
+    # a bright accepted surface: albedo of a flat plane (the model's own) at most 1
+    s = Scene.from_dem(np.zeros((4, 4)), material=OrenNayar(0.9, 0.5, full=True))
+    for zen in (0.0, 60.0, 85.0):
+        assert s.albedo(sun=(0.0, zen), spp=20000).value <= 1.0
+
+
+# ---- the perspective camera ----
+
+def test_perspective_flat_plane_horizon_and_sky():
+    rho, sky = 0.4, 0.3
+    s = Scene.from_dem(np.zeros((5, 5)), material=Lambertian(rho))
+    # horizontal view from 2 m: sky above the middle of the image, the lit plane below
+    img = s.render_perspective(sun=(45.0, 30.0), eye=(1.0, -1.0, 2.0), target=(1.0, 50.0, 2.0), fov=60.0,
+                               shape=(8, 6), spp=4, sky=sky)
+    ground = rho * (math.cos(math.radians(30.0)) + sky) / math.pi
+    assert np.allclose(img[:4], sky / math.pi, rtol=1e-6) and np.allclose(img[4:], ground, rtol=1e-6)
+    a = s.render_perspective(sun=(45.0, 30.0), shape=(6, 8), spp=2, n_threads=1)
+    assert np.array_equal(a, s.render_perspective(sun=(45.0, 30.0), shape=(6, 8), spp=2, n_threads=2))
+
+
+def test_perspective_sees_the_same_surface_as_the_orthographic_sensor():
+    # a camera far away with a narrow field of view looking straight down sees
+    # the tile almost orthographically: the image means agree within noise
+    scene = Scene.from_dem(_rough(16, amp=1.0), material=Lambertian(0.5))
+    d = 4000.0
+    fov = 2 * math.degrees(math.atan(8.0 / d))  # 16 m wide at the target
+    img = scene.render_perspective(sun=(90.0, 40.0), view=(0.0, 0.0), distance=d, fov=fov, shape=(32, 32),
+                                   spp=64, max_depth=1)
+    ortho = scene.render(sun=(90.0, 40.0), shape=(32, 32), spp=64, max_depth=1)
+    assert abs(img.mean() - ortho.mean()) < 0.01 * ortho.mean()
+    assert np.corrcoef(img.ravel(), ortho.ravel())[0, 1] > 0.9
+
+
+def test_perspective_bad_input():
+    s = Scene.from_dem(np.zeros((4, 4)))
+    with pytest.raises(ValueError, match="fov"):
+        s.render_perspective(sun=(0.0, 30.0), fov=180.0)
+    with pytest.raises(ValueError, match="target"):
+        s.render_perspective(sun=(0.0, 30.0), eye=(1.0, 1.0, 1.0), target=(1.0, 1.0, 1.0))
+    with pytest.raises(TypeError, match="eye"):
+        s.render_perspective(sun=(0.0, 30.0), eye=(1.0, 2.0))
+    with pytest.raises(ValueError, match="distance"):
+        s.render_perspective(sun=(0.0, 30.0), distance=-1.0)

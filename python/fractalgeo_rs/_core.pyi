@@ -80,6 +80,7 @@ __all__ = [
     "radiometry_bhr",
     "radiometry_brf_sky",
     "radiometry_render_psf",
+    "radiometry_render_perspective",
 ]
 
 # ---- geometry ----
@@ -630,6 +631,25 @@ def radiometry_bhr(
     seed: int,
     n_threads: Optional[int] = None,
 ) -> Tuple[float, float, int]: ...
+def radiometry_render_perspective(
+    dem: npt.NDArray[np.float64],
+    cell_size: Tuple[float, float],
+    periodic: bool,
+    split: str,
+    material: str,
+    params: Sequence[float],
+    sun: Tuple[float, float],
+    sky: float,
+    eye: Tuple[float, float, float],
+    target: Tuple[float, float, float],
+    fov: float,
+    shape: Tuple[int, int],
+    spp: int,
+    max_depth: int,
+    seed: int,
+    n_threads: Optional[int] = None,
+    progress: Optional[ProgressCounter] = None,
+) -> npt.NDArray[np.float32]: ...
 def radiometry_render_psf(
     dem: npt.NDArray[np.float64],
     cell_size: Tuple[float, float],

@@ -5,7 +5,7 @@
 use super::convert::{array2, c_order, run};
 use super::progress::{counter, ProgressCounter};
 use crate::error::{CoreError, CoreResult};
-use crate::radiometry::integrator::Psf;
+use crate::radiometry::integrator::{Pinhole, Psf};
 use crate::radiometry::{direction, material, Heightfield, Scene, Split};
 use numpy::{PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -305,6 +305,59 @@ fn radiometry_render_psf<'py>(
     array2(py, shape, img)
 }
 
+/// A float32 radiance image seen by a pinhole camera at `eye` looking at
+/// `target` (scene coordinates: x east, y north, z up) with the vertical
+/// field of view `fov` degrees.
+#[pyfunction]
+#[pyo3(signature = (dem, cell_size, periodic, split, material, params, sun, sky, eye, target, fov, shape, spp, max_depth, seed, n_threads=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+fn radiometry_render_perspective<'py>(
+    py: Python<'py>,
+    dem: PyReadonlyArray2<'py, f64>,
+    cell_size: (f64, f64),
+    periodic: bool,
+    split: &str,
+    material: &str,
+    params: Vec<f64>,
+    sun: (f64, f64),
+    sky: f64,
+    eye: (f64, f64, f64),
+    target: (f64, f64, f64),
+    fov: f64,
+    shape: (usize, usize),
+    spp: u64,
+    max_depth: u32,
+    seed: u64,
+    n_threads: Option<usize>,
+    progress: Option<&Bound<'py, ProgressCounter>>,
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let z = c_order(&dem);
+    let pr = counter(progress);
+    let img = run(py, n_threads, || {
+        let cam = Pinhole::new(eye.into(), target.into(), fov)?;
+        let s = build(
+            &z.data,
+            z.rows_cols(),
+            cell_size,
+            periodic,
+            split,
+            material,
+            &params,
+        )?;
+        s.render_perspective(
+            direction(sun, "sun")?,
+            sky,
+            &cam,
+            shape,
+            spp,
+            max_depth,
+            seed,
+            pr.as_deref(),
+        )
+    })?;
+    array2(py, shape, img)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(radiometry_albedo, m)?)?;
     m.add_function(wrap_pyfunction!(radiometry_brf, m)?)?;
@@ -312,5 +365,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(radiometry_bhr, m)?)?;
     m.add_function(wrap_pyfunction!(radiometry_brf_sky, m)?)?;
     m.add_function(wrap_pyfunction!(radiometry_render_psf, m)?)?;
+    m.add_function(wrap_pyfunction!(radiometry_render_perspective, m)?)?;
     Ok(())
 }

@@ -740,3 +740,149 @@ fn check_sky(sky: f64) -> CoreResult<()> {
     }
     Ok(())
 }
+
+// ---- A perspective (pinhole) camera for 3D views.
+
+const TAG_PERSPECTIVE: u64 = 0x7073_7000_0000_0000;
+
+/// A pinhole camera at `eye` looking at `target`, world up `+z`.
+#[derive(Debug, Clone, Copy)]
+pub struct Pinhole {
+    eye: DVec3,
+    fwd: DVec3,
+    right: DVec3,
+    up: DVec3,
+    /// tan(vertical field of view / 2).
+    tan_half: f64,
+}
+
+impl Pinhole {
+    /// A camera at `eye` looking at `target` with the vertical field of
+    /// view `fov_deg` degrees in (0, 180); image rows go down, columns right.
+    pub fn new(eye: DVec3, target: DVec3, fov_deg: f64) -> CoreResult<Pinhole> {
+        if !(eye.is_finite() && target.is_finite()) {
+            return Err(CoreError::invalid(
+                "eye",
+                "expected finite camera and target positions",
+            ));
+        }
+        let f = target - eye;
+        if f.length() <= 0.0 {
+            return Err(CoreError::invalid(
+                "target",
+                "expected a target distinct from the camera position",
+            ));
+        }
+        if !(fov_deg.is_finite() && fov_deg > 0.0 && fov_deg < 180.0) {
+            return Err(CoreError::invalid(
+                "fov",
+                format!("expected a field of view in (0, 180) degrees, got {fov_deg}"),
+            ));
+        }
+        let fwd = f.normalize();
+        let r = fwd.cross(DVec3::Z);
+        let right = if r.length() > 1e-12 {
+            r.normalize()
+        } else {
+            DVec3::X // looking straight down or up: east to the right
+        };
+        let up = right.cross(fwd);
+        Ok(Pinhole {
+            eye,
+            fwd,
+            right,
+            up,
+            tan_half: (0.5 * fov_deg.to_radians()).tan(),
+        })
+    }
+
+    /// The unit direction through the image point `(row, col)` (fractional
+    /// pixels from the top-left corner) of a `rows x cols` image.
+    #[inline]
+    pub fn ray(&self, row: f64, col: f64, (rows, cols): (usize, usize)) -> DVec3 {
+        let aspect = cols as f64 / rows as f64;
+        let sx = (2.0 * col / cols as f64 - 1.0) * self.tan_half * aspect;
+        let sy = (1.0 - 2.0 * row / rows as f64) * self.tan_half;
+        (self.fwd + sx * self.right + sy * self.up).normalize()
+    }
+}
+
+impl Scene {
+    /// A `rows x cols` radiance image seen by the pinhole camera `cam`
+    /// (box pixels, `spp` paths each), the sun towards `sun` and an
+    /// isotropic sky of horizontal irradiance `sky`. Rays that miss the
+    /// surface see the sky radiance `sky / pi` above the horizon and 0
+    /// below it.
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_perspective(
+        &self,
+        sun: DVec3,
+        sky: f64,
+        cam: &Pinhole,
+        shape: (usize, usize),
+        spp: u64,
+        max_depth: u32,
+        seed: u64,
+        progress: Option<&crate::progress::Progress>,
+    ) -> CoreResult<Vec<f32>> {
+        check_spp(spp)?;
+        check_depth(max_depth)?;
+        check_sky(sky)?;
+        let (rows, cols) = shape;
+        if rows == 0 || cols == 0 {
+            return Err(CoreError::invalid(
+                "shape",
+                format!("expected a positive number of rows and columns, got ({rows}, {cols})"),
+            ));
+        }
+        let npix = rows as u128 * cols as u128;
+        if npix > MAX_PIXELS as u128 {
+            return Err(CoreError::OutOfMemory {
+                param: "shape".into(),
+                bytes: npix * 4,
+            });
+        }
+        let mut img: Vec<f32> = crate::buffers::try_filled(rows * cols, 0.0f32, "shape")?;
+        if let Some(p) = progress {
+            p.add_total(rows as u64);
+        }
+        let hf = &self.hf;
+        let top = hf.zmax + 1e-6 * (1.0 + hf.zmax.abs());
+        let sky_l = sky / PI;
+        img.par_chunks_mut(cols).enumerate().for_each(|(i, line)| {
+            for (j, px) in line.iter_mut().enumerate() {
+                let pixel = (i * cols + j) as u64;
+                let mut s = 0.0;
+                for k in 0..spp {
+                    let key = StreamKey::new(
+                        seed,
+                        TAG_PERSPECTIVE ^ pixel.wrapping_mul(spp).wrapping_add(k),
+                    );
+                    let d = cam.ray(i as f64 + key.uniform(1), j as f64 + key.uniform(0), shape);
+                    // start on the plane just above the highest facet
+                    let o = if cam.eye.z > top {
+                        if d.z < 0.0 {
+                            Some(cam.eye + ((cam.eye.z - top) / -d.z) * d)
+                        } else {
+                            None
+                        }
+                    } else {
+                        Some(cam.eye)
+                    };
+                    s += match o {
+                        Some(o) if hf.intersect(o, d, None).is_some() => {
+                            self.radiance_sky(o, -d, sun, sky_l, max_depth, key, 2)
+                        }
+                        _ if d.z > 0.0 => sky_l,
+                        _ => 0.0,
+                    };
+                }
+                *px = (s / spp as f64) as f32;
+            }
+            if let Some(p) = progress {
+                p.tick(1);
+            }
+        });
+        Ok(img)
+    }
+}

@@ -894,3 +894,78 @@ fn psf_positions_follow_their_distributions() {
     assert!(Psf::table(&[1.0, -1.0], 1, 2, 1.0).is_err());
     assert!(Psf::gaussian(0.0, 3.0).is_err());
 }
+
+// ---- full Oren-Nayar and the perspective camera ----
+
+#[test]
+fn full_oren_nayar_is_reciprocal_bounded_and_its_sampler_fits() {
+    let m = material::from_name("oren-nayar-full", &[0.8, 0.4]).unwrap();
+    let key = StreamKey::new(5, 1);
+    for i in 0..2000u64 {
+        let a = super::material::cosine_hemisphere([key.uniform(4 * i), key.uniform(4 * i + 1)]);
+        let b =
+            super::material::cosine_hemisphere([key.uniform(4 * i + 2), key.uniform(4 * i + 3)]);
+        let (f1, f2) = (m.eval(a, b), m.eval(b, a));
+        assert!(
+            f1 >= 0.0 && (f1 - f2).abs() <= 1e-12 * f1.max(1e-300),
+            "{f1} {f2}"
+        );
+    }
+    // sigma = 0 is Lambertian
+    let l = material::from_name("oren-nayar-full", &[0.6, 0.0]).unwrap();
+    let (a, b) = (local(20.0, 10.0), local(70.0, 250.0));
+    assert!((l.eval(a, b) - 0.6 / std::f64::consts::PI).abs() < 1e-15);
+    // energy: rho = 1 and small sigma reflects more than the incident light at grazing
+    let e = material::from_name("oren-nayar-full", &[1.0, 0.3])
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("rho: "), "{e}");
+    let wo = local(50.0, 30.0);
+    let (bins, n) = (20usize, 200_000u64);
+    let mut count = vec![0u64; bins];
+    let (mut s1, mut s2) = (0.0, 0.0);
+    for i in 0..n {
+        let s = m
+            .sample(wo, [key.uniform(2 * i), key.uniform(2 * i + 1)])
+            .unwrap();
+        assert!((s.pdf - m.pdf(s.wi, wo)).abs() < 1e-15);
+        let want = m.eval(s.wi, wo) * s.wi.z / s.pdf;
+        assert!((s.weight - want).abs() <= 1e-12 * want.max(1.0));
+        s1 += s.weight;
+        s2 += s.weight * s.weight;
+        count[((s.wi.z * s.wi.z * bins as f64) as usize).min(bins - 1)] += 1;
+    }
+    let ex = n as f64 / bins as f64;
+    let chi2: f64 = count.iter().map(|&c| (c as f64 - ex).powi(2) / ex).sum();
+    assert!(chi2 < 43.8, "{chi2}"); // 19 dof, p = 0.001
+    let mean = s1 / n as f64;
+    let se = ((s2 / n as f64 - mean * mean) / n as f64).sqrt();
+    assert!(
+        (mean - m.albedo(wo)).abs() < 4.0 * se + 1e-4,
+        "{mean} +- {se}"
+    );
+}
+
+#[test]
+fn perspective_camera_over_a_flat_plane() {
+    use super::integrator::Pinhole;
+    let z = vec![0.0; 16];
+    let rho = 0.5;
+    let s = scene(&z, 4, 4, true, "lambertian", &[rho]);
+    let sun = dir(10.0, 60.0);
+    let sky = 0.4;
+    // looking horizontally from 3 m: the top half of the image is sky, the
+    // bottom half the lit plane, the horizon between the two middle rows
+    let cam = Pinhole::new(DVec3::new(1.0, -1.0, 3.0), DVec3::new(1.0, 10.0, 3.0), 50.0).unwrap();
+    let img = s
+        .render_perspective(sun, sky, &cam, (6, 5), 8, 4, 1, None)
+        .unwrap();
+    let ground = rho * (sun.z + sky) / std::f64::consts::PI;
+    let air = sky / std::f64::consts::PI;
+    for (k, v) in img.iter().enumerate() {
+        let want = if k / 5 < 3 { air } else { ground };
+        assert!((*v as f64 - want).abs() < 1e-6, "{k}: {v} vs {want}");
+    }
+    assert!(Pinhole::new(DVec3::ZERO, DVec3::ZERO, 40.0).is_err());
+    assert!(Pinhole::new(DVec3::ZERO, DVec3::Z, 180.0).is_err());
+}
