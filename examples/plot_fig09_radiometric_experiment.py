@@ -6,13 +6,13 @@ Section 4.1 of the seed paper images "an area of 32 x 32 microfacets ...
 from a nadir placed sensor with variable incident illumination" (figure 9),
 computes albedo and BRF from the images, and notes that "after a fractal
 resampling the local roughness increases and the BRF is modified". This
-example repeats the experiment with :mod:`fractalgeo_rs.radiometry`:
+example repeats the experiment with ``fractalgeo_rs.radiometry``:
 
 1. a periodic 32 x 32 fBm tile (``H = 0.7``), Lambertian facets
    (``rho = 0.5``), nadir sensor, sun in the east at zenith 0, 15, ..., 75
    and 89 degrees: the images of figure 9 and a perspective view of the
    (infinite, periodic) surface, the last scene of the figure
-   (:meth:`~fractalgeo_rs.radiometry.Scene.render_perspective`);
+   (``Scene.render_perspective``);
 2. the BRF of the same tile and of the tile after
    :func:`~fractalgeo_rs.fractal_resample` x2 and x4 (fBm detail added
    below the cell: steeper facets, more shadow);

@@ -95,6 +95,14 @@ def test_v_groove_sky_view_factor(sun):
         sun=sun, spp=3000, max_depth=1, seed=3)
 
 
+def test_brf_sweep_with_sky_is_brf_with_sky():
+    scene = Scene.from_dem(_rough(8), material=Lambertian(0.5))
+    sw = scene.brf_sweep(sun_zenith=[10, 50], view_zenith=[0, 30], sun_azimuth=45.0, spp=2000, sky=0.5)
+    for i, zs in enumerate((10, 50)):
+        for j, zv in enumerate((0, 30)):
+            assert sw.value[i, j] == scene.brf(sun=(45.0, zs), view=(0.0, zv), spp=2000, sky=0.5).value
+
+
 def test_sky_bad_input():
     s = Scene.from_dem(np.zeros((4, 4)))
     for bad in (-0.1, float("nan"), float("inf")):

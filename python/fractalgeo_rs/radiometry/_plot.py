@@ -51,13 +51,13 @@ def plot_brf_principal_plane(scene: Scene, sun, view_zenith: Sequence[float] = t
     view_zenith : sequence of float
         Signed view zeniths, degrees in (-90, 90).
     spp, max_depth, seed, n_threads
-        As in :meth:`Scene.brf` (one call per view zenith, same seed).
+        As in ``Scene.brf`` (one call per view zenith, same seed).
     ax : matplotlib.axes.Axes, optional
         Axes to draw into; a new figure when omitted.
     label : str, optional
         Legend label of the curve.
     **kwargs
-        Passed to :meth:`Scene.brf` (e.g. ``sky``).
+        Passed to ``Scene.brf`` (e.g. ``sky``).
 
     Returns
     -------
@@ -126,13 +126,13 @@ def plot_brf_polar(scene: Scene, sun, view_zenith: Sequence[float] = tuple(range
     view_azimuth : sequence of float
         View azimuths, degrees clockwise from north, increasing.
     spp, max_depth, seed, n_threads
-        As in :meth:`Scene.brf` (one call per direction, same seed).
+        As in ``Scene.brf`` (one call per direction, same seed).
     ax : matplotlib.axes.Axes, optional
         Polar axes to draw into; new ones when omitted.
     cmap : str
         Colour map.
     **kwargs
-        Passed to :meth:`Scene.brf` (e.g. ``sky``).
+        Passed to ``Scene.brf`` (e.g. ``sky``).
 
     Returns
     -------
@@ -210,13 +210,13 @@ def plot_incidence_series(scene: Scene, sun_zenith: Sequence[float] = PAPER_SUN_
     sun_azimuth : float
         Sun azimuth, degrees clockwise from north (default east).
     view, shape, spp, max_depth, seed, n_threads
-        As in :meth:`Scene.render`.
+        As in ``Scene.render``.
     axes : sequence of matplotlib.axes.Axes, optional
         One axes per sun zenith; a new row of axes when omitted.
     white : float, optional
         Radiance shown as white; default the largest pixel of the series.
     **kwargs
-        Passed to :meth:`Scene.render` (e.g. ``sky``, ``psf``).
+        Passed to ``Scene.render`` (e.g. ``sky``, ``psf``).
 
     Returns
     -------

@@ -1010,7 +1010,7 @@ class Scene:
 
     def brf_sweep(self, sun_zenith=PAPER_SUN_ZENITHS, view_zenith=(0.0,), sun_azimuth: float = 0.0,
                   view_azimuth: float = 0.0, spp: int = 65536, max_depth: int = 10, seed: int = 0,
-                  n_threads: Optional[int] = None, progress: Optional[bool] = None) -> BrfSweep:
+                  n_threads: Optional[int] = None, progress: Optional[bool] = None, sky: float = 0.0) -> BrfSweep:
         """BRF over every pair of sun and view zenith angles.
 
         One ``brf`` per pair (each with the same ``seed``: common random
@@ -1032,6 +1032,9 @@ class Scene:
             As in ``brf``.
         progress : bool, optional
             A progress bar over the angle pairs on stderr (needs tqdm).
+        sky : float
+            Horizontal irradiance of a uniform sky, as in ``brf`` (the
+            values are then HDRFs).
 
         Returns
         -------
@@ -1058,14 +1061,19 @@ class Scene:
         az_v = _azimuth(view_azimuth, "view_azimuth")
         spp = check_positive_int(spp, "spp")
         depth, seed, n_threads = _depth(max_depth), _seed(seed), check_n_threads(n_threads)
+        sky = _sky(sky)
         value = np.empty((suns.size, views.size))
         se = np.empty_like(value)
         args = self._args()
         with _progress.bar(suns.size * views.size, "brf", _progress.resolve(progress)) as bar:
             for i, zs in enumerate(suns):
                 for j, zv in enumerate(views):
-                    value[i, j], se[i, j], _ = _core.radiometry_brf(
-                        *args, (az_s, float(zs)), (az_v, float(zv)), spp, depth, seed, n_threads)
+                    if sky > 0.0:
+                        value[i, j], se[i, j], _ = _core.radiometry_brf_sky(
+                            *args, (az_s, float(zs)), (az_v, float(zv)), sky, spp, depth, seed, n_threads)
+                    else:
+                        value[i, j], se[i, j], _ = _core.radiometry_brf(
+                            *args, (az_s, float(zs)), (az_v, float(zv)), spp, depth, seed, n_threads)
                     bar.update(1)
         return BrfSweep(suns, views, az_s, az_v, value, se, spp)
 
