@@ -1,6 +1,6 @@
 """
 The virtual radiometric experiment (figures 8 and 9)
-=====================================================
+====================================================
 
 Section 4.1 of the seed paper images "an area of 32 x 32 microfacets ...
 from a nadir placed sensor with variable incident illumination" (figure 9),
@@ -65,7 +65,7 @@ fig.tight_layout()
 
 # %%
 # Albedo and BRF; fractal resampling makes the surface rougher
-# -----------------------------------------------------------
+# ------------------------------------------------------------
 # ``fractal_resample`` is not periodic, so the tile is padded by wrapping,
 # resampled (fBm continuation with the tile's ``H`` and ``sigma``) and the
 # middle cropped: the coarse samples are kept exactly and the new detail
