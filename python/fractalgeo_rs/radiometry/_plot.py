@@ -4,14 +4,26 @@ the polar BRF over the view hemisphere and the incidence series of images
 "fractalgeo_rs[plot]"``) and imported when a function is called."""
 from __future__ import annotations
 
+import math
 from typing import Optional, Sequence
 
 import numpy as np
 
 from fractalgeo_rs._backend import require
-from fractalgeo_rs.radiometry._scene import PAPER_SUN_ZENITHS, Scene, _direction
+from fractalgeo_rs.radiometry._scene import PAPER_SUN_ZENITHS, Scene
 
 __all__ = ["plot_brf_polar", "plot_brf_principal_plane", "plot_incidence_series"]
+
+
+def _sun(value):
+    """``(azimuth, zenith)`` in degrees, zenith in [0, 90) (as ``Scene.brf`` checks it)."""
+    try:
+        az, zen = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise TypeError(f"sun: expected (azimuth, zenith) in degrees, got {value!r}") from None
+    if not (math.isfinite(az) and math.isfinite(zen) and 0.0 <= zen < 90.0):
+        raise ValueError(f"sun: expected a finite azimuth and a zenith in [0, 90) degrees, got {value!r}")
+    return az, zen
 
 
 def _check_scene(scene) -> None:
@@ -85,7 +97,7 @@ def plot_brf_principal_plane(scene: Scene, sun, view_zenith: Sequence[float] = t
     """
     plt = require("matplotlib.pyplot")
     _check_scene(scene)
-    az_s, zen_s = _direction(sun, "sun")
+    az_s, zen_s = _sun(sun)
     vz = _zeniths(view_zenith, "view_zenith", signed=True)
     val = np.empty(vz.size)
     se = np.empty(vz.size)
@@ -159,7 +171,7 @@ def plot_brf_polar(scene: Scene, sun, view_zenith: Sequence[float] = tuple(range
     """
     plt = require("matplotlib.pyplot")
     _check_scene(scene)
-    az_s, zen_s = _direction(sun, "sun")
+    az_s, zen_s = _sun(sun)
     vz = _zeniths(view_zenith, "view_zenith", signed=False)
     try:
         va = np.atleast_1d(np.asarray(view_azimuth, dtype=np.float64))
