@@ -139,6 +139,16 @@ CASES = {
         a, (1.0, 2.0), False, "ne-sw", "lambertian", [0.5], (30.0, 40.0), 500, 3, 1)),
     "radiometry_render": (IMG[:9, :7], lambda a: _core.radiometry_render(
         a, (1.0, 2.0), False, "nw-se", "lambertian", [0.5], (30.0, 40.0), (0.0, 0.0), (5, 4), 4, 3, 1)),
+    "radiometry_brf_sky": (IMG[:9, :7], lambda a: _core.radiometry_brf_sky(
+        a, (1.0, 2.0), False, "ne-sw", "lambertian", [0.5], (30.0, 40.0), (200.0, 20.0), 0.4, 500, 3, 1)),
+    "radiometry_bhr": (IMG[:9, :7], lambda a: _core.radiometry_bhr(
+        a, (1.0, 2.0), False, "ne-sw", "lambertian", [0.5], 500, 3, 1)),
+    "radiometry_render_perspective": (IMG[:9, :7], lambda a: _core.radiometry_render_perspective(
+        a, (1.0, 2.0), True, "ne-sw", "lambertian", [0.5], (30.0, 40.0), 0.2, (3.0, 4.0, 60.0), (3.0, -8.0, 0.0),
+        40.0, (5, 4), 2, 3, 1)),
+    "radiometry_render_psf": (IMG[:9, :7], lambda a: _core.radiometry_render_psf(
+        a, (1.0, 2.0), False, "nw-se", "lambertian", [0.5], (30.0, 40.0), (0.0, 0.0), 0.3, (5, 4), 4, 3, 1,
+        "table", [0.5], np.abs(IMG[:3, :5]))),
 }
 # functions whose array arguments are not data laid out by the caller
 NOT_LAYOUT = {

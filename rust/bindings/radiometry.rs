@@ -5,6 +5,7 @@
 use super::convert::{array2, c_order, run};
 use super::progress::{counter, ProgressCounter};
 use crate::error::{CoreError, CoreResult};
+use crate::radiometry::integrator::{Pinhole, Psf};
 use crate::radiometry::{direction, material, Heightfield, Scene, Split};
 use numpy::{PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -155,9 +156,215 @@ fn radiometry_render<'py>(
     array2(py, shape, img)
 }
 
+/// `(value, se, n)` of the reflectance factor under the sun and an
+/// isotropic sky of horizontal irradiance `sky` (the HDRF).
+#[pyfunction]
+#[pyo3(signature = (dem, cell_size, periodic, split, material, params, sun, view, sky, spp, max_depth, seed, n_threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn radiometry_brf_sky(
+    py: Python<'_>,
+    dem: PyReadonlyArray2<'_, f64>,
+    cell_size: (f64, f64),
+    periodic: bool,
+    split: &str,
+    material: &str,
+    params: Vec<f64>,
+    sun: (f64, f64),
+    view: (f64, f64),
+    sky: f64,
+    spp: u64,
+    max_depth: u32,
+    seed: u64,
+    n_threads: Option<usize>,
+) -> PyResult<(f64, f64, u64)> {
+    let z = c_order(&dem);
+    let e = run(py, n_threads, || {
+        let s = build(
+            &z.data,
+            z.rows_cols(),
+            cell_size,
+            periodic,
+            split,
+            material,
+            &params,
+        )?;
+        s.brf_sky(
+            direction(sun, "sun")?,
+            direction(view, "view")?,
+            sky,
+            spp,
+            max_depth,
+            seed,
+        )
+    })?;
+    Ok((e.value, e.se, e.n))
+}
+
+/// `(value, se, n)` of the bi-hemispherical reflectance (white-sky albedo).
+#[pyfunction]
+#[pyo3(signature = (dem, cell_size, periodic, split, material, params, spp, max_depth, seed, n_threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn radiometry_bhr(
+    py: Python<'_>,
+    dem: PyReadonlyArray2<'_, f64>,
+    cell_size: (f64, f64),
+    periodic: bool,
+    split: &str,
+    material: &str,
+    params: Vec<f64>,
+    spp: u64,
+    max_depth: u32,
+    seed: u64,
+    n_threads: Option<usize>,
+) -> PyResult<(f64, f64, u64)> {
+    let z = c_order(&dem);
+    let e = run(py, n_threads, || {
+        let s = build(
+            &z.data,
+            z.rows_cols(),
+            cell_size,
+            periodic,
+            split,
+            material,
+            &params,
+        )?;
+        s.bhr(spp, max_depth, seed)
+    })?;
+    Ok((e.value, e.se, e.n))
+}
+
+/// A float32 radiance image with sky light and a point-spread function:
+/// `psf` is "box", "gaussian" (`psf_params` = [sigma, truncate], pixels and
+/// sigmas) or "table" (`psf_table` weights, `psf_params` = [cell size in pixels]).
+#[pyfunction]
+#[pyo3(signature = (dem, cell_size, periodic, split, material, params, sun, view, sky, shape, spp, max_depth, seed, psf, psf_params, psf_table=None, n_threads=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+fn radiometry_render_psf<'py>(
+    py: Python<'py>,
+    dem: PyReadonlyArray2<'py, f64>,
+    cell_size: (f64, f64),
+    periodic: bool,
+    split: &str,
+    material: &str,
+    params: Vec<f64>,
+    sun: (f64, f64),
+    view: (f64, f64),
+    sky: f64,
+    shape: (usize, usize),
+    spp: u64,
+    max_depth: u32,
+    seed: u64,
+    psf: &str,
+    psf_params: Vec<f64>,
+    psf_table: Option<PyReadonlyArray2<'py, f64>>,
+    n_threads: Option<usize>,
+    progress: Option<&Bound<'py, ProgressCounter>>,
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let z = c_order(&dem);
+    let table = psf_table.as_ref().map(c_order);
+    let pr = counter(progress);
+    let img = run(py, n_threads, || {
+        let kernel = match (psf, psf_params.as_slice(), &table) {
+            ("box", [], None) => Psf::Box,
+            ("gaussian", &[sigma, truncate], None) => Psf::gaussian(sigma, truncate)?,
+            ("table", &[step], Some(t)) => {
+                let (r, c) = t.rows_cols();
+                Psf::table(&t.data, r, c, step)?
+            }
+            _ => {
+                return Err(CoreError::invalid(
+                    "psf",
+                    format!(
+                        "expected 'box', 'gaussian' with [sigma, truncate] or 'table' with [step] and weights, got {psf:?} with {} parameter(s)",
+                        psf_params.len()
+                    ),
+                ))
+            }
+        };
+        let s = build(
+            &z.data,
+            z.rows_cols(),
+            cell_size,
+            periodic,
+            split,
+            material,
+            &params,
+        )?;
+        s.render_psf(
+            direction(sun, "sun")?,
+            direction(view, "view")?,
+            sky,
+            shape,
+            spp,
+            max_depth,
+            seed,
+            &kernel,
+            pr.as_deref(),
+        )
+    })?;
+    array2(py, shape, img)
+}
+
+/// A float32 radiance image seen by a pinhole camera at `eye` looking at
+/// `target` (scene coordinates: x east, y north, z up) with the vertical
+/// field of view `fov` degrees.
+#[pyfunction]
+#[pyo3(signature = (dem, cell_size, periodic, split, material, params, sun, sky, eye, target, fov, shape, spp, max_depth, seed, n_threads=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+fn radiometry_render_perspective<'py>(
+    py: Python<'py>,
+    dem: PyReadonlyArray2<'py, f64>,
+    cell_size: (f64, f64),
+    periodic: bool,
+    split: &str,
+    material: &str,
+    params: Vec<f64>,
+    sun: (f64, f64),
+    sky: f64,
+    eye: (f64, f64, f64),
+    target: (f64, f64, f64),
+    fov: f64,
+    shape: (usize, usize),
+    spp: u64,
+    max_depth: u32,
+    seed: u64,
+    n_threads: Option<usize>,
+    progress: Option<&Bound<'py, ProgressCounter>>,
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let z = c_order(&dem);
+    let pr = counter(progress);
+    let img = run(py, n_threads, || {
+        let cam = Pinhole::new(eye.into(), target.into(), fov)?;
+        let s = build(
+            &z.data,
+            z.rows_cols(),
+            cell_size,
+            periodic,
+            split,
+            material,
+            &params,
+        )?;
+        s.render_perspective(
+            direction(sun, "sun")?,
+            sky,
+            &cam,
+            shape,
+            spp,
+            max_depth,
+            seed,
+            pr.as_deref(),
+        )
+    })?;
+    array2(py, shape, img)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(radiometry_albedo, m)?)?;
     m.add_function(wrap_pyfunction!(radiometry_brf, m)?)?;
     m.add_function(wrap_pyfunction!(radiometry_render, m)?)?;
+    m.add_function(wrap_pyfunction!(radiometry_bhr, m)?)?;
+    m.add_function(wrap_pyfunction!(radiometry_brf_sky, m)?)?;
+    m.add_function(wrap_pyfunction!(radiometry_render_psf, m)?)?;
+    m.add_function(wrap_pyfunction!(radiometry_render_perspective, m)?)?;
     Ok(())
 }

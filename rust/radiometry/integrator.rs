@@ -348,3 +348,541 @@ impl Scene {
         Ok(img)
     }
 }
+
+// ---- Sky light, sensor point-spread functions and the bi-hemispherical
+// reflectance (new entry points beside the ones above; those are unchanged).
+
+const TAG_BHR: u64 = 0x6268_7200_0000_0000;
+
+/// The point-spread function of an image pixel: the weight with which the
+/// reference plane around the pixel's centre contributes to it. The renderer
+/// draws each path's footprint point from it, so a pixel estimates exactly
+/// the PSF-weighted integral of the radiance.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Psf {
+    /// Uniform over the pixel's footprint (a box one pixel wide).
+    Box,
+    /// Isotropic Gaussian of standard deviation `sigma` pixels, truncated to
+    /// the disc of radius `radius` pixels (and renormalised).
+    Gaussian {
+        /// Standard deviation, pixels.
+        sigma: f64,
+        /// Truncation radius, pixels.
+        radius: f64,
+    },
+    /// Piecewise constant on a `rows x cols` grid of cells `step` pixels
+    /// wide, centred on the pixel centre (row 0 north); `cdf` holds the
+    /// running sums of the weights (row-major), the last one the total.
+    Table {
+        /// Rows of the grid.
+        rows: usize,
+        /// Columns of the grid.
+        cols: usize,
+        /// Cell side, pixels.
+        step: f64,
+        /// Running sums of the non-negative weights.
+        cdf: Vec<f64>,
+    },
+}
+
+impl Psf {
+    /// A Gaussian PSF of `sigma` pixels truncated at `truncate * sigma`.
+    pub fn gaussian(sigma: f64, truncate: f64) -> CoreResult<Psf> {
+        if !(sigma.is_finite() && sigma > 0.0) {
+            return Err(CoreError::invalid(
+                "psf",
+                format!("expected a Gaussian sigma > 0 pixels, got {sigma}"),
+            ));
+        }
+        if !(truncate.is_finite() && truncate > 0.0) {
+            return Err(CoreError::invalid(
+                "psf",
+                format!("expected a Gaussian truncation > 0 sigmas, got {truncate}"),
+            ));
+        }
+        Ok(Psf::Gaussian {
+            sigma,
+            radius: truncate * sigma,
+        })
+    }
+
+    /// A tabulated PSF: `weights` row-major `rows x cols`, non-negative
+    /// with a positive sum, cells `step` pixels wide.
+    pub fn table(weights: &[f64], rows: usize, cols: usize, step: f64) -> CoreResult<Psf> {
+        if rows == 0 || cols == 0 || weights.len() != rows * cols {
+            return Err(CoreError::invalid(
+                "psf",
+                format!(
+                    "expected a non-empty 2D array of weights, got {} values for {rows} x {cols}",
+                    weights.len()
+                ),
+            ));
+        }
+        if !(step.is_finite() && step > 0.0) {
+            return Err(CoreError::invalid(
+                "psf_step",
+                format!("expected a cell size > 0 pixels, got {step}"),
+            ));
+        }
+        let mut cdf = Vec::with_capacity(weights.len());
+        let mut s = 0.0;
+        for &w in weights {
+            if !(w.is_finite() && w >= 0.0) {
+                return Err(CoreError::invalid(
+                    "psf",
+                    format!("expected finite weights >= 0, got {w}"),
+                ));
+            }
+            s += w;
+            cdf.push(s);
+        }
+        if s <= 0.0 {
+            return Err(CoreError::invalid(
+                "psf",
+                "expected weights with a positive sum, got all zeros",
+            ));
+        }
+        Ok(Psf::Table {
+            rows,
+            cols,
+            step,
+            cdf,
+        })
+    }
+
+    /// The footprint point, in pixels east and south of the pixel's
+    /// north-west corner, for the uniforms `u` in (0, 1): distributed as
+    /// the PSF centred on the pixel centre `(0.5, 0.5)`.
+    #[inline]
+    pub fn position(&self, u: [f64; 2]) -> (f64, f64) {
+        match self {
+            Psf::Box => (u[0], u[1]),
+            Psf::Gaussian { sigma, radius } => {
+                // radial inverse CDF of the disc-truncated Gaussian
+                let tail = (-0.5 * (radius / sigma).powi(2)).exp_m1(); // e^{-R^2/2s^2} - 1
+                let r = sigma * (-2.0 * (u[0] * tail).ln_1p()).max(0.0).sqrt();
+                let phi = 2.0 * PI * u[1];
+                (0.5 + r * phi.cos(), 0.5 + r * phi.sin())
+            }
+            Psf::Table {
+                rows,
+                cols,
+                step,
+                cdf,
+            } => {
+                let total = cdf[cdf.len() - 1];
+                let t = u[0] * total;
+                // first cell whose running sum exceeds t (never a zero-weight cell)
+                let k = cdf.partition_point(|&c| c <= t).min(cdf.len() - 1);
+                let lo = if k == 0 { 0.0 } else { cdf[k - 1] };
+                let w = cdf[k] - lo;
+                let fx = if w > 0.0 {
+                    ((t - lo) / w).clamp(0.0, 1.0)
+                } else {
+                    0.5
+                };
+                let (r, c) = ((k / cols) as f64, (k % cols) as f64);
+                (
+                    0.5 + (c + fx - 0.5 * *cols as f64) * step,
+                    0.5 + (r + u[1] - 0.5 * *rows as f64) * step,
+                )
+            }
+        }
+    }
+}
+
+impl Scene {
+    /// [`Scene::radiance`] with an isotropic sky of radiance `sky_l` over
+    /// the upper hemisphere: a path that leaves upwards after `k >= 1`
+    /// scattering events (`k <= max_depth`) adds `throughput * sky_l`. With
+    /// `sky_l = 0` it draws the same numbers and returns the same value as
+    /// [`Scene::radiance`].
+    #[allow(clippy::too_many_arguments)]
+    fn radiance_sky(
+        &self,
+        mut o: DVec3,
+        v: DVec3,
+        s: DVec3,
+        sky_l: f64,
+        max_depth: u32,
+        key: StreamKey,
+        mut dim: u64,
+    ) -> f64 {
+        let hf = &self.hf;
+        let mut d = -v;
+        let mut skip: Option<FacetId> = None;
+        let mut throughput = 1.0;
+        let mut l = 0.0;
+        let mut depth = 0u32;
+        loop {
+            let Some(hit) = hf.intersect(o, d, skip) else {
+                if depth > 0 && d.z > 0.0 {
+                    l += throughput * sky_l; // escaped into the sky
+                }
+                break;
+            };
+            if depth == max_depth {
+                break;
+            }
+            depth += 1;
+            let n = hit.normal;
+            if n.dot(d) >= 0.0 {
+                break; // reached a facet from below: numerically lost
+            }
+            let (p, facet) = hf.wrap(o + hit.t * d, hit.facet);
+            let (t, b) = basis(n);
+            let wo = Self::local(n, t, b, -d);
+            let cos_s = n.dot(s);
+            if cos_s > 0.0 && hf.intersect(p, s, Some(facet)).is_none() {
+                let wi = Self::local(n, t, b, s);
+                l += throughput * self.material.eval(wi, wo) * cos_s;
+            }
+            if depth == max_depth && sky_l == 0.0 {
+                break;
+            }
+            let Some((wi, weight)) = self.scatter((t, b, n), wo, key, &mut dim) else {
+                break;
+            };
+            throughput *= weight;
+            if throughput == 0.0 {
+                break;
+            }
+            d = wi;
+            o = p;
+            skip = Some(facet);
+        }
+        l
+    }
+
+    /// The reflectance factor under the sun towards `sun` (irradiance 1
+    /// normal to the beam) plus an isotropic sky whose irradiance on a
+    /// horizontal plane is `sky` (same unit): `pi L / (cos(sun zenith) +
+    /// sky)`, the hemispherical-directional reflectance factor (HDRF). With
+    /// `sky = 0` it equals [`Scene::brf`] bit for bit (same paths).
+    pub fn brf_sky(
+        &self,
+        sun: DVec3,
+        view: DVec3,
+        sky: f64,
+        spp: u64,
+        max_depth: u32,
+        seed: u64,
+    ) -> CoreResult<Estimate> {
+        check_spp(spp)?;
+        check_depth(max_depth)?;
+        check_sky(sky)?;
+        let (w, h) = self.hf.extent();
+        let norm = PI / (sun.z + sky);
+        let sky_l = sky / PI;
+        let blocks: Vec<(f64, f64, u64)> = (0..spp.div_ceil(BLOCK))
+            .into_par_iter()
+            .map(|blk| {
+                let (mut s1, mut s2) = (0.0, 0.0);
+                let end = ((blk + 1) * BLOCK).min(spp);
+                for i in blk * BLOCK..end {
+                    let key = StreamKey::new(seed, TAG_BRF ^ i);
+                    let (x, y) = (key.uniform(0) * w, -key.uniform(1) * h);
+                    let o = self.sensor_ray(x, y, view);
+                    let r = norm * self.radiance_sky(o, view, sun, sky_l, max_depth, key, 2);
+                    s1 += r;
+                    s2 += r * r;
+                }
+                (s1, s2, end - blk * BLOCK)
+            })
+            .collect();
+        Ok(finish(&blocks))
+    }
+
+    /// [`Scene::render_progress`] with an isotropic sky of horizontal
+    /// irradiance `sky` and the point-spread function `psf`: each path's
+    /// footprint point is drawn from the PSF around the pixel's centre
+    /// (it may fall outside the pixel, and outside a finite patch, where
+    /// nothing is seen). With `Psf::Box` and `sky = 0` the image equals
+    /// [`Scene::render`] bit for bit.
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_psf(
+        &self,
+        sun: DVec3,
+        view: DVec3,
+        sky: f64,
+        shape: (usize, usize),
+        spp: u64,
+        max_depth: u32,
+        seed: u64,
+        psf: &Psf,
+        progress: Option<&crate::progress::Progress>,
+    ) -> CoreResult<Vec<f32>> {
+        check_spp(spp)?;
+        check_depth(max_depth)?;
+        check_sky(sky)?;
+        let (rows, cols) = shape;
+        if rows == 0 || cols == 0 {
+            return Err(CoreError::invalid(
+                "shape",
+                format!("expected a positive number of rows and columns, got ({rows}, {cols})"),
+            ));
+        }
+        let npix = rows as u128 * cols as u128;
+        if npix > MAX_PIXELS as u128 {
+            return Err(CoreError::OutOfMemory {
+                param: "shape".into(),
+                bytes: npix * 4,
+            });
+        }
+        let mut img: Vec<f32> = crate::buffers::try_filled(rows * cols, 0.0f32, "shape")?;
+        if let Some(p) = progress {
+            p.add_total(rows as u64);
+        }
+        let (w, h) = self.hf.extent();
+        let (pw, ph) = (w / cols as f64, h / rows as f64);
+        let sky_l = sky / PI;
+        img.par_chunks_mut(cols).enumerate().for_each(|(i, line)| {
+            for (j, px) in line.iter_mut().enumerate() {
+                let pixel = (i * cols + j) as u64;
+                let mut s = 0.0;
+                for k in 0..spp {
+                    let key =
+                        StreamKey::new(seed, TAG_IMAGE ^ pixel.wrapping_mul(spp).wrapping_add(k));
+                    let (fx, fy) = psf.position([key.uniform(0), key.uniform(1)]);
+                    let x = (j as f64 + fx) * pw;
+                    let y = -(i as f64 + fy) * ph;
+                    let o = self.sensor_ray(x, y, view);
+                    s += self.radiance_sky(o, view, sun, sky_l, max_depth, key, 2);
+                }
+                *px = (s / spp as f64) as f32;
+            }
+            if let Some(p) = progress {
+                p.tick(1);
+            }
+        });
+        Ok(img)
+    }
+
+    /// The fraction of light arriving along `-sun` at the reference-plane
+    /// point `(x, y)` that leaves upwards after at most `max_depth`
+    /// scattering events (one path of [`Scene::albedo`]), uniforms from `dim`.
+    fn albedo_path(
+        &self,
+        sun: DVec3,
+        (x, y): (f64, f64),
+        max_depth: u32,
+        key: StreamKey,
+        mut dim: u64,
+    ) -> f64 {
+        let hf = &self.hf;
+        let mut o = self.sensor_ray(x, y, sun);
+        let mut d = -sun;
+        let mut skip = None;
+        let mut throughput = 1.0;
+        for depth in 0..=max_depth {
+            let Some(hit) = hf.intersect(o, d, skip) else {
+                return if depth > 0 { throughput } else { 0.0 };
+            };
+            if depth == max_depth || hit.normal.dot(d) >= 0.0 {
+                return 0.0;
+            }
+            let n = hit.normal;
+            let (p, facet) = hf.wrap(o + hit.t * d, hit.facet);
+            let (t, b) = basis(n);
+            let wo = Self::local(n, t, b, -d);
+            let Some((wi, weight)) = self.scatter((t, b, n), wo, key, &mut dim) else {
+                return 0.0;
+            };
+            throughput *= weight;
+            if throughput == 0.0 {
+                return 0.0;
+            }
+            d = wi;
+            o = p;
+            skip = Some(facet);
+        }
+        0.0
+    }
+
+    /// Bi-hemispherical reflectance (white-sky albedo): the albedo under a
+    /// uniform sky, `(1/pi) * integral of albedo(s) cos(s) ds` over the
+    /// upper hemisphere. Each of the `spp` paths draws its sun direction
+    /// cosine-weighted, then follows it as [`Scene::albedo`] does.
+    pub fn bhr(&self, spp: u64, max_depth: u32, seed: u64) -> CoreResult<Estimate> {
+        check_spp(spp)?;
+        check_depth(max_depth)?;
+        let (w, h) = self.hf.extent();
+        let blocks: Vec<(f64, f64, u64)> = (0..spp.div_ceil(BLOCK))
+            .into_par_iter()
+            .map(|blk| {
+                let (mut s1, mut s2) = (0.0, 0.0);
+                let end = ((blk + 1) * BLOCK).min(spp);
+                for i in blk * BLOCK..end {
+                    let key = StreamKey::new(seed, TAG_BHR ^ i);
+                    let (x, y) = (key.uniform(0) * w, -key.uniform(1) * h);
+                    let sun = super::material::cosine_hemisphere([key.uniform(2), key.uniform(3)]);
+                    let r = if sun.z > 0.0 {
+                        self.albedo_path(sun, (x, y), max_depth, key, 4)
+                    } else {
+                        0.0
+                    };
+                    s1 += r;
+                    s2 += r * r;
+                }
+                (s1, s2, end - blk * BLOCK)
+            })
+            .collect();
+        Ok(finish(&blocks))
+    }
+}
+
+fn check_sky(sky: f64) -> CoreResult<()> {
+    if !(sky.is_finite() && sky >= 0.0) {
+        return Err(CoreError::invalid(
+            "sky",
+            format!("expected a finite sky irradiance >= 0, got {sky}"),
+        ));
+    }
+    Ok(())
+}
+
+// ---- A perspective (pinhole) camera for 3D views.
+
+const TAG_PERSPECTIVE: u64 = 0x7073_7000_0000_0000;
+
+/// A pinhole camera at `eye` looking at `target`, world up `+z`.
+#[derive(Debug, Clone, Copy)]
+pub struct Pinhole {
+    eye: DVec3,
+    fwd: DVec3,
+    right: DVec3,
+    up: DVec3,
+    /// tan(vertical field of view / 2).
+    tan_half: f64,
+}
+
+impl Pinhole {
+    /// A camera at `eye` looking at `target` with the vertical field of
+    /// view `fov_deg` degrees in (0, 180); image rows go down, columns right.
+    pub fn new(eye: DVec3, target: DVec3, fov_deg: f64) -> CoreResult<Pinhole> {
+        if !(eye.is_finite() && target.is_finite()) {
+            return Err(CoreError::invalid(
+                "eye",
+                "expected finite camera and target positions",
+            ));
+        }
+        let f = target - eye;
+        if f.length() <= 0.0 {
+            return Err(CoreError::invalid(
+                "target",
+                "expected a target distinct from the camera position",
+            ));
+        }
+        if !(fov_deg.is_finite() && fov_deg > 0.0 && fov_deg < 180.0) {
+            return Err(CoreError::invalid(
+                "fov",
+                format!("expected a field of view in (0, 180) degrees, got {fov_deg}"),
+            ));
+        }
+        let fwd = f.normalize();
+        let r = fwd.cross(DVec3::Z);
+        let right = if r.length() > 1e-12 {
+            r.normalize()
+        } else {
+            DVec3::X // looking straight down or up: east to the right
+        };
+        let up = right.cross(fwd);
+        Ok(Pinhole {
+            eye,
+            fwd,
+            right,
+            up,
+            tan_half: (0.5 * fov_deg.to_radians()).tan(),
+        })
+    }
+
+    /// The unit direction through the image point `(row, col)` (fractional
+    /// pixels from the top-left corner) of a `rows x cols` image.
+    #[inline]
+    pub fn ray(&self, row: f64, col: f64, (rows, cols): (usize, usize)) -> DVec3 {
+        let aspect = cols as f64 / rows as f64;
+        let sx = (2.0 * col / cols as f64 - 1.0) * self.tan_half * aspect;
+        let sy = (1.0 - 2.0 * row / rows as f64) * self.tan_half;
+        (self.fwd + sx * self.right + sy * self.up).normalize()
+    }
+}
+
+impl Scene {
+    /// A `rows x cols` radiance image seen by the pinhole camera `cam`
+    /// (box pixels, `spp` paths each), the sun towards `sun` and an
+    /// isotropic sky of horizontal irradiance `sky`. Rays that miss the
+    /// surface see the sky radiance `sky / pi` above the horizon and 0
+    /// below it.
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_perspective(
+        &self,
+        sun: DVec3,
+        sky: f64,
+        cam: &Pinhole,
+        shape: (usize, usize),
+        spp: u64,
+        max_depth: u32,
+        seed: u64,
+        progress: Option<&crate::progress::Progress>,
+    ) -> CoreResult<Vec<f32>> {
+        check_spp(spp)?;
+        check_depth(max_depth)?;
+        check_sky(sky)?;
+        let (rows, cols) = shape;
+        if rows == 0 || cols == 0 {
+            return Err(CoreError::invalid(
+                "shape",
+                format!("expected a positive number of rows and columns, got ({rows}, {cols})"),
+            ));
+        }
+        let npix = rows as u128 * cols as u128;
+        if npix > MAX_PIXELS as u128 {
+            return Err(CoreError::OutOfMemory {
+                param: "shape".into(),
+                bytes: npix * 4,
+            });
+        }
+        let mut img: Vec<f32> = crate::buffers::try_filled(rows * cols, 0.0f32, "shape")?;
+        if let Some(p) = progress {
+            p.add_total(rows as u64);
+        }
+        let hf = &self.hf;
+        let top = hf.zmax + 1e-6 * (1.0 + hf.zmax.abs());
+        let sky_l = sky / PI;
+        img.par_chunks_mut(cols).enumerate().for_each(|(i, line)| {
+            for (j, px) in line.iter_mut().enumerate() {
+                let pixel = (i * cols + j) as u64;
+                let mut s = 0.0;
+                for k in 0..spp {
+                    let key = StreamKey::new(
+                        seed,
+                        TAG_PERSPECTIVE ^ pixel.wrapping_mul(spp).wrapping_add(k),
+                    );
+                    let d = cam.ray(i as f64 + key.uniform(1), j as f64 + key.uniform(0), shape);
+                    // start on the plane just above the highest facet
+                    let o = if cam.eye.z > top {
+                        if d.z < 0.0 {
+                            Some(cam.eye + ((cam.eye.z - top) / -d.z) * d)
+                        } else {
+                            None
+                        }
+                    } else {
+                        Some(cam.eye)
+                    };
+                    s += match o {
+                        Some(o) if hf.intersect(o, d, None).is_some() => {
+                            self.radiance_sky(o, -d, sun, sky_l, max_depth, key, 2)
+                        }
+                        _ if d.z > 0.0 => sky_l,
+                        _ => 0.0,
+                    };
+                }
+                *px = (s / spp as f64) as f32;
+            }
+            if let Some(p) = progress {
+                p.tick(1);
+            }
+        });
+        Ok(img)
+    }
+}

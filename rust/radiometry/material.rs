@@ -91,6 +91,7 @@ pub fn basis(n: DVec3) -> (DVec3, DVec3) {
 /// |---|---|
 /// | `lambertian` | `rho` in [0, 1] |
 /// | `oren-nayar` | `rho` in [0, 1], `sigma` (slope standard deviation, radians) >= 0 |
+/// | `oren-nayar-full` | the same, full 1994 model with the interreflection term |
 /// | `phong` | `kd`, `ks` in [0, 1] with `kd + ks <= 1`, exponent >= 0 |
 /// | `hapke` | `w`, `b`, `c`, `theta_bar` (degrees), `B0`, `h` |
 /// | `specular` | `eta` > 0, `k` >= 0 (complex relative refractive index) |
@@ -119,6 +120,12 @@ pub fn from_name(name: &str, params: &[f64]) -> CoreResult<Box<dyn Bsdf>> {
                 params[0], params[1],
             )?))
         }
+        "oren-nayar-full" => {
+            want(2, "rho, sigma")?;
+            Ok(Box::new(super::oren_nayar_full::OrenNayarFull::new(
+                params[0], params[1],
+            )?))
+        }
         "phong" => {
             want(3, "kd, ks, exponent")?;
             Ok(Box::new(super::phong::Phong::new(
@@ -140,7 +147,7 @@ pub fn from_name(name: &str, params: &[f64]) -> CoreResult<Box<dyn Bsdf>> {
         _ => Err(CoreError::invalid(
             "material",
             format!(
-                "expected one of 'lambertian', 'oren-nayar', 'phong', 'hapke', 'specular', got {name:?}"
+                "expected one of 'lambertian', 'oren-nayar', 'oren-nayar-full', 'phong', 'hapke', 'specular', got {name:?}"
             ),
         )),
     }

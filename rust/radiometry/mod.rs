@@ -23,6 +23,7 @@ pub mod integrator;
 pub mod lambertian;
 pub mod material;
 pub mod oren_nayar;
+pub mod oren_nayar_full;
 pub mod phong;
 pub mod specular;
 

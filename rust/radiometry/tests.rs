@@ -793,3 +793,179 @@ fn specular_mirror_reflects_the_fresnel_fraction() {
     assert!(material::from_name("specular", &[0.0, 0.0]).is_err());
     assert!(material::from_name("specular", &[1.5, -1.0]).is_err());
 }
+
+// ---- sky light, PSFs and the bi-hemispherical reflectance ----
+
+#[test]
+fn sky_zero_is_the_plain_brf_and_image() {
+    let z = rough(12, 1.5, 3);
+    let s = scene(&z, 12, 12, true, "lambertian", &[0.6]);
+    let (sun, view) = (dir(120.0, 40.0), dir(300.0, 20.0));
+    assert_eq!(
+        s.brf(sun, view, 3000, 5, 7).unwrap(),
+        s.brf_sky(sun, view, 0.0, 3000, 5, 7).unwrap()
+    );
+    let a = s.render(sun, view, (5, 4), 3, 5, 2).unwrap();
+    let b = s
+        .render_psf(
+            sun,
+            view,
+            0.0,
+            (5, 4),
+            3,
+            5,
+            2,
+            &super::integrator::Psf::Box,
+            None,
+        )
+        .unwrap();
+    assert_eq!(a, b);
+}
+
+#[test]
+fn flat_lambertian_under_sun_and_sky() {
+    // L = rho (cos(sun zenith) + E_sky) / pi exactly; the HDRF is rho
+    let z = vec![0.0; 16];
+    let rho = 0.4;
+    let s = scene(&z, 4, 4, true, "lambertian", &[rho]);
+    for (zen, sky) in [(0.0, 0.3), (60.0, 2.0), (80.0, 0.05)] {
+        let sun = dir(33.0, zen);
+        let e = s.brf_sky(sun, dir(0.0, 0.0), sky, 500, 1, 1).unwrap();
+        assert!((e.value - rho).abs() < 1e-12, "{e:?}");
+        let gauss = super::integrator::Psf::gaussian(0.8, 3.0).unwrap();
+        let img = s
+            .render_psf(sun, dir(200.0, 35.0), sky, (3, 3), 4, 3, 0, &gauss, None)
+            .unwrap();
+        let want = rho * (sun.z + sky) / std::f64::consts::PI;
+        for v in img {
+            assert!((v as f64 - want).abs() < 1e-6 * want, "{v} vs {want}");
+        }
+    }
+    for bad in [-1.0, f64::NAN, f64::INFINITY] {
+        let e = s.brf_sky(dir(0.0, 0.0), dir(0.0, 0.0), bad, 10, 1, 0);
+        assert!(e.unwrap_err().to_string().starts_with("sky: "));
+    }
+}
+
+#[test]
+fn bhr_of_a_flat_plane_is_rho() {
+    let z = vec![0.0; 16];
+    let s = scene(&z, 4, 4, true, "lambertian", &[0.3]);
+    let e = s.bhr(2000, 10, 4).unwrap();
+    assert!((e.value - 0.3).abs() < 1e-12 && e.se < 1e-12, "{e:?}");
+}
+
+#[test]
+fn psf_positions_follow_their_distributions() {
+    use super::integrator::Psf;
+    // truncated Gaussian: every draw inside the disc; the radial CDF at
+    // sigma matches (1 - e^{-1/2}) / (1 - e^{-R^2/2 sigma^2})
+    let g = Psf::gaussian(0.7, 2.0).unwrap();
+    let n = 20000;
+    let k = StreamKey::new(1, 2);
+    let mut inside = 0;
+    for i in 0..n {
+        let (x, y) = g.position([k.uniform(2 * i), k.uniform(2 * i + 1)]);
+        let r = ((x - 0.5).powi(2) + (y - 0.5).powi(2)).sqrt();
+        assert!(r <= 1.4 + 1e-12);
+        if r < 0.7 {
+            inside += 1;
+        }
+    }
+    let p = (1.0 - (-0.5f64).exp()) / (1.0 - (-2.0f64).exp());
+    let f = inside as f64 / n as f64;
+    assert!(
+        (f - p).abs() < 4.0 * (p * (1.0 - p) / n as f64).sqrt(),
+        "{f} {p}"
+    );
+    // table: a 1 x 2 grid with weights 1 and 3, cells of 2 pixels
+    let t = Psf::table(&[1.0, 3.0], 1, 2, 2.0).unwrap();
+    let mut right = 0;
+    for i in 0..n {
+        let (x, y) = t.position([k.uniform(2 * i), k.uniform(2 * i + 1)]);
+        assert!((-1.5..=2.5).contains(&x) && (-0.5..=1.5).contains(&y));
+        if x > 0.5 {
+            right += 1;
+        }
+    }
+    let f = right as f64 / n as f64;
+    assert!((f - 0.75).abs() < 4.0 * (0.1875 / n as f64).sqrt(), "{f}");
+    assert!(Psf::table(&[0.0, 0.0], 1, 2, 1.0).is_err());
+    assert!(Psf::table(&[1.0, -1.0], 1, 2, 1.0).is_err());
+    assert!(Psf::gaussian(0.0, 3.0).is_err());
+}
+
+// ---- full Oren-Nayar and the perspective camera ----
+
+#[test]
+fn full_oren_nayar_is_reciprocal_bounded_and_its_sampler_fits() {
+    let m = material::from_name("oren-nayar-full", &[0.8, 0.4]).unwrap();
+    let key = StreamKey::new(5, 1);
+    for i in 0..2000u64 {
+        let a = super::material::cosine_hemisphere([key.uniform(4 * i), key.uniform(4 * i + 1)]);
+        let b =
+            super::material::cosine_hemisphere([key.uniform(4 * i + 2), key.uniform(4 * i + 3)]);
+        let (f1, f2) = (m.eval(a, b), m.eval(b, a));
+        assert!(
+            f1 >= 0.0 && (f1 - f2).abs() <= 1e-12 * f1.max(1e-300),
+            "{f1} {f2}"
+        );
+    }
+    // sigma = 0 is Lambertian
+    let l = material::from_name("oren-nayar-full", &[0.6, 0.0]).unwrap();
+    let (a, b) = (local(20.0, 10.0), local(70.0, 250.0));
+    assert!((l.eval(a, b) - 0.6 / std::f64::consts::PI).abs() < 1e-15);
+    // energy: rho = 1 and small sigma reflects more than the incident light at grazing
+    let e = material::from_name("oren-nayar-full", &[1.0, 0.3])
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("rho: "), "{e}");
+    let wo = local(50.0, 30.0);
+    let (bins, n) = (20usize, 200_000u64);
+    let mut count = vec![0u64; bins];
+    let (mut s1, mut s2) = (0.0, 0.0);
+    for i in 0..n {
+        let s = m
+            .sample(wo, [key.uniform(2 * i), key.uniform(2 * i + 1)])
+            .unwrap();
+        assert!((s.pdf - m.pdf(s.wi, wo)).abs() < 1e-15);
+        let want = m.eval(s.wi, wo) * s.wi.z / s.pdf;
+        assert!((s.weight - want).abs() <= 1e-12 * want.max(1.0));
+        s1 += s.weight;
+        s2 += s.weight * s.weight;
+        count[((s.wi.z * s.wi.z * bins as f64) as usize).min(bins - 1)] += 1;
+    }
+    let ex = n as f64 / bins as f64;
+    let chi2: f64 = count.iter().map(|&c| (c as f64 - ex).powi(2) / ex).sum();
+    assert!(chi2 < 43.8, "{chi2}"); // 19 dof, p = 0.001
+    let mean = s1 / n as f64;
+    let se = ((s2 / n as f64 - mean * mean) / n as f64).sqrt();
+    assert!(
+        (mean - m.albedo(wo)).abs() < 4.0 * se + 1e-4,
+        "{mean} +- {se}"
+    );
+}
+
+#[test]
+fn perspective_camera_over_a_flat_plane() {
+    use super::integrator::Pinhole;
+    let z = vec![0.0; 16];
+    let rho = 0.5;
+    let s = scene(&z, 4, 4, true, "lambertian", &[rho]);
+    let sun = dir(10.0, 60.0);
+    let sky = 0.4;
+    // looking horizontally from 3 m: the top half of the image is sky, the
+    // bottom half the lit plane, the horizon between the two middle rows
+    let cam = Pinhole::new(DVec3::new(1.0, -1.0, 3.0), DVec3::new(1.0, 10.0, 3.0), 50.0).unwrap();
+    let img = s
+        .render_perspective(sun, sky, &cam, (6, 5), 8, 4, 1, None)
+        .unwrap();
+    let ground = rho * (sun.z + sky) / std::f64::consts::PI;
+    let air = sky / std::f64::consts::PI;
+    for (k, v) in img.iter().enumerate() {
+        let want = if k / 5 < 3 { air } else { ground };
+        assert!((*v as f64 - want).abs() < 1e-6, "{k}: {v} vs {want}");
+    }
+    assert!(Pinhole::new(DVec3::ZERO, DVec3::ZERO, 40.0).is_err());
+    assert!(Pinhole::new(DVec3::ZERO, DVec3::Z, 180.0).is_err());
+}

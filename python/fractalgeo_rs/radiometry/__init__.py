@@ -27,5 +27,7 @@ from fractalgeo_rs.radiometry._scene import (
     Scene,
     Specular,
 )
+from fractalgeo_rs.radiometry._plot import plot_brf_polar, plot_brf_principal_plane, plot_incidence_series
 
-__all__ = ["BrfSweep", "Estimate", "Hapke", "Lambertian", "OrenNayar", "PAPER_SUN_ZENITHS", "Phong", "Scene", "Specular"]
+__all__ = ["BrfSweep", "Estimate", "Hapke", "Lambertian", "OrenNayar", "PAPER_SUN_ZENITHS", "Phong", "Scene", "Specular",
+           "plot_brf_polar", "plot_brf_principal_plane", "plot_incidence_series"]

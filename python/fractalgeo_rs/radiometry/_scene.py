@@ -73,12 +73,28 @@ class Lambertian:
 
 @dataclass(frozen=True)
 class OrenNayar:
-    """The qualitative Oren-Nayar model of a rough diffuse facet.
+    """The Oren-Nayar model of a rough diffuse facet: qualitative, or the
+    full 1994 model with the interreflection term.
 
+    Qualitative (``full=False``, equation 30):
     ``f = rho/pi (A + B max(0, cos(phi_i - phi_o)) sin(alpha) tan(beta))`` with
     ``A = 1 - 0.5 s^2/(s^2 + 0.33)``, ``B = 0.45 s^2/(s^2 + 0.09)``,
     ``alpha = max(theta_i, theta_o)``, ``beta = min(theta_i, theta_o)``.
-    Reciprocal; sampled cosine-weighted. ``sigma = 0`` is Lambertian.
+
+    Full (``full=True``, equations 27-29 and the interreflection term of
+    section 4.4): with ``c = cos(phi_i - phi_o)``,
+    ``f = rho/pi [C1 + c C2 tan(beta) + (1 - |c|) C3 tan((alpha + beta)/2)]
+    + 0.17 rho^2/pi s^2/(s^2 + 0.13) (1 - c (2 beta/pi)^2)``,
+    ``C1 = A``, ``C2 = 0.45 s^2/(s^2 + 0.09) sin(alpha)`` for ``c >= 0`` and
+    ``0.45 s^2/(s^2 + 0.09) (sin(alpha) - (2 beta/pi)^3)`` otherwise,
+    ``C3 = 0.125 s^2/(s^2 + 0.09) (4 alpha beta/pi^2)^2``. The full model
+    reflects slightly more light than it receives at grazing incidence when
+    ``rho`` is near 1 (1.04 times at ``rho = 1, sigma = 0.3``, zenith 89
+    degrees): such parameters raise ``ValueError`` naming ``rho`` when a
+    scene uses them (the albedo is checked by quadrature at 12 zeniths).
+
+    Both are reciprocal and sampled cosine-weighted; ``sigma = 0`` is
+    Lambertian.
 
     Parameters
     ----------
@@ -86,25 +102,34 @@ class OrenNayar:
         Reflectance in [0, 1].
     sigma : float
         Standard deviation of the micro-facet slope angle, radians (>= 0).
+    full : bool
+        The full model with the interreflection term (default False: the
+        qualitative model).
 
     Examples
     --------
     >>> from fractalgeo_rs.radiometry import OrenNayar
     >>> OrenNayar(0.5, sigma=0.3).sigma
     0.3
+    >>> OrenNayar(0.5, sigma=0.3, full=True).full
+    True
 
     References
     ----------
     M. Oren and S. K. Nayar, "Generalization of Lambert's reflectance
     model", *SIGGRAPH '94*, 239-246, 1994, doi:10.1145/192161.192213
-    (equation 30).
+    (equations 27-30).
     """
 
     rho: float
     sigma: float
+    full: bool = False
 
     def __post_init__(self):
         object.__setattr__(self, "rho", _reflectance(self.rho, "rho"))
+        if not isinstance(self.full, (bool, np.bool_)):
+            raise TypeError(f"full: expected True or False, got {self.full!r}")
+        object.__setattr__(self, "full", bool(self.full))
         s = self.sigma
         if isinstance(s, bool) or not isinstance(s, numbers.Real):
             raise TypeError(f"sigma: expected a number of radians >= 0, got {s!r}")
@@ -113,7 +138,7 @@ class OrenNayar:
         object.__setattr__(self, "sigma", float(s))
 
     def _spec(self) -> Tuple[str, List[float]]:
-        return "oren-nayar", [self.rho, self.sigma]
+        return ("oren-nayar-full" if self.full else "oren-nayar"), [self.rho, self.sigma]
 
 
 @dataclass(frozen=True)
@@ -400,6 +425,47 @@ def _direction(value, name: str) -> Tuple[float, float]:
     return (az, zen)
 
 
+def _sky(value) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"sky: expected a horizontal sky irradiance >= 0 (a number), got {value!r}")
+    v = float(value)
+    if not (math.isfinite(v) and v >= 0.0):
+        raise ValueError(f"sky: expected a finite sky irradiance >= 0, got {v}")
+    return v
+
+
+def _psf(value, step) -> Tuple[str, List[float], Optional[np.ndarray]]:
+    """``(kind, params, table)`` for the kernel from the ``psf`` argument."""
+    if isinstance(value, str):
+        if value != "box":
+            raise ValueError(f"psf: expected 'box', ('gaussian', sigma) or an array of weights, got {value!r}")
+        return "box", [], None
+    if isinstance(value, tuple) and value and isinstance(value[0], str):
+        if value[0] != "gaussian" or len(value) not in (2, 3):
+            raise ValueError(f"psf: expected ('gaussian', sigma) or ('gaussian', sigma, truncate), got {value!r}")
+        sigma = check_positive_float(value[1], "psf")
+        truncate = check_positive_float(value[2], "psf") if len(value) == 3 else 4.0
+        return "gaussian", [sigma, truncate], None
+    w = as_array(value, "psf")
+    if w.ndim != 2 or w.size == 0 or w.dtype.kind not in "iuf":
+        raise ValueError(f"psf: expected 'box', ('gaussian', sigma) or a non-empty 2D array of weights, "
+                         f"got {value!r}")
+    w = np.array(w, dtype=np.float64)
+    if not np.all(np.isfinite(w)) or (w < 0).any() or w.sum() <= 0:
+        raise ValueError("psf: expected finite weights >= 0 with a positive sum")
+    return "table", [check_positive_float(step, "psf_step")], w
+
+
+def _point(value, name: str) -> Tuple[float, float, float]:
+    try:
+        x, y, z = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name}: expected (x, y, z), got {value!r}") from None
+    if not all(math.isfinite(v) for v in (x, y, z)):
+        raise ValueError(f"{name}: expected finite (x, y, z), got {value!r}")
+    return (x, y, z)
+
+
 def _depth(value) -> int:
     d = check_positive_int(value, "max_depth")
     if d > MAX_DEPTH:
@@ -598,7 +664,7 @@ class Scene:
         return (self.dem, self.cell_size, self.periodic, self.split, name, params)
 
     def brf(self, sun, view="nadir", spp: int = 65536, max_depth: int = 10, seed: int = 0,
-            n_threads: Optional[int] = None) -> Estimate:
+            n_threads: Optional[int] = None, sky: float = 0.0) -> Estimate:
         """Bidirectional reflectance factor of the whole tile.
 
         ``BRF = pi L / cos(sun zenith)``, with ``L`` the radiance towards
@@ -626,6 +692,14 @@ class Scene:
             for any ``n_threads``.
         n_threads : int, optional
             Threads (default: all cores).
+        sky : float
+            Irradiance of a uniform (isotropic) sky on a horizontal plane,
+            relative to the sun's irradiance normal to the beam (>= 0;
+            default 0: the sun only). With ``sky > 0`` the result is the
+            hemispherical-directional reflectance factor ``pi L / (cos(sun
+            zenith) + sky)``, ``L`` including the sky light scattered up to
+            ``max_depth`` times; a flat Lambertian plane still gives
+            ``rho``.
 
         Returns
         -------
@@ -646,9 +720,63 @@ class Scene:
         for Reflectance*, NBS Monograph 160, 1977 (reflectance factor).
         """
         args = self._args()
+        sky = _sky(sky)
+        if sky > 0.0:
+            v, se, n = _core.radiometry_brf_sky(*args, _direction(sun, "sun"), _direction(view, "view"), sky,
+                                                check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed),
+                                                check_n_threads(n_threads))
+            return Estimate(v, se, n)
         v, se, n = _core.radiometry_brf(*args, _direction(sun, "sun"), _direction(view, "view"),
                                         check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed),
                                         check_n_threads(n_threads))
+        return Estimate(v, se, n)
+
+    def bhr(self, spp: int = 65536, max_depth: int = 100, seed: int = 0,
+            n_threads: Optional[int] = None) -> Estimate:
+        """Bi-hemispherical reflectance (white-sky albedo).
+
+        The fraction of the flux of a uniform sky on the tile's horizontal
+        area that leaves it upwards: ``(2 / pi) * integral of albedo(theta,
+        phi) cos(theta) sin(theta) dtheta dphi`` over the upper hemisphere,
+        ``albedo`` the directional-hemispherical reflectance of ``albedo``.
+        Each path draws its sun direction cosine-weighted (the distribution
+        of a uniform sky's light on a horizontal plane), then follows the
+        light as ``albedo`` does, so one estimate integrates over sun
+        directions and positions at once.
+
+        Parameters
+        ----------
+        spp : int
+            Number of rays (> 0).
+        max_depth : int
+            Largest number of scattering events per ray.
+        seed : int
+            Seed of the counter-based random numbers.
+        n_threads : int, optional
+            Threads (default: all cores); the result does not depend on it.
+
+        Returns
+        -------
+        Estimate
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from fractalgeo_rs.radiometry import Lambertian, Scene
+        >>> s = Scene.from_dem(np.zeros((4, 4)), material=Lambertian(0.35))
+        >>> round(s.bhr(spp=500).value, 9)
+        0.35
+
+        References
+        ----------
+        C. B. Schaaf et al., "First operational BRDF, albedo nadir
+        reflectance products from MODIS", *Remote Sensing of Environment*
+        83, 135-148, 2002, doi:10.1016/S0034-4257(02)00091-3 (white-sky
+        albedo). F. E. Nicodemus et al., NBS Monograph 160, 1977
+        (bi-hemispherical reflectance).
+        """
+        v, se, n = _core.radiometry_bhr(*self._args(), check_positive_int(spp, "spp"), _depth(max_depth),
+                                        _seed(seed), check_n_threads(n_threads))
         return Estimate(v, se, n)
 
     def albedo(self, sun, spp: int = 65536, max_depth: int = 100, seed: int = 0,
@@ -701,13 +829,15 @@ class Scene:
 
     def render(self, sun, view="nadir", shape: Optional[Tuple[int, int]] = None, spp: int = 16,
                max_depth: int = 10, seed: int = 0, n_threads: Optional[int] = None,
-               max_memory=None, progress: Optional[bool] = None) -> np.ndarray:
+               max_memory=None, progress: Optional[bool] = None, sky: float = 0.0, psf="box",
+               psf_step: float = 1.0) -> np.ndarray:
         """Radiance image seen by an orthographic sensor.
 
         The tile's horizontal extent is divided into ``shape`` pixels; pixel
-        ``(i, j)`` (row 0 north) averages ``spp`` paths through uniform
-        points of its box footprint on the reference plane (the DEM's mean
-        height), traced as in ``brf``. Values are radiances for unit sun
+        ``(i, j)`` (row 0 north) averages ``spp`` paths through points of
+        the reference plane (the DEM's mean height) drawn from its
+        point-spread function ``psf`` (default: uniform over its box
+        footprint), traced as in ``brf``. Values are radiances for unit sun
         irradiance normal to the beam: ``pi * image.mean() / cos(sun
         zenith)`` estimates the BRF.
 
@@ -733,6 +863,25 @@ class Scene:
         progress : bool, optional
             A progress bar over the image rows on stderr (needs tqdm); the
             image does not depend on it.
+        sky : float
+            Irradiance of a uniform sky on a horizontal plane relative to
+            the sun's irradiance normal to the beam (>= 0, default 0). A
+            flat Lambertian plane then has ``L = rho (cos(sun zenith) + sky)
+            / pi``.
+        psf : "box", ("gaussian", sigma[, truncate]) or array_like
+            The sensor's point-spread function, over the reference plane
+            around the pixel's centre, in image pixels: ``"box"`` (uniform
+            over the pixel, the default); an isotropic Gaussian of standard
+            deviation ``sigma`` pixels truncated to the disc of radius
+            ``truncate * sigma`` (default ``truncate=4``); or a 2D array of
+            non-negative weights, piecewise constant on cells ``psf_step``
+            pixels wide centred on the pixel's centre (row 0 north). Each
+            path's footprint point is drawn from the PSF, so a pixel
+            estimates exactly the PSF-weighted mean radiance (footprints
+            may overlap neighbouring pixels; outside a finite patch nothing
+            is seen).
+        psf_step : float
+            Cell size of an array ``psf``, pixels (> 0).
 
         Returns
         -------
@@ -763,14 +912,105 @@ class Scene:
         check_memory(rows * cols * 4, "shape", max_memory=max_memory, what=f"a {rows} x {cols} float32 image")
         from fractalgeo_rs import _progress
 
-        args = (*self._args(), _direction(sun, "sun"), _direction(view, "view"), (rows, cols),
+        sky = _sky(sky)
+        kind, pparams, table = _psf(psf, psf_step)
+        sd = (_direction(sun, "sun"), _direction(view, "view"))
+        rest = (check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed))
+        nt = check_n_threads(n_threads)
+        with _progress.Steps(rows, "render", _progress.resolve(progress)) as steps:
+            if sky == 0.0 and kind == "box":
+                return steps.counted(lambda counter: _core.radiometry_render(
+                    *self._args(), *sd, (rows, cols), *rest, nt, progress=counter), rows)
+            return steps.counted(lambda counter: _core.radiometry_render_psf(
+                *self._args(), *sd, sky, (rows, cols), *rest, kind, pparams, table, nt, progress=counter), rows)
+
+    def render_perspective(self, sun, view=(135.0, 60.0), distance: Optional[float] = None, eye=None,
+                           target=None, fov: float = 40.0, shape: Tuple[int, int] = (240, 320), spp: int = 16,
+                           max_depth: int = 10, seed: int = 0, n_threads: Optional[int] = None, sky: float = 0.0,
+                           max_memory=None, progress: Optional[bool] = None) -> np.ndarray:
+        """Radiance image seen by a perspective (pinhole) camera: the 3D
+        view that ends figure 9 of the seed paper.
+
+        The camera looks at ``target`` (default the tile's centre at the
+        DEM's mean height) from ``eye``, or, without ``eye``, from
+        ``distance`` along the direction ``view`` (``(azimuth, zenith)``
+        from the target, as for the sun). Image rows go down and columns
+        right, the horizon horizontal. A periodic scene is seen as an
+        infinite surface; rays that miss the surface see the sky radiance
+        ``sky / pi`` above the horizon and 0 below it. Pixels are boxes of
+        ``spp`` jittered rays, each traced as in ``render``.
+
+        Parameters
+        ----------
+        sun : (float, float)
+            Direction towards the sun, ``(azimuth, zenith)`` in degrees.
+        view : (float, float)
+            Direction from the target towards the camera when ``eye`` is
+            not given.
+        distance : float, optional
+            Camera distance from the target (> 0), in the unit of the
+            heights; default 1.2 times the tile's diagonal.
+        eye, target : (float, float, float), optional
+            Positions in the scene's frame: ``x`` east and ``y`` north of
+            the DEM's first sample (the tile spans ``y`` from 0 to ``-rows
+            * dy``), ``z`` the height. The camera should be above the
+            surface.
+        fov : float
+            Vertical field of view, degrees in (0, 180).
+        shape : (int, int)
+            ``(rows, cols)`` of the image.
+        spp, max_depth, seed, n_threads, sky, max_memory, progress
+            As in ``render``.
+
+        Returns
+        -------
+        numpy.ndarray of float32, shape ``shape``
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from fractalgeo_rs.radiometry import Lambertian, Scene
+        >>> s = Scene.from_dem(np.zeros((4, 4)), material=Lambertian(1.0))
+        >>> img = s.render_perspective(sun=(0.0, 60.0), view=(180.0, 45.0), shape=(3, 4), spp=2)
+        >>> bool(np.allclose(img, 0.5 / np.pi))  # a flat plane: rho cos(60) / pi everywhere
+        True
+
+        References
+        ----------
+        M. Pharr, W. Jakob and G. Humphreys, *Physically Based Rendering*,
+        3rd ed., 2016 (the pinhole camera). M. Datcu and K. Seidel, 1995
+        (see ``Scene``), figure 9.
+        """
+        try:
+            rows, cols = shape
+        except (TypeError, ValueError):
+            raise TypeError(f"shape: expected (rows, cols), got {shape!r}") from None
+        rows, cols = check_positive_int(rows, "shape"), check_positive_int(cols, "shape")
+        check_memory(rows * cols * 4, "shape", max_memory=max_memory, what=f"a {rows} x {cols} float32 image")
+        dx, dy = self.cell_size
+        cells = self.dem.shape if self.periodic else (self.dem.shape[0] - 1, self.dem.shape[1] - 1)
+        w, h = cells[1] * dx, cells[0] * dy
+        tgt = _point(target, "target") if target is not None else (0.5 * w, -0.5 * h, float(self.dem.mean()))
+        if eye is None:
+            az, zen = _direction(view, "view")
+            dist = 1.2 * math.hypot(w, h) if distance is None else check_positive_float(distance, "distance")
+            a, z = math.radians(az), math.radians(zen)
+            e = (tgt[0] + dist * math.sin(a) * math.sin(z), tgt[1] + dist * math.cos(a) * math.sin(z),
+                 tgt[2] + dist * math.cos(z))
+        else:
+            e = _point(eye, "eye")
+        if isinstance(fov, bool) or not isinstance(fov, numbers.Real) or not 0.0 < float(fov) < 180.0:
+            raise ValueError(f"fov: expected a field of view in (0, 180) degrees, got {fov!r}")
+        from fractalgeo_rs import _progress
+
+        args = (*self._args(), _direction(sun, "sun"), _sky(sky), e, tgt, float(fov), (rows, cols),
                 check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed), check_n_threads(n_threads))
         with _progress.Steps(rows, "render", _progress.resolve(progress)) as steps:
-            return steps.counted(lambda counter: _core.radiometry_render(*args, progress=counter), rows)
+            return steps.counted(lambda counter: _core.radiometry_render_perspective(*args, progress=counter), rows)
 
     def brf_sweep(self, sun_zenith=PAPER_SUN_ZENITHS, view_zenith=(0.0,), sun_azimuth: float = 0.0,
                   view_azimuth: float = 0.0, spp: int = 65536, max_depth: int = 10, seed: int = 0,
-                  n_threads: Optional[int] = None, progress: Optional[bool] = None) -> BrfSweep:
+                  n_threads: Optional[int] = None, progress: Optional[bool] = None, sky: float = 0.0) -> BrfSweep:
         """BRF over every pair of sun and view zenith angles.
 
         One ``brf`` per pair (each with the same ``seed``: common random
@@ -792,6 +1032,9 @@ class Scene:
             As in ``brf``.
         progress : bool, optional
             A progress bar over the angle pairs on stderr (needs tqdm).
+        sky : float
+            Horizontal irradiance of a uniform sky, as in ``brf`` (the
+            values are then HDRFs).
 
         Returns
         -------
@@ -818,14 +1061,19 @@ class Scene:
         az_v = _azimuth(view_azimuth, "view_azimuth")
         spp = check_positive_int(spp, "spp")
         depth, seed, n_threads = _depth(max_depth), _seed(seed), check_n_threads(n_threads)
+        sky = _sky(sky)
         value = np.empty((suns.size, views.size))
         se = np.empty_like(value)
         args = self._args()
         with _progress.bar(suns.size * views.size, "brf", _progress.resolve(progress)) as bar:
             for i, zs in enumerate(suns):
                 for j, zv in enumerate(views):
-                    value[i, j], se[i, j], _ = _core.radiometry_brf(
-                        *args, (az_s, float(zs)), (az_v, float(zv)), spp, depth, seed, n_threads)
+                    if sky > 0.0:
+                        value[i, j], se[i, j], _ = _core.radiometry_brf_sky(
+                            *args, (az_s, float(zs)), (az_v, float(zv)), sky, spp, depth, seed, n_threads)
+                    else:
+                        value[i, j], se[i, j], _ = _core.radiometry_brf(
+                            *args, (az_s, float(zs)), (az_v, float(zv)), spp, depth, seed, n_threads)
                     bar.update(1)
         return BrfSweep(suns, views, az_s, az_v, value, se, spp)
 
