@@ -348,7 +348,12 @@ def analyse_padded(z, half, block, levels, r_floor, step=R.STEP, n_threads=None)
     # H on the nodes of the kernel's tables (201 in [0.01, 0.99], steps of
     # 0.0049): the kernel then redoes its table lookup only where H changes.
     q = (LEVEL_H[1] - LEVEL_H[0]) / (H_TABLE_NODES - 1)
-    level_h = LEVEL_H[0] + np.rint((level_h - LEVEL_H[0]) / q) * q
+    # (in place: the same operations as ``lo + rint((h - lo) / q) * q``)
+    level_h -= LEVEL_H[0]
+    level_h /= q
+    np.rint(level_h, out=level_h)
+    level_h *= q
+    level_h += LEVEL_H[0]
     # Counts over the nodes whose pixel lies in the block's core.
     ar = (k0r + np.arange(nd["r"].shape[0])) * step
     ac = (k0c + np.arange(nd["r"].shape[1])) * step
