@@ -81,20 +81,33 @@ def model_table(block, lags=LAGS):
     return rr, hh, np.stack(cols, 1)
 
 
+def lag_weights(lags):
+    """Weights of the lags in the fit, ``1 / k`` normalised: the sampling
+    variance of a window's log mean squared increment grows about linearly
+    with the lag (increments of lag ``k`` are correlated over ``k`` cells,
+    so a window holds about ``1 / k`` as many independent ones), so this is
+    the inverse-variance (weighted least squares) weighting."""
+    w = 1.0 / np.asarray(lags, dtype=float)
+    return w / w.sum()
+
+
 @functools.lru_cache(maxsize=8)
 def _tree(block, lags=LAGS):
     from scipy.spatial import cKDTree
 
     _, _, ls = model_table(block, lags)
-    return cKDTree(ls - ls.mean(1, keepdims=True))
+    w = lag_weights(lags)
+    return cKDTree((ls - (ls * w).sum(1, keepdims=True)) * np.sqrt(w))
 
 
 def fit(logd, block, lags=LAGS):
-    """Least-squares fit of the model's shape to log structure functions
-    ``logd`` (``(..., len(lags))``, amplitude free): ``(r, H, log_shape)``
-    of the nearest model of the grid in the centred log space."""
+    """Weighted least-squares fit of the model's shape to log structure
+    functions ``logd`` (``(..., len(lags))``, amplitude free; weights
+    :func:`lag_weights`): ``(r, H, log_shape)`` of the nearest model of the
+    grid in the weighted, centred log space."""
     rr, hh, ls = model_table(block, lags)
-    q = logd - logd.mean(-1, keepdims=True)
+    w = lag_weights(lags)
+    q = (logd - (logd * w).sum(-1, keepdims=True)) * np.sqrt(w)
     flat = q.reshape(-1, len(lags))
     idx = np.zeros(flat.shape[0], dtype=np.intp)
     ok = np.isfinite(flat).all(1)
