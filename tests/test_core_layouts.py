@@ -96,6 +96,8 @@ CASES = {
     "resample_node_variograms": (IMG, lambda a: _core.resample_node_variograms(a, 4, 8, [1, 2, 4, 8])),
     "resample_interp_nodes": (IMG[:8, :4].reshape(2, 4, 4),
                               lambda a: _core.resample_interp_nodes(a, 1, 1, (24, 24), 8, 8)),
+    "resample_local_amplitude": (IMG, lambda a: _core.resample_local_amplitude(
+        a, np.ones((a.shape[0] - 8, a.shape[1] - 8)), 4)),
     "tin_delaunay": (rng.random((60, 3)), lambda a: _core.tin_delaunay(a)),
     "tin_greedy": (IMG[:20, :17].copy(), lambda a: _core.tin_greedy(a, 0.5)),
     "tin_grid": (rng.random((60, 2)) * 10, lambda a: _core.tin_grid(

@@ -64,6 +64,7 @@ __all__ = [
     "resample_local_maps",
     "resample_node_variograms",
     "resample_interp_nodes",
+    "resample_local_amplitude",
     "RESAMPLE_HALO",
     "tin_delaunay",
     "tin_greedy",
@@ -475,6 +476,12 @@ def resample_interp_nodes(
     shape: Tuple[int, int],
     t: int,
     step: int,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.float64]: ...
+def resample_local_amplitude(
+    dem: npt.NDArray[np.float64],
+    d1: npt.NDArray[np.float64],
+    t: int,
     n_threads: Optional[int] = None,
 ) -> npt.NDArray[np.float64]: ...
 def tin_delaunay(

@@ -267,6 +267,30 @@ fn resample_interp_nodes<'py>(
     array3(py, (m, or, oc), out)
 }
 
+/// The local amplitude factor of the scale-aware model's detail at the
+/// pixels of a NaN-padded block without a border of `t` cells:
+/// `sqrt(g / d1)`, `g` the mean squared lag-1 increment of the 3 x 3 cells
+/// around each pixel, `d1` the window's (`(rows - 2t, cols - 2t)`); 1 where
+/// not finite.
+#[pyfunction]
+#[pyo3(signature = (dem, d1, t, n_threads=None))]
+fn resample_local_amplitude<'py>(
+    py: Python<'py>,
+    dem: PyReadonlyArray2<'py, f64>,
+    d1: PyReadonlyArray2<'py, f64>,
+    t: usize,
+    n_threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let z = c_order(&dem);
+    let d = c_order(&d1);
+    let shape = z.rows_cols();
+    let out = run(py, n_threads, || {
+        model_nodes::local_amplitude(&z.data, shape, t, &d.data)
+    })?;
+    let (or, oc) = (shape.0.saturating_sub(2 * t), shape.1.saturating_sub(2 * t));
+    array2(py, (or, oc), out)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(hillshade_f64, m)?)?;
     m.add_function(wrap_pyfunction!(shade_to_byte, m)?)?;
@@ -276,6 +300,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(resample_local_maps, m)?)?;
     m.add_function(wrap_pyfunction!(resample_node_variograms, m)?)?;
     m.add_function(wrap_pyfunction!(resample_interp_nodes, m)?)?;
+    m.add_function(wrap_pyfunction!(resample_local_amplitude, m)?)?;
     m.add("RESAMPLE_HALO", resample::HALO)?;
     Ok(())
 }

@@ -334,6 +334,93 @@ pub fn interp_nodes(
     Ok(out)
 }
 
+/// Squared increment `(b - a)^2`, or `None` when it is not finite (a hole).
+#[inline]
+fn sq(a: f64, b: f64) -> Option<f64> {
+    let d = b - a;
+    let d = d * d;
+    d.is_finite().then_some(d)
+}
+
+/// The local amplitude factor of the detail at the pixels `t .. rows - t`,
+/// `t .. cols - t` of a NaN-padded block `z` (`t >= 1`): `sqrt(g / d1)`,
+/// `g` the mean squared lag-1 increment (rows and columns, finite pairs)
+/// over the 12 increments with both ends in the 3 x 3 cells around the
+/// pixel and `d1` the window's (`(rows - 2t, cols - 2t)`, row-major); 1
+/// where that is not finite. The sums are formed in the order of the numpy
+/// reference (`_resample_model.local_amplitude_reference`): vertical
+/// increments `((v(i-1, j-1) + v(i, j-1)) + (v(i-1, j) + v(i, j))) +
+/// (v(i-1, j+1) + v(i, j+1))`, then the horizontal ones likewise, so the
+/// bits are the reference's for any block and thread count.
+pub fn local_amplitude(
+    z: &[f64],
+    (rows, cols): (usize, usize),
+    t: usize,
+    d1: &[f64],
+) -> CoreResult<Vec<f64>> {
+    if z.len() != rows * cols {
+        return Err(CoreError::Internal("dem shape".into()));
+    }
+    if t == 0 || rows < 2 * t || cols < 2 * t {
+        return Err(CoreError::invalid(
+            "t",
+            format!("expected 1 <= t <= half the block {rows} x {cols}, got {t}"),
+        ));
+    }
+    let (or, oc) = (rows - 2 * t, cols - 2 * t);
+    if d1.len() != or * oc {
+        return Err(CoreError::invalid(
+            "d1",
+            format!("expected {or} x {oc} values, got {}", d1.len()),
+        ));
+    }
+    let mut out = try_zeroed(or * oc, "dem")?;
+    if or == 0 || oc == 0 {
+        return Ok(out);
+    }
+    out.par_chunks_mut(oc).enumerate().for_each_init(
+        || (vec![0.0; oc + 2], vec![0u8; oc + 2]),
+        |(vs, vc), (oi, orow)| {
+            let i = oi + t; // pixel row in z
+            let row = |r: usize| &z[r * cols + t - 1..r * cols + t + oc + 1];
+            let (a0, a1, a2) = (row(i - 1), row(i), row(i + 1));
+            // vs[c] = v(i-1, c) + v(i, c) over the columns t-1 .. t+oc+1
+            for c in 0..oc + 2 {
+                let (x, nx) = match sq(a0[c], a1[c]) {
+                    Some(d) => (d, 1u8),
+                    None => (0.0, 0),
+                };
+                let (y, ny) = match sq(a1[c], a2[c]) {
+                    Some(d) => (d, 1u8),
+                    None => (0.0, 0),
+                };
+                vs[c] = x + y;
+                vc[c] = nx + ny;
+            }
+            // horizontal: ((h(i-1, j) + h(i-1, j+1)) + (h(i, j) + h(i, j+1))) +
+            // (h(i+1, j) + h(i+1, j+1)), h(r, c) = (z[r, c+1] - z[r, c])^2
+            for (j, o) in orow.iter_mut().enumerate() {
+                let vsum = (vs[j] + vs[j + 1]) + vs[j + 2];
+                let vn = vc[j] as u32 + vc[j + 1] as u32 + vc[j + 2] as u32;
+                let mut hsum = 0.0;
+                let mut hn = 0u32;
+                for (k, a) in [a0, a1, a2].iter().enumerate() {
+                    let x = sq(a[j], a[j + 1]);
+                    let y = sq(a[j + 1], a[j + 2]);
+                    let part = x.unwrap_or(0.0) + y.unwrap_or(0.0);
+                    hn += x.is_some() as u32 + y.is_some() as u32;
+                    hsum = if k == 0 { part } else { hsum + part };
+                }
+                let n = vn + hn;
+                let g = (vsum + hsum) / n as f64;
+                let m = (g / d1[oi * oc + j]).sqrt();
+                *o = if m.is_finite() { m } else { 1.0 };
+            }
+        },
+    );
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -60,6 +60,8 @@ pub const H_MIN: f64 = 0.01;
 /// Upper end of the `H` tables.
 pub const H_MAX: f64 = 0.99;
 const N_FULL: usize = 201;
+/// `1 / (H_MAX - H_MIN)`.
+const INV_H_SPAN: f64 = 1.0 / (H_MAX - H_MIN);
 const N_PARTIAL: usize = 41;
 const NS: usize = 16;
 
@@ -349,16 +351,21 @@ impl Table {
     #[inline]
     fn node(&self, h: f64) -> Option<usize> {
         let n = self.entries.len();
-        let t = ((h.clamp(H_MIN, H_MAX) - H_MIN) / (H_MAX - H_MIN)) * (n - 1) as f64;
-        let k = t.round();
-        ((t - k).abs() < 1e-9).then_some(k as usize)
+        // Multiplication by the constant reciprocal (no division): the
+        // 1e-9 tolerance absorbs the last-bit difference.
+        let t = (h.clamp(H_MIN, H_MAX) - H_MIN) * ((n - 1) as f64 * INV_H_SPAN);
+        // t >= 0: a truncating cast instead of `round` (a libm call
+        // without SSE4.1); the same node within the tolerance.
+        let k = (t + 0.5) as usize;
+        ((t - k as f64).abs() < 1e-9).then_some(k)
     }
     /// Interpolated weights and standard deviation at `h`.
     #[inline]
     fn at(&self, h: f64) -> ([f64; NP], f64) {
         let n = self.entries.len();
         let t = ((h.clamp(H_MIN, H_MAX) - H_MIN) / (H_MAX - H_MIN)) * (n - 1) as f64;
-        let k = (t.floor() as usize).min(n - 2);
+        // t >= 0: the truncating cast is the floor (no libm call).
+        let k = (t as usize).min(n - 2);
         let f = t - k as f64;
         let (a, b) = (&self.entries[k], &self.entries[k + 1]);
         let mut w = [0.0; NP];
@@ -799,7 +806,7 @@ fn level_point(
                     // Every stencil offset has |dr|, |dc| <= 3.
                     assert!(c0 >= 3 * fc + 3 && c0 + 3 * fc + 3 < len);
                     let mut acc = 0.0;
-                    for (w, &o) in pc.w.iter().zip(&offs) {
+                    for (w, &o) in pc.weights(full).iter().zip(&offs) {
                         let k = c0.wrapping_add_signed(o);
                         debug_assert!(k < len);
                         // SAFETY: k lies within 3 rows and 3 columns of c0,
@@ -817,7 +824,7 @@ fn level_point(
                         // bits: a tile's edge and the whole array agree).
                         let (w, sd) = if m == all {
                             pc.update(full, &node_hf, h, s);
-                            (pc.w, pc.sd)
+                            (*pc.weights(full), pc.sd)
                         } else {
                             match partial.map.get(&m) {
                                 Some(t) => {
@@ -875,6 +882,9 @@ fn draw(sd: f64, key: &StreamKey, g0: u64, g1: u64, gcols: u64, i: usize, j: usi
 /// `sigma` alone costs one product per sample).
 struct ParamCache {
     h: f64,
+    /// The table node of `h`, or `NO_NODE` (then `w` holds the
+    /// interpolated weights): a node's weights are read in place, not copied.
+    k: usize,
     w: [f64; NP],
     hf: f64,
     sd: f64,
@@ -886,6 +896,7 @@ impl ParamCache {
     fn new(detail: bool, scale: f64) -> Self {
         ParamCache {
             h: f64::NAN,
+            k: NO_NODE,
             w: [0.0; NP],
             hf: 0.0,
             sd: 0.0,
@@ -900,11 +911,12 @@ impl ParamCache {
                 // H on a node of the table (the estimated maps are rounded
                 // to them): its weights, and sd and power from the node.
                 Some(k) => {
-                    self.w = t.entries[k].w;
+                    self.k = k;
                     self.hf = node_hf[k];
                 }
                 None => {
                     let (w, sd) = t.at(h);
+                    self.k = NO_NODE;
                     self.w = w;
                     self.hf = h_factor(sd, h, self.scale);
                 }
@@ -917,11 +929,23 @@ impl ParamCache {
             s * self.hf
         };
     }
+    /// The weights of the last `update` (`t`: the table it was given).
+    #[inline]
+    fn weights<'t>(&'t self, t: &'t Table) -> &'t [f64; NP] {
+        if self.k == NO_NODE {
+            &self.w
+        } else {
+            &t.entries[self.k].w
+        }
+    }
     #[inline]
     fn noise(&self, key: &StreamKey, g0: u64, g1: u64, gcols: u64, i: usize, j: usize) -> f64 {
         draw(self.sd, key, g0, g1, gcols, i, j)
     }
 }
+
+/// `ParamCache::k` when `H` is not on a table node.
+const NO_NODE: usize = usize::MAX;
 
 /// One area-support level: `(r, c)` -> `(2r, 2c)`, block means kept.
 ///
@@ -1243,7 +1267,8 @@ impl AreaTable {
     pub fn at(&self, h: f64) -> AreaEntry {
         let n = self.entries.len();
         let t = ((h.clamp(H_MIN, H_MAX) - H_MIN) / (H_MAX - H_MIN)) * (n - 1) as f64;
-        let k = (t.floor() as usize).min(n - 2);
+        // t >= 0: the truncating cast is the floor (no libm call).
+        let k = (t as usize).min(n - 2);
         let f = t - k as f64;
         let (a, b) = (&self.entries[k], &self.entries[k + 1]);
         let mut e = *a;

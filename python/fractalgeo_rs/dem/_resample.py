@@ -54,10 +54,13 @@ class ResampleAnalysis:
         the constant-H fBm of lags 1-2 or the user's values) or
         ``"smooth"`` (the structure function with an inner scale of
         docs/resampling.md; ``hurst`` is then the fitted ``H`` of the
-        fractal regime and ``sigma`` the measured lag-1 increment sd).
+        fractal regime and ``sigma`` the level-0 increment scale: the
+        window's lag-1 increment sd times the local amplitude factor).
     level_hurst, level_sigma : ndarray of float64, shape (levels, rows, cols), or None
         The per-level exponent and increment scale the kernel draws level
-        ``l`` (coarse spacing ``2^-l`` input cells) with; None from
+        ``l`` (coarse spacing ``2^-l`` input cells) with (``"smooth"``: the
+        scale includes the local amplitude factor, the rms lag-1 increment
+        of the 3 x 3 cells around a sample over the window's); None from
         :func:`~fractalgeo_rs.dem.resample_analysis` without ``factor``.
     inner_scale : ndarray of float64, shape of the DEM, or None
         ``model="smooth"``: the fitted inner scale ``r`` (input cells;

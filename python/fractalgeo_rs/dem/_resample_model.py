@@ -81,20 +81,33 @@ def model_table(block, lags=LAGS):
     return rr, hh, np.stack(cols, 1)
 
 
+def lag_weights(lags):
+    """Weights of the lags in the fit, ``1 / k`` normalised: the sampling
+    variance of a window's log mean squared increment grows about linearly
+    with the lag (increments of lag ``k`` are correlated over ``k`` cells,
+    so a window holds about ``1 / k`` as many independent ones), so this is
+    the inverse-variance (weighted least squares) weighting."""
+    w = 1.0 / np.asarray(lags, dtype=float)
+    return w / w.sum()
+
+
 @functools.lru_cache(maxsize=8)
 def _tree(block, lags=LAGS):
     from scipy.spatial import cKDTree
 
     _, _, ls = model_table(block, lags)
-    return cKDTree(ls - ls.mean(1, keepdims=True))
+    w = lag_weights(lags)
+    return cKDTree((ls - (ls * w).sum(1, keepdims=True)) * np.sqrt(w))
 
 
 def fit(logd, block, lags=LAGS):
-    """Least-squares fit of the model's shape to log structure functions
-    ``logd`` (``(..., len(lags))``, amplitude free): ``(r, H, log_shape)``
-    of the nearest model of the grid in the centred log space."""
+    """Weighted least-squares fit of the model's shape to log structure
+    functions ``logd`` (``(..., len(lags))``, amplitude free; weights
+    :func:`lag_weights`): ``(r, H, log_shape)`` of the nearest model of the
+    grid in the weighted, centred log space."""
     rr, hh, ls = model_table(block, lags)
-    q = logd - logd.mean(-1, keepdims=True)
+    w = lag_weights(lags)
+    q = (logd - (logd * w).sum(-1, keepdims=True)) * np.sqrt(w)
     flat = q.reshape(-1, len(lags))
     idx = np.zeros(flat.shape[0], dtype=np.intp)
     ok = np.isfinite(flat).all(1)
@@ -268,7 +281,61 @@ def analyse_nodes(z, half, block, levels, r_floor=0.0, step=R.STEP, n_threads=No
     amp = np.where(np.isfinite(amp), amp, 0.0)
     lh, lsg = level_params(r, hfit, amp, levels)
     return dict(r=r, H=hfit, h12=h12, valid=valid, enough=enough, level_h=lh, level_s=lsg,
-                k0r=k0r, k0c=k0c)
+                d1=np.where(valid & np.isfinite(d1), d1, 0.0), k0r=k0r, k0c=k0c)
+
+
+def local_lag1(z, t):
+    """Mean squared lag-1 increment (rows and columns, pairs of finite
+    samples) over the increments with both ends in the 3 x 3 cells around
+    each pixel of the core ``z[t:-t, t:-t]`` of a NaN-padded block
+    (``t >= 1``); NaN where there is none. Each value is a fixed-order sum
+    of its own neighbourhood, so any block of a larger array gives the same
+    bits."""
+    a = z[t - 1:z.shape[0] - t + 1, t - 1:z.shape[1] - t + 1]
+    v = a[1:] - a[:-1]
+    v *= v
+    h = a[:, 1:] - a[:, :-1]
+    h *= h
+    vm = np.isfinite(v)
+    hm = np.isfinite(h)
+    v[~vm] = 0.0
+    h[~hm] = 0.0
+    # vertical increments of rows (i, i+1) and (i+1, i+2), columns j..j+2;
+    # horizontal of rows i..i+2, column pairs (j, j+1) and (j+1, j+2).
+    vs = v[:-1] + v[1:]
+    hs = h[:, :-1] + h[:, 1:]
+    tot = (vs[:, :-2] + vs[:, 1:-1] + vs[:, 2:]) + (hs[:-2] + hs[1:-1] + hs[2:])
+    vc = vm[:-1].astype(np.int8) + vm[1:]
+    hc = hm[:, :-1].astype(np.int8) + hm[:, 1:]
+    cnt = (vc[:, :-2] + vc[:, 1:-1] + vc[:, 2:]) + (hc[:-2] + hc[1:-1] + hc[2:])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return tot / cnt
+
+
+def local_amplitude_reference(z, t, d1_map):
+    """numpy twin of :func:`local_amplitude` (the same bits)."""
+    g = local_lag1(z, t)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        m = np.sqrt(g / d1_map)
+    return np.where(np.isfinite(m), m, 1.0)
+
+
+def local_amplitude(z, t, d1_map, n_threads=None):
+    """Factor on the detail's sd at each core pixel of a NaN-padded block:
+    ``sqrt(g_loc / g_win)``, the rms lag-1 increment of the 3 x 3 cells
+    around the pixel (:func:`local_lag1`) over the window's (``d1_map``,
+    the analysis window's mean squared lag-1 increment interpolated to the
+    pixels); 1 where either is missing (and where the window's is 0, whose
+    sigma is 0 anyway). Real relief is intermittent: its fine-scale detail
+    sits where the coarse DEM is locally rough (scarps, channel banks), not
+    spread evenly over the window (docs/resampling.md). The Rust kernel
+    (``_core.resample_local_amplitude``, the bits of
+    :func:`local_amplitude_reference` for any ``n_threads``)."""
+    from fractalgeo_rs import _core
+
+    return _core.resample_local_amplitude(np.asarray(z, dtype=np.float64),
+                                          np.ascontiguousarray(d1_map, dtype=np.float64), int(t),
+                                          n_threads)
 
 
 def analyse_padded(z, half, block, levels, r_floor, step=R.STEP, n_threads=None):
@@ -285,14 +352,21 @@ def analyse_padded(z, half, block, levels, r_floor, step=R.STEP, n_threads=None)
     shape = z.shape
     k0r, k0c = nd["k0r"], nd["k0c"]
     maps = interp_to_pixels(np.concatenate([nd["level_h"], nd["level_s"], nd["r"][None],
-                                            nd["H"][None]]), k0r, k0c, shape, t, step,
-                                 n_threads)
+                                            nd["H"][None], nd["d1"][None]]), k0r, k0c, shape, t,
+                            step, n_threads)
     lv = nd["level_h"].shape[0]
     level_h, level_s, r_map, h_map = maps[:lv], maps[lv:2 * lv], maps[2 * lv], maps[2 * lv + 1]
+    # The detail's amplitude follows the local relief (intermittency).
+    level_s *= local_amplitude(z, t, maps[2 * lv + 2], n_threads)[None]
     # H on the nodes of the kernel's tables (201 in [0.01, 0.99], steps of
     # 0.0049): the kernel then redoes its table lookup only where H changes.
     q = (LEVEL_H[1] - LEVEL_H[0]) / (H_TABLE_NODES - 1)
-    level_h = LEVEL_H[0] + np.rint((level_h - LEVEL_H[0]) / q) * q
+    # (in place: the same operations as ``lo + rint((h - lo) / q) * q``)
+    level_h -= LEVEL_H[0]
+    level_h /= q
+    np.rint(level_h, out=level_h)
+    level_h *= q
+    level_h += LEVEL_H[0]
     # Counts over the nodes whose pixel lies in the block's core.
     ar = (k0r + np.arange(nd["r"].shape[0])) * step
     ac = (k0c + np.arange(nd["r"].shape[1])) * step
