@@ -133,10 +133,13 @@ fn fast_acos(x: f64) -> f64 {
     let big = a > 0.5;
     let s = if big { ((1.0 - a) * 0.5).sqrt() } else { a };
     let z = s * s;
-    let mut h = ASIN_P[10];
-    for &c in ASIN_P[..10].iter().rev() {
-        h = h * z + c;
-    }
+    // Estrin's scheme: a short dependency chain (no FMA on the baseline target)
+    let c = &ASIN_P;
+    let (z2, z4) = (z * z, z * z * (z * z));
+    let r0 = (c[0] + c[1] * z) + (c[2] + c[3] * z) * z2;
+    let r1 = (c[4] + c[5] * z) + (c[6] + c[7] * z) * z2;
+    let r2 = (c[8] + c[9] * z) + c[10] * z2;
+    let h = r0 + r1 * z4 + r2 * (z4 * z4);
     let asn = s + s * z * h;
     let r = if big {
         2.0 * asn
@@ -316,7 +319,7 @@ pub struct Slant {
 
 /// Edges `(left, right)` of the footprint of pixel `j` of a line of slant
 /// positions: the midpoints to its neighbours (extrapolated at the ends).
-#[inline]
+#[inline(always)]
 fn footprint(p: &[f64], j: usize) -> (f64, f64) {
     let n = p.len();
     let pj = p[j];
@@ -353,7 +356,7 @@ fn ceil_nonneg(a: f64) -> usize {
 /// Add `v` spread uniformly over the half-open slant interval between `e0`
 /// and `e1` (either order) to `img`, and count the bins whose centre it
 /// covers in `cnt` (and in `lt` when `lit`).
-#[inline]
+#[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn deposit(img: &mut [f64], cnt: &mut [u32], lt: &mut [u32], e0: f64, e1: f64, v: f64, lit: bool) {
     let n_bins = img.len();

@@ -250,8 +250,12 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
 
     Parameters
     ----------
-    dem : array_like or xarray.DataArray, shape (rows, cols)
+    dem : array_like, dask.array.Array or xarray.DataArray, shape (rows, cols)
         Heights in metres, row 0 to the north. NaN = missing. Not modified.
+        A Dask array (or a DataArray of one) gives Dask outputs computed in
+        strips of whole range lines, equal to the numpy result bit for bit;
+        it needs a ``look_azimuth`` that is a multiple of 90, ``multilook=None``
+        and ``ground_range=True`` (else a ValueError saying why).
     cell_size : float, (float, float) or None
         Cell size (or (row, column) spacing) in metres; ``None`` reads it
         from a DataArray's coords, else a ValueError.
@@ -293,7 +297,8 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
     SARScene
         ``image``, ``sigma0`` (no speckle), ``layover`` and ``shadow`` masks,
         ``local_incidence``; with a DataArray DEM and ``ground_range``, the
-        images are DataArrays with its coords and attrs.
+        images are DataArrays with its coords and attrs; with a Dask DEM,
+        Dask arrays.
 
     References
     ----------
@@ -438,15 +443,15 @@ def _simulate_dask(z, dem, kind, dy, dx, look, inc, table, step, looks, seed, n_
     slant = (lo, math.ceil(span) + 1)
     table_l = table.tolist()
     n_lk = 0 if looks is None else looks
-    parts: list = [[] for _ in range(5)]
     dtypes = (np.float64, np.float64, np.float64, bool, bool)
+    tasks = []
     for a, b in zip(bounds[:-1], bounds[1:]):
         h0, h1 = max(a - 1, 0), min(b + 1, rows)
-        d = dask.delayed(_strip, nout=5)(zr[h0:h1], a - h0, b - h0, h0, d_range, d_az, inc, table_l, step,
-                                         n_lk, seed, slant, n_threads)
-        for k in range(5):
-            parts[k].append(da.from_delayed(d[k], shape=(b - a, cols), dtype=dtypes[k]))
-    theta_l, g_img, g_s0, g_lay, g_shd = (da.concatenate(p, axis=0) for p in parts)
+        tasks.append((dask.delayed(_strip, nout=5)(zr[h0:h1], a - h0, b - h0, h0, d_range, d_az, inc, table_l,
+                                                   step, n_lk, seed, slant, n_threads), b - a))
+    theta_l, g_img, g_s0, g_lay, g_shd = (
+        da.concatenate([da.from_delayed(d[k], shape=(n, cols), dtype=dtypes[k]) for d, n in tasks], axis=0)
+        for k in range(5))
     spacing = d_range * math.sin(math.radians(inc))
     return _to_ground(g_img, g_s0, g_lay, g_shd, theta_l, None, dem, kind, look, None, dy, dx, spacing)
 
