@@ -266,6 +266,7 @@ pub fn geometry(
         ));
     }
     let prm = Params::new(dx, dy, incidence, table, table_step);
+    let (lo, n_bins) = slant_axis(z, cols, &prm)?;
     let n = rows * cols;
     let mut theta = vec![0.0; n];
     let mut power = vec![0.0; n];
@@ -280,29 +281,13 @@ pub fn geometry(
         .for_each(|(r, (((th, pw), ps), fl))| {
             geometry_row(z, rows, cols, r, &prm, th, pw, ps, fl);
         });
-    let lo = pos
-        .iter()
-        .filter(|p| p.is_finite())
-        .fold(f64::INFINITY, |a, &b| a.min(b));
-    let hi = pos
-        .iter()
-        .filter(|p| p.is_finite())
-        .fold(f64::NEG_INFINITY, |a, &b| a.max(b));
-    let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (0.0, 0.0) };
-    let span = hi - lo;
-    if span > 1e9 {
-        return Err(CoreError::invalid(
-            "dem",
-            format!("the scene spans {span:.3e} slant-range bins: heights and cell_size in the same units?"),
-        ));
-    }
     pos.par_iter_mut().for_each(|p| *p -= lo);
     Ok(Geometry {
         theta_local: theta,
         power,
         position: pos,
         flags,
-        n_bins: span.ceil() as usize + 1,
+        n_bins,
     })
 }
 
@@ -315,6 +300,19 @@ pub struct Slant {
     pub count: Vec<u32>,
     /// Number of lit (non-shadowed, finite power > 0 or not) footprints covering it.
     pub lit: Vec<u32>,
+}
+
+/// The slant bin nearest to the position `p` (clamped to the axis).
+#[inline(always)]
+fn slant_bin(p: f64, n_bins: usize) -> usize {
+    ((p + 0.5).max(0.0) as usize).min(n_bins - 1)
+}
+
+/// Layover of a pixel whose bin has `count` footprints and whose flags are
+/// `flag`: more than one footprint, or active layover.
+#[inline(always)]
+fn in_layover(count: u32, flag: u8) -> bool {
+    count > 1 || flag & ACTIVE_LAYOVER != 0
 }
 
 /// Edges `(left, right)` of the footprint of pixel `j` of a line of slant
@@ -366,8 +364,8 @@ fn deposit(img: &mut [f64], cnt: &mut [u32], lt: &mut [u32], e0: f64, e1: f64, v
         return;
     }
     // the bin holding `a` (`a >= -0.5`: the cast is a floor)
-    let ka = ((a + 0.5) as usize).min(n_bins - 1);
-    let kb = ((b + 0.5) as usize).min(n_bins - 1);
+    let ka = slant_bin(a, n_bins);
+    let kb = slant_bin(b, n_bins);
     let len = b - a;
     if kb <= ka + 1 && len >= 1e-12 {
         // the common case, at most two bins: centres ka and kb counted when
@@ -439,7 +437,7 @@ fn project_row(p: &[f64], w: &[f64], l: &[u8], img: &mut [f64], cnt: &mut [u32],
     // pixels that fall in it (its geocoded value is defined)
     for j in 0..p.len() {
         if p[j].is_finite() {
-            let k = ((p[j] + 0.5).max(0.0) as usize).min(img.len() - 1);
+            let k = slant_bin(p[j], img.len());
             if cnt[k] == 0 {
                 cnt[k] = 1;
                 lt[k] = u32::from(l[j] & SHADOW == 0);
@@ -523,7 +521,7 @@ pub fn geocode(
     if slants.iter().any(|s| s.len() != rows * n_bins) || n_bins == 0 {
         return Err(CoreError::invalid("slant", "expected rows x n_bins images"));
     }
-    let bin = |p: f64| ((p + 0.5).max(0.0) as usize).min(n_bins - 1);
+    let bin = |p: f64| slant_bin(p, n_bins);
     let mut outs: Vec<Vec<f64>> = Vec::with_capacity(slants.len());
     for s in slants {
         let mut o = vec![0.0; n];
@@ -546,7 +544,7 @@ pub fn geocode(
         let f = &flags[r * cols..(r + 1) * cols];
         let c = &count[r * n_bins..(r + 1) * n_bins];
         for j in 0..cols {
-            o[j] = u8::from(p[j].is_finite() && (c[bin(p[j])] > 1 || f[j] & ACTIVE_LAYOVER != 0));
+            o[j] = u8::from(p[j].is_finite() && in_layover(c[bin(p[j])], f[j]));
         }
     });
     Ok((outs, lay))
@@ -682,7 +680,7 @@ pub fn scene_block(
     let mut sigma0 = vec![0.0; n];
     let mut layover = vec![0u8; n];
     let mut shadow = vec![0u8; n];
-    let bin = |p: f64| ((p + 0.5).max(0.0) as usize).min(n_bins - 1);
+    let bin = |p: f64| slant_bin(p, n_bins);
     theta
         .par_chunks_mut(cols)
         .zip(image.par_chunks_mut(cols))
@@ -732,7 +730,7 @@ pub fn scene_block(
                         let k = bin(p);
                         im[j] = spk[k];
                         s0[j] = img[k];
-                        lay[j] = u8::from(cnt[k] > 1 || fl[j] & ACTIVE_LAYOVER != 0);
+                        lay[j] = u8::from(in_layover(cnt[k], fl[j]));
                     } else {
                         im[j] = f64::NAN;
                         s0[j] = f64::NAN;
