@@ -427,10 +427,16 @@ def _simulate_dask(z, dem, kind, dy, dx, look, inc, table, step, looks, seed, n_
     with the speckle placed by the global line: the numpy result, bit for bit."""
     import dask
     import dask.array as da
+    import dask.utils
 
     zr = _TO_RANGE[look](z).rechunk({1: -1})  # whole range lines in every chunk
     d_range, d_az = (dx, dy) if look in (90, 270) else (dy, dx)
     rows, cols = zr.shape
+    # strips no taller than dask's chunk-size budget allows for float64 lines (the user's azimuth
+    # chunks otherwise; the result does not depend on them)
+    max_rows = max(1, dask.utils.parse_bytes(dask.config.get("array.chunk-size")) // (8 * cols))
+    if max(zr.chunks[0]) > max_rows:
+        zr = zr.rechunk({0: max_rows})
     bounds = np.concatenate([[0], np.cumsum(zr.chunks[0])]).astype(int)
     ext = dask.compute(*(dask.delayed(_extent)(b, d_range, inc, n_threads) for b in zr.to_delayed().ravel()))
     lo, hi = min(e[0] for e in ext), max(e[1] for e in ext)
