@@ -180,7 +180,8 @@ fn ziggurat_loop(mut bits: u64) -> f64 {
 /// Top 53 bits to (0, 1): (k + 0.5) / 2^53, never 0 or 1.
 #[inline(always)]
 pub fn bits_to_open_unit(bits: u64) -> f64 {
-    ((bits >> 11) as f64 + 0.5) * (1.0 / 9_007_199_254_740_992.0)
+    // `as i64`: the 53 bits fit, and a signed conversion is one instruction
+    ((bits >> 11) as i64 as f64 + 0.5) * (1.0 / 9_007_199_254_740_992.0)
 }
 
 /// Inverse of the standard normal CDF for p in (0, 1).

@@ -135,6 +135,7 @@ CASES = {
     "radar_geocode": (np.abs(IMG), lambda a: _core.radar_geocode(
         a, a + 1, (a > 1).astype(np.uint32) + 1, np.abs(IMG[:, :20]), (IMG[:, :20] > 0).astype(np.uint8) * 2)),
     "radar_scene": (IMG, lambda a: _core.radar_scene(a, 2.0, 1.5, 35.0, [1.0, 0.5, 0.2], 45.0, 3, 5)),
+    "radar_slant_extent": (IMG, lambda a: _core.radar_slant_extent(a, 2.0, 35.0)),
     "radiometry_brf": (IMG[:9, :7], lambda a: _core.radiometry_brf(
         a, (1.0, 2.0), False, "ne-sw", "lambertian", [0.5], (30.0, 40.0), (200.0, 20.0), 500, 3, 1)),
     "radiometry_albedo": (IMG[:9, :7], lambda a: _core.radiometry_albedo(

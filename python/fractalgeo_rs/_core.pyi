@@ -74,6 +74,7 @@ __all__ = [
     "radar_geometry",
     "radar_project",
     "radar_scene",
+    "radar_slant_extent",
     "speckle_f64",
     "radiometry_albedo",
     "radiometry_brf",
@@ -559,6 +560,8 @@ def radar_scene(
     looks: int,
     seed: int,
     n_threads: Optional[int] = None,
+    row0: int = 0,
+    slant: Optional[Tuple[float, int]] = None,
 ) -> Tuple[
     npt.NDArray[np.float64],
     npt.NDArray[np.float64],
@@ -566,6 +569,9 @@ def radar_scene(
     npt.NDArray[np.uint8],
     npt.NDArray[np.uint8],
 ]: ...
+def radar_slant_extent(
+    dem: npt.NDArray[np.float64], dx: float, incidence: float, n_threads: Optional[int] = None
+) -> Tuple[float, float]: ...
 # ---- radiometry ----
 
 def radiometry_brf(

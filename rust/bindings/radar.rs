@@ -159,8 +159,12 @@ fn radar_geocode<'py>(
 /// Geometry, projection, speckle and terrain geocoding fused per range
 /// line: `(theta_local, image, sigma0, layover, shadow)` on the DEM's grid
 /// (`looks` 0: no speckle).
+///
+/// A strip of whole range lines of a larger scene: `row0` the global index
+/// of its first line, `slant = (lo, n_bins)` the whole scene's slant axis
+/// (from `radar_slant_extent`).
 #[pyfunction]
-#[pyo3(signature = (dem, dx, dy, incidence, table, table_step, looks, seed, n_threads=None))]
+#[pyo3(signature = (dem, dx, dy, incidence, table, table_step, looks, seed, n_threads=None, row0=0, slant=None))]
 #[allow(clippy::type_complexity, clippy::too_many_arguments)]
 fn radar_scene<'py>(
     py: Python<'py>,
@@ -173,6 +177,8 @@ fn radar_scene<'py>(
     looks: u32,
     seed: u64,
     n_threads: Option<usize>,
+    row0: u64,
+    slant: Option<(f64, usize)>,
 ) -> PyResult<(
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<f64>>,
@@ -184,8 +190,8 @@ fn radar_scene<'py>(
     let (rows, cols) = a.rows_cols();
     let looks = (looks > 0).then_some(looks);
     let s = run(py, n_threads, || {
-        geometry::scene(
-            &a.data, rows, cols, dx, dy, incidence, &table, table_step, looks, seed,
+        geometry::scene_block(
+            &a.data, rows, cols, dx, dy, incidence, &table, table_step, looks, seed, row0, slant,
         )
     })?;
     Ok((
@@ -197,11 +203,36 @@ fn radar_scene<'py>(
     ))
 }
 
+/// The smallest and largest finite unshifted slant-range position (bins of
+/// `dx sin(incidence)`) of the lines of a DEM in the range frame, as
+/// `radar_scene` computes them (infinities when none is finite).
+#[pyfunction]
+#[pyo3(signature = (dem, dx, incidence, n_threads=None))]
+fn radar_slant_extent(
+    py: Python<'_>,
+    dem: PyReadonlyArray2<'_, f64>,
+    dx: f64,
+    incidence: f64,
+    n_threads: Option<usize>,
+) -> PyResult<(f64, f64)> {
+    let a = c_order(&dem);
+    let (_, cols) = a.rows_cols();
+    run(py, n_threads, || {
+        Ok(geometry::slant_extent(
+            &a.data,
+            cols,
+            dx,
+            geometry::cot_of(incidence),
+        ))
+    })
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(speckle_f64, m)?)?;
     m.add_function(wrap_pyfunction!(radar_geometry, m)?)?;
     m.add_function(wrap_pyfunction!(radar_project, m)?)?;
     m.add_function(wrap_pyfunction!(radar_geocode, m)?)?;
     m.add_function(wrap_pyfunction!(radar_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(radar_slant_extent, m)?)?;
     Ok(())
 }

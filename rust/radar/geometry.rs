@@ -52,19 +52,6 @@ pub struct Geometry {
     pub n_bins: usize,
 }
 
-/// sigma0 at `angle` degrees from a table sampled every `step` degrees from 0
-/// (linear interpolation, clamped at the table's ends).
-#[inline]
-fn lookup(table: &[f64], step: f64, angle: f64) -> f64 {
-    let x = (angle / step).max(0.0);
-    let i = x as usize; // floor: x >= 0 (a cast, not a libm call)
-    if i + 1 >= table.len() {
-        return table[table.len() - 1];
-    }
-    let f = x - i as f64;
-    table[i] * (1.0 - f) + table[i + 1] * f
-}
-
 fn check(z: &[f64], rows: usize, cols: usize, dx: f64, dy: f64, incidence: f64) -> CoreResult<()> {
     if rows * cols != z.len() || rows < 1 || cols < 2 {
         return Err(CoreError::invalid(
@@ -86,19 +73,10 @@ fn check(z: &[f64], rows: usize, cols: usize, dx: f64, dy: f64, incidence: f64) 
     Ok(())
 }
 
-/// Derivative along a line of samples `v` spaced `h` at index `i` (central
-/// inside, one-sided at the ends).
-#[inline]
-fn deriv(v: impl Fn(usize) -> f64, i: usize, n: usize, h: f64) -> f64 {
-    if n < 2 {
-        0.0
-    } else if i == 0 {
-        (v(1) - v(0)) / h
-    } else if i == n - 1 {
-        (v(n - 1) - v(n - 2)) / h
-    } else {
-        (v(i + 1) - v(i - 1)) / (2.0 * h)
-    }
+/// `cot(incidence)` as the kernels compute it (for [`slant_extent`]).
+pub fn cot_of(incidence: f64) -> f64 {
+    let (st, ct) = incidence.to_radians().sin_cos();
+    ct / st
 }
 
 /// Constants of the geometry at one incidence.
@@ -119,13 +97,59 @@ impl<'a> Params<'a> {
         Params {
             st,
             ct,
-            cot: ct / st,
+            cot: cot_of(incidence),
             tan_t: st / ct,
             dx,
             dy,
             table,
             step,
         }
+    }
+}
+
+/// Coefficients of `asin(s) = s + s z P(z)`, `z = s^2`, on `s` in [0, 1/2]
+/// (a least-squares fit on Chebyshev nodes of the Maclaurin series; the
+/// error of [`fast_acos`] is below 2e-15 rad, see its test).
+const ASIN_P: [f64; 11] = [
+    0.1666666666666696,
+    0.07499999999711905,
+    0.044642857597766865,
+    0.030381916507840744,
+    0.02237303550867808,
+    0.017336812498264156,
+    0.014144396614212894,
+    0.010270206855440509,
+    0.015511194143790765,
+    -0.00694636657411397,
+    0.027970731079700266,
+];
+
+/// `acos(x)` for `x` in [-1, 1] (NaN stays NaN) without a libm call:
+/// `pi/2 -+ asin(|x|)` for `|x| <= 1/2`, else `2 asin(sqrt((1 - |x|) / 2))`
+/// (Sterbenz: `1 - |x|` is exact there), `asin` from [`ASIN_P`].
+#[inline]
+fn fast_acos(x: f64) -> f64 {
+    let a = x.abs();
+    let big = a > 0.5;
+    let s = if big { ((1.0 - a) * 0.5).sqrt() } else { a };
+    let z = s * s;
+    // Estrin's scheme: a short dependency chain (no FMA on the baseline target)
+    let c = &ASIN_P;
+    let (z2, z4) = (z * z, z * z * (z * z));
+    let r0 = (c[0] + c[1] * z) + (c[2] + c[3] * z) * z2;
+    let r1 = (c[4] + c[5] * z) + (c[6] + c[7] * z) * z2;
+    let r2 = (c[8] + c[9] * z) + c[10] * z2;
+    let h = r0 + r1 * z4 + r2 * (z4 * z4);
+    let asn = s + s * z * h;
+    let r = if big {
+        2.0 * asn
+    } else {
+        std::f64::consts::FRAC_PI_2 - asn
+    };
+    if x < 0.0 {
+        std::f64::consts::PI - r
+    } else {
+        r
     }
 }
 
@@ -156,27 +180,42 @@ fn geometry_row(
     } else {
         None
     };
-    // the derivative across range lines: central inside, one-sided at the edges
-    let (lo_line, hi_line, hy) = match (up, down) {
-        (Some(u), Some(d)) => (u, d, 2.0 * p.dy),
-        (None, Some(d)) => (line, d, p.dy),
-        (Some(u), None) => (u, line, p.dy),
-        (None, None) => (line, line, p.dy),
+    // the derivative across range lines: central inside, one-sided at the
+    // edges (0 for a single line)
+    let (lo_line, hi_line, inv_hy) = match (up, down) {
+        (Some(u), Some(d)) => (u, d, 0.5 / p.dy),
+        (None, Some(d)) => (line, d, 1.0 / p.dy),
+        (Some(u), None) => (u, line, 1.0 / p.dy),
+        (None, None) => (line, line, 0.0),
     };
+    let single = up.is_none() && down.is_none();
+    let (inv_dx, inv_2dx) = (1.0 / dx, 0.5 / dx);
+    let cot_dx = cot / dx;
+    let dx_cot = dx * cot;
+    let inv_step = 1.0 / p.step;
+    let (table, last) = (p.table, p.table.len() - 1);
+    let to_deg = 180.0 / std::f64::consts::PI;
     let mut umax = f64::NEG_INFINITY;
     for j in 0..cols {
-        let zx = deriv(|i| line[i], j, cols, dx);
-        let zy = if rows < 2 {
+        let zx = if j == 0 {
+            (line[1] - line[0]) * inv_dx
+        } else if j == cols - 1 {
+            (line[j] - line[j - 1]) * inv_dx
+        } else {
+            (line[j + 1] - line[j - 1]) * inv_2dx
+        };
+        let zy = if single {
             0.0
         } else {
-            (hi_line[j] - lo_line[j]) / hy
+            (hi_line[j] - lo_line[j]) * inv_hy
         };
         let norm = (1.0 + zx * zx + zy * zy).sqrt();
         let c = ((ct + st * zx) / norm).clamp(-1.0, 1.0);
-        let angle = c.acos().to_degrees();
-        th[j] = if c.is_nan() { f64::NAN } else { angle };
-        ps[j] = j as f64 - line[j] * cot / dx;
-        let u = line[j] + j as f64 * dx * cot;
+        let angle = fast_acos(c) * to_deg;
+        th[j] = angle;
+        let zj = line[j];
+        ps[j] = j as f64 - zj * cot_dx;
+        let u = zj + j as f64 * dx_cot;
         // relative tolerance: a plane exactly at grazing slope is lit
         let tol = 1e-12 * (u.abs() + umax.abs().min(f64::MAX));
         let cast = u.is_finite() && umax > u + tol;
@@ -187,7 +226,17 @@ fn geometry_row(
         } else if shadow {
             0.0
         } else {
-            lookup(p.table, p.step, angle) * norm
+            // sigma0 at `angle` by linear interpolation in the table
+            // (clamped at its ends; `x >= 0`, the cast is a floor)
+            let x = (angle * inv_step).max(0.0);
+            let i = x as usize;
+            let s0 = if i >= last {
+                table[last]
+            } else {
+                let f = x - i as f64;
+                table[i] * (1.0 - f) + table[i + 1] * f
+            };
+            s0 * norm
         };
         if u > umax {
             umax = u;
@@ -217,6 +266,7 @@ pub fn geometry(
         ));
     }
     let prm = Params::new(dx, dy, incidence, table, table_step);
+    let (lo, n_bins) = slant_axis(z, cols, &prm)?;
     let n = rows * cols;
     let mut theta = vec![0.0; n];
     let mut power = vec![0.0; n];
@@ -231,29 +281,13 @@ pub fn geometry(
         .for_each(|(r, (((th, pw), ps), fl))| {
             geometry_row(z, rows, cols, r, &prm, th, pw, ps, fl);
         });
-    let lo = pos
-        .iter()
-        .filter(|p| p.is_finite())
-        .fold(f64::INFINITY, |a, &b| a.min(b));
-    let hi = pos
-        .iter()
-        .filter(|p| p.is_finite())
-        .fold(f64::NEG_INFINITY, |a, &b| a.max(b));
-    let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (0.0, 0.0) };
-    let span = hi - lo;
-    if span > 1e9 {
-        return Err(CoreError::invalid(
-            "dem",
-            format!("the scene spans {span:.3e} slant-range bins: heights and cell_size in the same units?"),
-        ));
-    }
     pos.par_iter_mut().for_each(|p| *p -= lo);
     Ok(Geometry {
         theta_local: theta,
         power,
         position: pos,
         flags,
-        n_bins: span.ceil() as usize + 1,
+        n_bins,
     })
 }
 
@@ -268,9 +302,22 @@ pub struct Slant {
     pub lit: Vec<u32>,
 }
 
+/// The slant bin nearest to the position `p` (clamped to the axis).
+#[inline(always)]
+fn slant_bin(p: f64, n_bins: usize) -> usize {
+    ((p + 0.5).max(0.0) as usize).min(n_bins - 1)
+}
+
+/// Layover of a pixel whose bin has `count` footprints and whose flags are
+/// `flag`: more than one footprint, or active layover.
+#[inline(always)]
+fn in_layover(count: u32, flag: u8) -> bool {
+    count > 1 || flag & ACTIVE_LAYOVER != 0
+}
+
 /// Edges `(left, right)` of the footprint of pixel `j` of a line of slant
 /// positions: the midpoints to its neighbours (extrapolated at the ends).
-#[inline]
+#[inline(always)]
 fn footprint(p: &[f64], j: usize) -> (f64, f64) {
     let n = p.len();
     let pj = p[j];
@@ -307,13 +354,40 @@ fn ceil_nonneg(a: f64) -> usize {
 /// Add `v` spread uniformly over the half-open slant interval between `e0`
 /// and `e1` (either order) to `img`, and count the bins whose centre it
 /// covers in `cnt` (and in `lt` when `lit`).
-#[inline]
+#[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn deposit(img: &mut [f64], cnt: &mut [u32], lt: &mut [u32], e0: f64, e1: f64, v: f64, lit: bool) {
     let n_bins = img.len();
     let (a, b) = if e0 <= e1 { (e0, e1) } else { (e1, e0) };
     let (a, b) = (a.max(-0.5), b.min(n_bins as f64 - 0.5));
     if b < a {
+        return;
+    }
+    // the bin holding `a` (`a >= -0.5`: the cast is a floor)
+    let ka = slant_bin(a, n_bins);
+    let kb = slant_bin(b, n_bins);
+    let len = b - a;
+    if kb <= ka + 1 && len >= 1e-12 {
+        // the common case, at most two bins: centres ka and kb counted when
+        // inside [a, b), the power split at the edge between the bins
+        let in_a = a <= ka as f64 && (ka as f64) < b;
+        cnt[ka] += u32::from(in_a);
+        lt[ka] += u32::from(in_a && lit);
+        if kb > ka {
+            let in_b = (kb as f64) < b;
+            cnt[kb] += u32::from(in_b);
+            lt[kb] += u32::from(in_b && lit);
+        }
+        if !(v.is_finite() && v != 0.0) {
+            return;
+        }
+        if kb == ka {
+            img[ka] += v;
+        } else {
+            let va = v * ((ka as f64 + 0.5) - a) / len;
+            img[ka] += va;
+            img[kb] += v * (b - (ka as f64 + 0.5)) / len;
+        }
         return;
     }
     // bins whose centre k lies in [a, b)
@@ -326,13 +400,11 @@ fn deposit(img: &mut [f64], cnt: &mut [u32], lt: &mut [u32], e0: f64, e1: f64, v
     if !(v.is_finite() && v != 0.0) {
         return;
     }
-    let len = b - a;
     if len < 1e-12 {
-        let k = ((a + 0.5).max(0.0) as usize).min(n_bins - 1);
-        img[k] += v;
+        img[ka] += v;
         return;
     }
-    let mut k = (a + 0.5).max(0.0) as usize;
+    let mut k = ka;
     while k < n_bins && (k as f64 - 0.5) < b {
         let lo = (k as f64 - 0.5).max(a);
         let hi = (k as f64 + 0.5).min(b);
@@ -365,7 +437,7 @@ fn project_row(p: &[f64], w: &[f64], l: &[u8], img: &mut [f64], cnt: &mut [u32],
     // pixels that fall in it (its geocoded value is defined)
     for j in 0..p.len() {
         if p[j].is_finite() {
-            let k = ((p[j] + 0.5).max(0.0) as usize).min(img.len() - 1);
+            let k = slant_bin(p[j], img.len());
             if cnt[k] == 0 {
                 cnt[k] = 1;
                 lt[k] = u32::from(l[j] & SHADOW == 0);
@@ -449,7 +521,7 @@ pub fn geocode(
     if slants.iter().any(|s| s.len() != rows * n_bins) || n_bins == 0 {
         return Err(CoreError::invalid("slant", "expected rows x n_bins images"));
     }
-    let bin = |p: f64| ((p + 0.5).max(0.0) as usize).min(n_bins - 1);
+    let bin = |p: f64| slant_bin(p, n_bins);
     let mut outs: Vec<Vec<f64>> = Vec::with_capacity(slants.len());
     for s in slants {
         let mut o = vec![0.0; n];
@@ -472,7 +544,7 @@ pub fn geocode(
         let f = &flags[r * cols..(r + 1) * cols];
         let c = &count[r * n_bins..(r + 1) * n_bins];
         for j in 0..cols {
-            o[j] = u8::from(p[j].is_finite() && (c[bin(p[j])] > 1 || f[j] & ACTIVE_LAYOVER != 0));
+            o[j] = u8::from(p[j].is_finite() && in_layover(c[bin(p[j])], f[j]));
         }
     });
     Ok((outs, lay))
@@ -493,6 +565,45 @@ pub struct Scene {
     pub shadow: Vec<u8>,
 }
 
+/// The slant-range axis of a scene, as in [`geometry`]: `(lo, n_bins)`, the
+/// smallest unshifted position and the number of bins from it.
+fn slant_axis(z: &[f64], cols: usize, prm: &Params) -> CoreResult<(f64, usize)> {
+    let (lo, hi) = slant_extent(z, cols, prm.dx, prm.cot);
+    let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (0.0, 0.0) };
+    let span = hi - lo;
+    if span > 1e9 {
+        return Err(CoreError::invalid(
+            "dem",
+            format!("the scene spans {span:.3e} slant-range bins: heights and cell_size in the same units?"),
+        ));
+    }
+    Ok((lo, span.ceil() as usize + 1))
+}
+
+/// The smallest and largest finite unshifted slant position `j - z cot / dx`
+/// of the rows of `z` (`cols` columns) at cotangent `cot` (infinities when
+/// none is finite); the positions of [`scene_block`]'s lines, bit for bit.
+pub fn slant_extent(z: &[f64], cols: usize, dx: f64, cot: f64) -> (f64, f64) {
+    let cot_dx = cot / dx;
+    z.par_chunks(cols.max(1))
+        .map(|line| {
+            let mut lo = f64::INFINITY;
+            let mut hi = f64::NEG_INFINITY;
+            for (j, &v) in line.iter().enumerate() {
+                let p = j as f64 - v * cot_dx;
+                if p.is_finite() {
+                    lo = lo.min(p);
+                    hi = hi.max(p);
+                }
+            }
+            (lo, hi)
+        })
+        .reduce(
+            || (f64::INFINITY, f64::NEG_INFINITY),
+            |a, b| (a.0.min(b.0), a.1.max(b.1)),
+        )
+}
+
 /// [`geometry`], [`project`], speckle ([`crate::radar::speckle::speckle`]
 /// of the slant image, `rows x n_bins`, origin `(0, 0)`) and [`geocode`]
 /// fused per range line: the same values, without the intermediate
@@ -511,6 +622,34 @@ pub fn scene(
     looks: Option<u32>,
     seed: u64,
 ) -> CoreResult<Scene> {
+    scene_block(
+        z, rows, cols, dx, dy, incidence, table, table_step, looks, seed, 0, None,
+    )
+}
+
+/// [`scene`] of a strip of whole range lines of a larger scene: `row0` is
+/// the global index of the strip's first line (it places the speckle draws)
+/// and `slant = Some((lo, n_bins))` fixes the slant-range axis to the whole
+/// scene's (the position `lo`, in bins of the unshifted axis, is bin 0;
+/// `None`: the strip's own extent, as [`scene`]). A strip computed with the
+/// whole scene's `(lo, n_bins)` and `row0`, and one line more on each side
+/// where the scene has them (for the derivative across lines), equals the
+/// same lines of the whole scene.
+#[allow(clippy::too_many_arguments)]
+pub fn scene_block(
+    z: &[f64],
+    rows: usize,
+    cols: usize,
+    dx: f64,
+    dy: f64,
+    incidence: f64,
+    table: &[f64],
+    table_step: f64,
+    looks: Option<u32>,
+    seed: u64,
+    row0: u64,
+    slant: Option<(f64, usize)>,
+) -> CoreResult<Scene> {
     check(z, rows, cols, dx, dy, incidence)?;
     if table.is_empty() || !(table_step.is_finite() && table_step > 0.0) {
         return Err(CoreError::invalid(
@@ -522,34 +661,18 @@ pub fn scene(
         return Err(CoreError::invalid("looks", "expected an integer >= 1"));
     }
     let prm = Params::new(dx, dy, incidence, table, table_step);
-    // the extent of the slant axis, as in `geometry`
-    let (lo, hi) = z
-        .par_chunks(cols)
-        .map(|line| {
-            let mut lo = f64::INFINITY;
-            let mut hi = f64::NEG_INFINITY;
-            for (j, &v) in line.iter().enumerate() {
-                let p = j as f64 - v * prm.cot / dx;
-                if p.is_finite() {
-                    lo = lo.min(p);
-                    hi = hi.max(p);
-                }
+    let (lo, n_bins) = match slant {
+        Some((lo, n_bins)) => {
+            if !lo.is_finite() || n_bins == 0 || n_bins > 1 << 31 {
+                return Err(CoreError::invalid(
+                    "slant",
+                    format!("expected a finite origin and 1..2^31 bins, got ({lo}, {n_bins})"),
+                ));
             }
-            (lo, hi)
-        })
-        .reduce(
-            || (f64::INFINITY, f64::NEG_INFINITY),
-            |a, b| (a.0.min(b.0), a.1.max(b.1)),
-        );
-    let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (0.0, 0.0) };
-    let span = hi - lo;
-    if span > 1e9 {
-        return Err(CoreError::invalid(
-            "dem",
-            format!("the scene spans {span:.3e} slant-range bins: heights and cell_size in the same units?"),
-        ));
-    }
-    let n_bins = span.ceil() as usize + 1;
+            (lo, n_bins)
+        }
+        None => slant_axis(z, cols, &prm)?,
+    };
     let key = crate::rng::StreamKey::new(seed, crate::radar::speckle::STREAM);
     let n = rows * cols;
     let mut theta = vec![0.0; n];
@@ -557,7 +680,7 @@ pub fn scene(
     let mut sigma0 = vec![0.0; n];
     let mut layover = vec![0u8; n];
     let mut shadow = vec![0u8; n];
-    let bin = |p: f64| ((p + 0.5).max(0.0) as usize).min(n_bins - 1);
+    let bin = |p: f64| slant_bin(p, n_bins);
     theta
         .par_chunks_mut(cols)
         .zip(image.par_chunks_mut(cols))
@@ -586,7 +709,7 @@ pub fn scene(
                 project_row(ps, pw, fl, img, cnt, lt);
                 match looks {
                     Some(l) => {
-                        let start = (r as u64).wrapping_mul(n_bins as u64);
+                        let start = (row0 + r as u64).wrapping_mul(n_bins as u64);
                         for (k, (o, &v)) in spk.iter_mut().zip(img.iter()).enumerate() {
                             *o = if v.is_nan() {
                                 f64::NAN
@@ -607,7 +730,7 @@ pub fn scene(
                         let k = bin(p);
                         im[j] = spk[k];
                         s0[j] = img[k];
-                        lay[j] = u8::from(cnt[k] > 1 || fl[j] & ACTIVE_LAYOVER != 0);
+                        lay[j] = u8::from(in_layover(cnt[k], fl[j]));
                     } else {
                         im[j] = f64::NAN;
                         s0[j] = f64::NAN;
@@ -629,6 +752,31 @@ pub fn scene(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fast_acos_matches_libm() {
+        let n = 2_000_000;
+        let mut worst = 0.0f64;
+        for i in 0..=n {
+            let x = -1.0 + 2.0 * i as f64 / n as f64;
+            worst = worst.max((fast_acos(x) - x.acos()).abs());
+        }
+        for x in [
+            -1.0,
+            -0.5,
+            0.0,
+            0.5,
+            1.0,
+            1e-300,
+            -1e-300,
+            0.5 + 1e-16,
+            1.0 - 1e-16,
+        ] {
+            worst = worst.max((fast_acos(x) - f64::acos(x)).abs());
+        }
+        assert!(worst < 2e-15, "{worst}");
+        assert!(fast_acos(f64::NAN).is_nan());
+    }
 
     fn plane(rows: usize, cols: usize, dx: f64, slope_deg: f64) -> Vec<f64> {
         let g = slope_deg.to_radians().tan();
@@ -782,5 +930,61 @@ mod tests {
         assert_eq!(sc.layover, lay);
         let shd: Vec<u8> = g.flags.iter().map(|f| f & SHADOW).collect();
         assert_eq!(sc.shadow, shd);
+    }
+
+    #[test]
+    fn strips_of_range_lines_equal_the_whole() {
+        let (rows, cols) = (11, 37);
+        let z: Vec<f64> = (0..rows * cols)
+            .map(|i| {
+                let (r, c) = ((i / cols) as f64, (i % cols) as f64);
+                20.0 * (0.4 * c).sin() * (0.3 * r).cos() + if i == 100 { f64::NAN } else { 0.0 }
+            })
+            .collect();
+        let table: Vec<f64> = (0..900).map(|i| (-(i as f64) / 300.0).exp()).collect();
+        let whole = scene(&z, rows, cols, 1.5, 2.0, 30.0, &table, 0.1, Some(2), 11).unwrap();
+        let (lo, hi) = slant_extent(&z, cols, 1.5, cot_of(30.0));
+        let axis = Some((lo, (hi - lo).ceil() as usize + 1));
+        // strips [a, b) computed with one line more on each side where there is one
+        for (a, b) in [(0, 4), (4, 5), (5, 11)] {
+            let (h0, h1) = (a.max(1) - 1, (b + 1).min(rows));
+            let blk = &z[h0 * cols..h1 * cols];
+            let s = scene_block(
+                blk,
+                h1 - h0,
+                cols,
+                1.5,
+                2.0,
+                30.0,
+                &table,
+                0.1,
+                Some(2),
+                11,
+                h0 as u64,
+                axis,
+            )
+            .unwrap();
+            let off = (a - h0) * cols;
+            let m = (b - a) * cols;
+            let same = |x: &[f64], y: &[f64]| {
+                x.iter()
+                    .zip(y)
+                    .all(|(p, q)| p.to_bits() == q.to_bits() || p.is_nan() && q.is_nan())
+            };
+            assert!(same(
+                &s.image[off..off + m],
+                &whole.image[a * cols..b * cols]
+            ));
+            assert!(same(
+                &s.sigma0[off..off + m],
+                &whole.sigma0[a * cols..b * cols]
+            ));
+            assert!(same(
+                &s.theta_local[off..off + m],
+                &whole.theta_local[a * cols..b * cols]
+            ));
+            assert_eq!(&s.layover[off..off + m], &whole.layover[a * cols..b * cols]);
+            assert_eq!(&s.shadow[off..off + m], &whole.shadow[a * cols..b * cols]);
+        }
     }
 }

@@ -37,13 +37,14 @@ _FROM_RANGE = {
 }
 
 
-_DASK_REFUSAL = (
-    "dem: simulate does not take Dask arrays: tiling is not exact. A radar shadow reaches "
-    "relief * tan(incidence) and layover relief * cot(incidence) along a range line (unbounded by the "
-    "chunk), the slant-range bins of a line start at its nearest point, and speckle is seeded by the "
-    "global slant bin, so a chunk's result depends on the whole range line. Pass a numpy array (or "
-    "dem.compute()), or split the scene into strips along azimuth yourself; fractalgeo_rs.radar.speckle "
-    "takes Dask arrays.")
+_DASK_ROTATED = (
+    "look_azimuth: with a Dask DEM, expected a multiple of 90 degrees (range lines along the grid's rows "
+    "or columns, so that strips of whole range lines are exact), got {!r}. Other azimuths resample the "
+    "whole scene onto a rotated grid: pass a numpy array (dem.compute()), or rotate the DEM yourself.")
+_DASK_SLANT = (
+    "{}: with a Dask DEM, simulate returns the terrain-geocoded scene only (ground_range=True, "
+    "multilook=None): the slant-range image and its block averages span the slant axis of the whole "
+    "scene. Pass a numpy array (dem.compute()) for them.")
 
 
 @dataclass(frozen=True)
@@ -249,8 +250,12 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
 
     Parameters
     ----------
-    dem : array_like or xarray.DataArray, shape (rows, cols)
+    dem : array_like, dask.array.Array or xarray.DataArray, shape (rows, cols)
         Heights in metres, row 0 to the north. NaN = missing. Not modified.
+        A Dask array (or a DataArray of one) gives Dask outputs computed in
+        strips of whole range lines, equal to the numpy result bit for bit;
+        it needs a ``look_azimuth`` that is a multiple of 90, ``multilook=None``
+        and ``ground_range=True`` (else a ValueError saying why).
     cell_size : float, (float, float) or None
         Cell size (or (row, column) spacing) in metres; ``None`` reads it
         from a DataArray's coords, else a ValueError.
@@ -292,7 +297,8 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
     SARScene
         ``image``, ``sigma0`` (no speckle), ``layover`` and ``shadow`` masks,
         ``local_incidence``; with a DataArray DEM and ``ground_range``, the
-        images are DataArrays with its coords and attrs.
+        images are DataArrays with its coords and attrs; with a Dask DEM,
+        Dask arrays.
 
     References
     ----------
@@ -315,12 +321,9 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
     (True, False, False)
     """
     kind = array_kind(dem)
-    if kind == "dask":
-        raise TypeError(_DASK_REFUSAL)
     data = dem.data if kind == "xarray" else dem
-    if array_kind(data) == "dask":
-        raise TypeError(_DASK_REFUSAL)
-    z = check_real_array(data, "dem")
+    lazy = array_kind(data) == "dask"
+    z = data if lazy else check_real_array(data, "dem")
     if z.ndim != 2 or min(z.shape) < 2:
         raise ValueError(f"dem: expected a 2D array of at least 2 x 2, got shape {z.shape}")
     if z.dtype.kind not in "iuf":
@@ -355,6 +358,14 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
         warnings.warn(f"simulate: model={model!r} is outside its range of validity at incidence {inc:g}: "
                       f"{val.ranges[model]}; here k*sigma = {val.k_sigma:.3g}, k*l = {val.k_l:.3g}, "
                       f"rms slope = {val.rms_slope:.3g}", RadarValidityWarning, stacklevel=user_stacklevel())
+    if lazy:
+        if look is None:
+            raise ValueError(_DASK_ROTATED.format(look_azimuth))
+        if ml is not None:
+            raise ValueError(_DASK_SLANT.format("multilook"))
+        if not ground_range:
+            raise ValueError(_DASK_SLANT.format("ground_range"))
+        return _simulate_dask(z, dem, kind, dy, dx, look, inc, table, step, looks, seed, n_threads)
     z64 = np.asarray(z, dtype=np.float64)
     frame = None
     if look is not None:
@@ -394,12 +405,69 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
                       frame, dy, dx, spacing)
 
 
+def _strip(block, lo_row, hi_row, row0, d_range, d_az, inc, table, step, looks, seed, slant, n_threads):
+    """``radar_scene`` of the range lines ``[lo_row, hi_row)`` of ``block`` (whole range lines, with the
+    neighbouring line on each side where the scene has one), placed at global line ``row0`` of the
+    block's first line on the whole scene's slant axis."""
+    zb = np.ascontiguousarray(check_real_array(block, "dem"), dtype=np.float64)
+    out = _core.radar_scene(zb, d_range, d_az, inc, table, step, looks, seed, n_threads, row0, slant)
+    theta_l, img, s0, lay, shd = (a[lo_row:hi_row] for a in out)
+    return theta_l, img, s0, lay.view(bool), shd.view(bool)
+
+
+def _extent(block, d_range, inc, n_threads):
+    return _core.radar_slant_extent(np.ascontiguousarray(check_real_array(block, "dem"), dtype=np.float64),
+                                    d_range, inc, n_threads)
+
+
+def _simulate_dask(z, dem, kind, dy, dx, look, inc, table, step, looks, seed, n_threads):
+    """:func:`simulate` of a Dask DEM: strips of whole range lines (the range axis rechunked to one
+    chunk, the azimuth chunks kept), each with one neighbouring line on each side for the derivative
+    across lines, on the slant axis of the whole scene (one pass over the DEM for its extent) and
+    with the speckle placed by the global line: the numpy result, bit for bit."""
+    import dask
+    import dask.array as da
+    import dask.utils
+
+    zr = _TO_RANGE[look](z).rechunk({1: -1})  # whole range lines in every chunk
+    d_range, d_az = (dx, dy) if look in (90, 270) else (dy, dx)
+    rows, cols = zr.shape
+    # strips no taller than dask's chunk-size budget allows for float64 lines (the user's azimuth
+    # chunks otherwise; the result does not depend on them)
+    max_rows = max(1, dask.utils.parse_bytes(dask.config.get("array.chunk-size")) // (8 * cols))
+    if max(zr.chunks[0]) > max_rows:
+        zr = zr.rechunk({0: max_rows})
+    bounds = np.concatenate([[0], np.cumsum(zr.chunks[0])]).astype(int)
+    ext = dask.compute(*(dask.delayed(_extent)(b, d_range, inc, n_threads) for b in zr.to_delayed().ravel()))
+    lo, hi = min(e[0] for e in ext), max(e[1] for e in ext)
+    if not math.isfinite(lo):
+        lo, hi = 0.0, 0.0
+    span = hi - lo
+    if span > 1e9:
+        raise ValueError(f"dem: the scene spans {span:.3e} slant-range bins: heights and cell_size in the "
+                         "same units?")
+    slant = (lo, math.ceil(span) + 1)
+    table_l = table.tolist()
+    n_lk = 0 if looks is None else looks
+    dtypes = (np.float64, np.float64, np.float64, bool, bool)
+    tasks = []
+    for a, b in zip(bounds[:-1], bounds[1:]):
+        h0, h1 = max(a - 1, 0), min(b + 1, rows)
+        tasks.append((dask.delayed(_strip, nout=5)(zr[h0:h1], a - h0, b - h0, h0, d_range, d_az, inc, table_l,
+                                                   step, n_lk, seed, slant, n_threads), b - a))
+    theta_l, g_img, g_s0, g_lay, g_shd = (
+        da.concatenate([da.from_delayed(d[k], shape=(n, cols), dtype=dtypes[k]) for d, n in tasks], axis=0)
+        for k in range(5))
+    spacing = d_range * math.sin(math.radians(inc))
+    return _to_ground(g_img, g_s0, g_lay, g_shd, theta_l, None, dem, kind, look, None, dy, dx, spacing)
+
+
 def _to_ground(g_img, g_s0, g_lay, g_shd, theta_l, z64, dem, kind, look, frame, dy, dx, spacing):
     """Range-frame images on the DEM's grid (DataArrays for a DataArray DEM)."""
     if look is not None:
         back = _FROM_RANGE[look]
-        out_img, out_s0, inc_map, lay, shd = (np.ascontiguousarray(back(a))
-                                              for a in (g_img, g_s0, theta_l, g_lay, g_shd))
+        keep = (lambda a: a) if array_kind(g_img) == "dask" else np.ascontiguousarray
+        out_img, out_s0, inc_map, lay, shd = (keep(back(a)) for a in (g_img, g_s0, theta_l, g_lay, g_shd))
     else:
         flat = _from_rotated(z64.shape, dy, dx, frame)
         out_img, out_s0, inc_map, lay, shd = (np.take(a.ravel(), flat) for a in (g_img, g_s0, theta_l, g_lay, g_shd))
