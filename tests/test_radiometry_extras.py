@@ -344,3 +344,14 @@ def test_perspective_bad_input():
         s.render_perspective(sun=(0.0, 30.0), eye=(1.0, 2.0))
     with pytest.raises(ValueError, match="distance"):
         s.render_perspective(sun=(0.0, 30.0), distance=-1.0)
+
+
+def test_huge_spp_is_a_memory_error_not_an_abort():
+    # the kernel keeps one partial sum per block of 1024 paths: spp = 2**62
+    # asked for 9e16 bytes and aborted the interpreter (Rust OOM) before
+    s = Scene.from_dem(np.zeros((4, 4)), material=Lambertian(0.5))
+    for call in (lambda: s.brf(sun=(0.0, 30.0), spp=2**62), lambda: s.albedo(sun=(0.0, 30.0), spp=2**62),
+                 lambda: s.bhr(spp=2**62), lambda: s.brf_sweep(sun_zenith=(0.0,), spp=2**62)):
+        with pytest.raises(MemoryError, match="spp"):
+            call()
+    assert s.brf(sun=(0.0, 30.0), spp=1000).value == pytest.approx(0.5)

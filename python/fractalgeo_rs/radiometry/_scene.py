@@ -473,6 +473,14 @@ def _depth(value) -> int:
     return d
 
 
+def _spp(value) -> int:
+    """Paths of one estimate; the kernel keeps one partial sum (24 bytes) per
+    block of 1024 paths, checked against the memory limit before the call."""
+    n = check_positive_int(value, "spp")
+    check_memory(-(-n // 1024) * 24, "spp", what=f"spp={n} paths (24 bytes per block of 1024)")
+    return n
+
+
 def _seed(value) -> int:
     if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not 0 <= int(value) < 2**64:
         raise ValueError(f"seed: expected an int in [0, 2**64), got {value!r}")
@@ -723,11 +731,11 @@ class Scene:
         sky = _sky(sky)
         if sky > 0.0:
             v, se, n = _core.radiometry_brf_sky(*args, _direction(sun, "sun"), _direction(view, "view"), sky,
-                                                check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed),
+                                                _spp(spp), _depth(max_depth), _seed(seed),
                                                 check_n_threads(n_threads))
             return Estimate(v, se, n)
         v, se, n = _core.radiometry_brf(*args, _direction(sun, "sun"), _direction(view, "view"),
-                                        check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed),
+                                        _spp(spp), _depth(max_depth), _seed(seed),
                                         check_n_threads(n_threads))
         return Estimate(v, se, n)
 
@@ -775,7 +783,7 @@ class Scene:
         albedo). F. E. Nicodemus et al., NBS Monograph 160, 1977
         (bi-hemispherical reflectance).
         """
-        v, se, n = _core.radiometry_bhr(*self._args(), check_positive_int(spp, "spp"), _depth(max_depth),
+        v, se, n = _core.radiometry_bhr(*self._args(), _spp(spp), _depth(max_depth),
                                         _seed(seed), check_n_threads(n_threads))
         return Estimate(v, se, n)
 
@@ -823,7 +831,7 @@ class Scene:
         83, 135-148, 2002, doi:10.1016/S0034-4257(02)00091-3.
         """
         v, se, n = _core.radiometry_albedo(*self._args(), _direction(sun, "sun"),
-                                           check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed),
+                                           _spp(spp), _depth(max_depth), _seed(seed),
                                            check_n_threads(n_threads))
         return Estimate(v, se, n)
 
@@ -1059,7 +1067,7 @@ class Scene:
         views = _angles(view_zenith, "view_zenith")
         az_s = _azimuth(sun_azimuth, "sun_azimuth")
         az_v = _azimuth(view_azimuth, "view_azimuth")
-        spp = check_positive_int(spp, "spp")
+        spp = _spp(spp)
         depth, seed, n_threads = _depth(max_depth), _seed(seed), check_n_threads(n_threads)
         sky = _sky(sky)
         value = np.empty((suns.size, views.size))
