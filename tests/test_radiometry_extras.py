@@ -355,3 +355,30 @@ def test_huge_spp_is_a_memory_error_not_an_abort():
         with pytest.raises(MemoryError, match="spp"):
             call()
     assert s.brf(sun=(0.0, 30.0), spp=1000).value == pytest.approx(0.5)
+
+
+def test_perspective_image_is_not_georeferenced(tmp_path):
+    # a camera view written with the DEM's transform scaled to the image was a
+    # wrong map; orthographic images keep theirs
+    pytest.importorskip("rasterio")
+    from affine import Affine
+
+    import fractalgeo_rs as fg
+
+    prof = {"crs": "EPSG:32633", "transform": Affine(30, 0, 500, 0, -30, 900)}
+    s = Scene.from_dem(np.zeros((4, 4)), profile=prof)
+    persp = s.render_perspective(sun=(0.0, 30.0), shape=(3, 5), spp=1)
+    ortho = s.render(sun=(0.0, 30.0), shape=(2, 2), spp=1)
+    s.save_image(tmp_path / "p.tif", persp)
+    s.save_image(tmp_path / "o.tif", ortho)
+    s.save_image(tmp_path / "p.png", persp)
+    s.save_image(tmp_path / "f.tif", persp, georeference=True)
+    s.save_image(tmp_path / "n.tif", ortho, georeference=False)
+    p, o = fg.read_raster(tmp_path / "p.tif")[1], fg.read_raster(tmp_path / "o.tif")[1]
+    assert p["crs"] is None and p["transform"] == Affine.identity()
+    assert o["crs"] is not None and tuple(o["transform"])[:6] == (60.0, 0.0, 515.0, 0.0, -60.0, 885.0)
+    assert not (tmp_path / "p.pgw").exists()
+    assert fg.read_raster(tmp_path / "f.tif")[1]["crs"] is not None
+    assert fg.read_raster(tmp_path / "n.tif")[1]["crs"] is None
+    with pytest.raises(TypeError, match="georeference"):
+        s.save_image(tmp_path / "x.tif", ortho, georeference="yes")

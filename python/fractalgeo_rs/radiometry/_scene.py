@@ -6,8 +6,9 @@ import math
 import numbers
 import os
 import warnings
+import weakref
 from dataclasses import dataclass
-from typing import List, Optional, Tuple, Union
+from typing import Dict, List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -569,6 +570,9 @@ class Scene:
     def __init__(self, dem: np.ndarray, cell_size: Tuple[float, float], periodic: bool, material: Material,
                  split: str, profile: Optional[dict] = None):
         self.profile = profile
+        # images returned by render_perspective (id -> weak reference): not maps, so
+        # save_image does not georeference them
+        self._perspective: Dict[int, weakref.ref] = {}
         self.dem = dem
         self.cell_size = cell_size
         self.periodic = periodic
@@ -1014,7 +1018,10 @@ class Scene:
         args = (*self._args(), _direction(sun, "sun"), _sky(sky), e, tgt, float(fov), (rows, cols),
                 check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed), check_n_threads(n_threads))
         with _progress.Steps(rows, "render", _progress.resolve(progress)) as steps:
-            return steps.counted(lambda counter: _core.radiometry_render_perspective(*args, progress=counter), rows)
+            img = steps.counted(lambda counter: _core.radiometry_render_perspective(*args, progress=counter), rows)
+        key = id(img)
+        self._perspective[key] = weakref.ref(img, lambda _r, k=key, d=self._perspective: d.pop(k, None))
+        return img
 
     def brf_sweep(self, sun_zenith=PAPER_SUN_ZENITHS, view_zenith=(0.0,), sun_azimuth: float = 0.0,
                   view_azimuth: float = 0.0, spp: int = 65536, max_depth: int = 10, seed: int = 0,
@@ -1127,7 +1134,7 @@ class Scene:
         cells = self.dem.shape if self.periodic else (self.dem.shape[0] - 1, self.dem.shape[1] - 1)
         return t * Affine.translation(0.5, 0.5) * Affine.scale(cells[1] / cols, cells[0] / rows)
 
-    def save_image(self, path, image, white: float = 1.0 / math.pi) -> None:
+    def save_image(self, path, image, white: float = 1.0 / math.pi, georeference: Optional[bool] = None) -> None:
         """Write a rendered image, atomically (temporary file and rename).
 
         The format follows the extension: ``.exr`` (float32 radiance, through
@@ -1147,6 +1154,11 @@ class Scene:
             PNG only: the radiance shown as 255 (> 0). The default ``1 / pi``
             is a white Lambertian plane with the sun at zenith, so a series
             of sun zeniths keeps one scale.
+        georeference : bool, optional
+            Write the CRS and ``image_transform`` (GeoTIFF, PNG world file).
+            Default: yes for an orthographic image of ``render``, no for an
+            image returned by ``render_perspective`` (a camera view is not a
+            map); False for any image that is not on the scene's grid.
 
         Returns
         -------
@@ -1176,8 +1188,13 @@ class Scene:
         if img.dtype.kind not in "iuf":
             raise TypeError(f"image: expected real radiances, got dtype {img.dtype}")
         ext = os.path.splitext(os.fspath(path))[1].lower()
-        t = self.image_transform(img.shape)
-        crs = (self.profile or {}).get("crs")
+        if georeference is None:
+            ref = self._perspective.get(id(image))
+            georeference = not (ref is not None and ref() is image)
+        elif not isinstance(georeference, (bool, np.bool_)):
+            raise TypeError(f"georeference: expected True, False or None, got {georeference!r}")
+        t = self.image_transform(img.shape) if georeference else None
+        crs = (self.profile or {}).get("crs") if georeference else None
         if ext == ".png":
             w = check_positive_float(white, "white")
             with np.errstate(invalid="ignore"):
