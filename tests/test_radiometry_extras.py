@@ -382,3 +382,7 @@ def test_perspective_image_is_not_georeferenced(tmp_path):
     assert fg.read_raster(tmp_path / "n.tif")[1]["crs"] is None
     with pytest.raises(TypeError, match="georeference"):
         s.save_image(tmp_path / "x.tif", ortho, georeference="yes")
+    import pickle
+
+    s2 = pickle.loads(pickle.dumps(s))  # still picklable after a perspective render
+    assert np.array_equal(s2.dem, s.dem) and s2.profile == s.profile

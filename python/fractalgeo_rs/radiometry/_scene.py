@@ -579,6 +579,16 @@ class Scene:
         self.material = material
         self.split = split
 
+    def __getstate__(self) -> dict:
+        # the perspective images' weak references are per process: not pickled
+        state = dict(self.__dict__)
+        state["_perspective"] = {}
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self.__dict__.setdefault("_perspective", {})
+
     def __repr__(self) -> str:
         return (f"Scene({self.dem.shape[0]} x {self.dem.shape[1]} heights, cell_size={self.cell_size}, "
                 f"periodic={self.periodic}, material={self.material!r}, split={self.split!r})")
