@@ -460,6 +460,12 @@ def test_cli_render_and_brf(tmp_path, capsys):
     assert cli.main(["render", str(tmp_path / "dem.npy"), str(out), "--sun", "0", "30", "--cell-size", "1",
                      "--material", "hapke:2"]) == 1
     assert "--material" in capsys.readouterr().err
+    # a wrong output name fails before the DEM is read and rendered (here the DEM does not even exist)
+    for bad in ("out.jpg", "no_such_dir/out.exr"):
+        assert cli.main(["render", str(tmp_path / "missing.npy"), str(tmp_path / bad), "--sun", "0", "30",
+                         "--cell-size", "1"]) == 1
+        err = capsys.readouterr().err
+        assert "output" in err and "missing.npy" not in err
 
 
 def test_specular_flat_mirror_reflects_the_fresnel_fraction():

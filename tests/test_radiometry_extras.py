@@ -344,3 +344,45 @@ def test_perspective_bad_input():
         s.render_perspective(sun=(0.0, 30.0), eye=(1.0, 2.0))
     with pytest.raises(ValueError, match="distance"):
         s.render_perspective(sun=(0.0, 30.0), distance=-1.0)
+
+
+def test_huge_spp_is_a_memory_error_not_an_abort():
+    # the kernel keeps one partial sum per block of 1024 paths: spp = 2**62
+    # asked for 9e16 bytes and aborted the interpreter (Rust OOM) before
+    s = Scene.from_dem(np.zeros((4, 4)), material=Lambertian(0.5))
+    for call in (lambda: s.brf(sun=(0.0, 30.0), spp=2**62), lambda: s.albedo(sun=(0.0, 30.0), spp=2**62),
+                 lambda: s.bhr(spp=2**62), lambda: s.brf_sweep(sun_zenith=(0.0,), spp=2**62)):
+        with pytest.raises(MemoryError, match="spp"):
+            call()
+    assert s.brf(sun=(0.0, 30.0), spp=1000).value == pytest.approx(0.5)
+
+
+def test_perspective_image_is_not_georeferenced(tmp_path):
+    # a camera view written with the DEM's transform scaled to the image was a
+    # wrong map; orthographic images keep theirs
+    pytest.importorskip("rasterio")
+    from affine import Affine
+
+    import fractalgeo_rs as fg
+
+    prof = {"crs": "EPSG:32633", "transform": Affine(30, 0, 500, 0, -30, 900)}
+    s = Scene.from_dem(np.zeros((4, 4)), profile=prof)
+    persp = s.render_perspective(sun=(0.0, 30.0), shape=(3, 5), spp=1)
+    ortho = s.render(sun=(0.0, 30.0), shape=(2, 2), spp=1)
+    s.save_image(tmp_path / "p.tif", persp)
+    s.save_image(tmp_path / "o.tif", ortho)
+    s.save_image(tmp_path / "p.png", persp)
+    s.save_image(tmp_path / "f.tif", persp, georeference=True)
+    s.save_image(tmp_path / "n.tif", ortho, georeference=False)
+    p, o = fg.read_raster(tmp_path / "p.tif")[1], fg.read_raster(tmp_path / "o.tif")[1]
+    assert p["crs"] is None and p["transform"] == Affine.identity()
+    assert o["crs"] is not None and tuple(o["transform"])[:6] == (60.0, 0.0, 515.0, 0.0, -60.0, 885.0)
+    assert not (tmp_path / "p.pgw").exists()
+    assert fg.read_raster(tmp_path / "f.tif")[1]["crs"] is not None
+    assert fg.read_raster(tmp_path / "n.tif")[1]["crs"] is None
+    with pytest.raises(TypeError, match="georeference"):
+        s.save_image(tmp_path / "x.tif", ortho, georeference="yes")
+    import pickle
+
+    s2 = pickle.loads(pickle.dumps(s))  # still picklable after a perspective render
+    assert np.array_equal(s2.dem, s.dem) and s2.profile == s.profile

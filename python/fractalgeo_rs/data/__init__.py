@@ -23,14 +23,24 @@ def _load(name: str):
     return np.load(os.path.join(_HERE, name), allow_pickle=False)
 
 
+def _ground_cell(a: float, e: float, lat: float) -> Tuple[float, float]:
+    """``(x, y)`` metres of a cell of ``a`` x ``e`` degrees at latitude ``lat``
+    on the WGS84 ellipsoid, as the CLI and ``hillshade`` convert geographic
+    grids (a degree of latitude is 111.1 km at 44 N, not the equator's
+    110.57 km)."""
+    from fractalgeo_rs.dem import metres_per_degree
+
+    m_lat, m_lon = metres_per_degree(lat)
+    return (float(abs(a) * m_lon), float(abs(e) * m_lat))
+
+
 def _srtm(key: str, description: str) -> Tuple[np.ndarray, Dict[str, Any]]:
     with _load("srtm_n44e007_crops.npz") as f:
         z = f[key].copy()
         r0, c0 = (int(v) for v in f[f"{key}_origin"])
         a, b, c, d, e, g = (float(v) for v in f["transform"])
     transform = (a, b, c + c0 * a, d, e, g + r0 * e)
-    lat = transform[5] + e * z.shape[0] / 2
-    cell = (abs(a) * 111_320.0 * np.cos(np.radians(lat)), abs(e) * 110_574.0)
+    cell = _ground_cell(a, e, transform[5] + e * z.shape[0] / 2)
     return z, {
         "description": description,
         "attribution": _SRTM,
@@ -145,8 +155,7 @@ def _sentinel1(key: str, pol: str) -> Tuple[np.ndarray, Dict[str, Any]]:
     with _load("s1_vega_baja_vv_vh_db.npz") as f:
         band = f[key].copy()
     a, e, f0 = _S1_TRANSFORM[0], _S1_TRANSFORM[4], _S1_TRANSFORM[5]
-    lat = f0 + e * band.shape[0] / 2
-    cell = (abs(a) * 111_320.0 * np.cos(np.radians(lat)), abs(e) * 110_574.0)
+    cell = _ground_cell(a, e, f0 + e * band.shape[0] / 2)
     return band, {
         "description": f"Sentinel-1 IW GRD sigma0 {pol} (dB), Vega Baja del Segura, Sept 2019 flood",
         "attribution": "Contains modified Copernicus Sentinel data 2019 (Sen1Floods11 sample)",

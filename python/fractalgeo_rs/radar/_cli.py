@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 
 import numpy as np
 
@@ -37,6 +38,10 @@ def _run_sar(args: argparse.Namespace) -> int:
     from fractalgeo_rs.io import read_raster, write_raster
     from fractalgeo_rs.radar import simulate, to_db
 
+    # checked before the simulation, not after it in write_raster
+    ext = os.path.splitext(str(args.output))[1].lower()
+    if ext not in (".tif", ".tiff", ".npy"):
+        raise ValueError(f"output: expected a .tif or .npy file name, got {str(args.output)!r}")
     z, prof = read_raster(args.dem, band=args.band)
     z = np.asarray(z, dtype=np.float64)
     cell = None
@@ -57,8 +62,11 @@ def _run_sar(args: argparse.Namespace) -> int:
         with np.errstate(divide="ignore"):
             img = np.where(img > 0, to_db(np.where(img > 0, img, 1.0)), np.nan)
     out = np.asarray(img, dtype=np.float32)
-    write_raster(args.output, out, crs=(prof or {}).get("crs"), transform=(prof or {}).get("transform"),
-                 nodata=float("nan") if str(args.output).lower().endswith((".tif", ".tiff")) else None)
+    if ext == ".npy":  # a bare array: no georeferencing to keep
+        write_raster(args.output, out)
+    else:
+        write_raster(args.output, out, crs=(prof or {}).get("crs"), transform=(prof or {}).get("transform"),
+                     nodata=float("nan"))
     print(f"sar: {z.shape[0]} x {z.shape[1]} DEM, incidence {args.incidence:g}, look azimuth "
           f"{args.look_azimuth:g}, {args.looks} looks: layover {100 * scene.layover.mean():.1f} %, "
           f"shadow {100 * scene.shadow.mean():.1f} % -> {args.output}")

@@ -92,6 +92,12 @@ class SARScene:
 def _cell_pair(cell_size, dem):
     if cell_size is None:
         if array_kind(dem) == "xarray":
+            from fractalgeo_rs.dem._resample import is_geographic_xarray
+
+            if is_geographic_xarray(dem):
+                raise ValueError("cell_size: the DataArray's coordinates are in degrees; pass cell_size in "
+                                 "metres, (row spacing, column spacing) (e.g. from "
+                                 "fractalgeo_rs.dem.metres_per_degree)")
             steps = []
             for dim in dem.dims[-2:]:
                 try:
@@ -217,7 +223,7 @@ def _from_rotated(shape, dy, dx, frame):
 
 
 def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model="kirchhoff",
-             permittivity=5 + 0.5j, rms_height=0.01, correlation_length=0.1, correlation="exponential",
+             permittivity=5 + 0.5j, rms_height=None, correlation_length=None, correlation="exponential",
              hurst=None, topothesy=None, polarization="vv", looks=1, seed=None, multilook=None, ground_range=True,
              n_threads=None):
     r"""Synthetic SAR intensity image of a DEM, with layover, shadow and speckle.
@@ -272,7 +278,10 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
     wavelength : float
         Metres (C band 0.056).
     model, permittivity, rms_height, correlation_length, correlation, hurst, topothesy, polarization
-        The facet backscatter, as in :func:`~fractalgeo_rs.radar.backscatter`.
+        The facet backscatter, as in :func:`~fractalgeo_rs.radar.backscatter`;
+        ``rms_height`` and ``correlation_length`` default to 0.01 m and
+        0.1 m for the Gaussian and exponential correlations, and are not
+        used with ``correlation="fbm"`` (``hurst`` and ``topothesy``).
     looks : int or None
         Looks of the speckle (1: single look); ``None``: no speckle.
     seed : int or None
@@ -329,6 +338,9 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
     if z.dtype.kind not in "iuf":
         raise TypeError(f"dem: expected a numeric array, got dtype {z.dtype}")
     dy, dx = _cell_pair(cell_size, dem)
+    if not (isinstance(correlation, str) and correlation == "fbm"):
+        rms_height = 0.01 if rms_height is None else rms_height
+        correlation_length = 0.1 if correlation_length is None else correlation_length
     azimuth, look = _look(look_azimuth)
     ml = _multilook(multilook)
     if isinstance(incidence, bool) or not isinstance(incidence, numbers.Real):

@@ -134,6 +134,14 @@ def _run_render(args: argparse.Namespace) -> int:
             raise ValueError(f"view: expected 'nadir' or AZIMUTH ZENITH in degrees, got {args.view}") from None
     else:
         raise ValueError(f"view: expected 'nadir' or AZIMUTH ZENITH in degrees, got {args.view}")
+    import os
+
+    # checked before the (possibly long) render, not after it in save_image
+    if os.path.splitext(args.output)[1].lower() not in (".exr", ".tif", ".tiff", ".png", ".npy"):
+        raise ValueError(f"output: expected a .exr, .tif, .png or .npy file name, got {args.output!r}")
+    parent = os.path.dirname(os.path.abspath(args.output))
+    if not os.path.isdir(parent):
+        raise ValueError(f"output: directory {parent!r} does not exist")
     scene = _scene(args)
     img = scene.render(sun=tuple(args.sun), view=view, shape=tuple(args.shape) if args.shape else None,
                        spp=args.spp, max_depth=args.max_depth, seed=args.seed, n_threads=args.n_threads,

@@ -6,8 +6,9 @@ import math
 import numbers
 import os
 import warnings
+import weakref
 from dataclasses import dataclass
-from typing import List, Optional, Tuple, Union
+from typing import Dict, List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -473,6 +474,14 @@ def _depth(value) -> int:
     return d
 
 
+def _spp(value) -> int:
+    """Paths of one estimate; the kernel keeps one partial sum (24 bytes) per
+    block of 1024 paths, checked against the memory limit before the call."""
+    n = check_positive_int(value, "spp")
+    check_memory(-(-n // 1024) * 24, "spp", what=f"spp={n} paths (24 bytes per block of 1024)")
+    return n
+
+
 def _seed(value) -> int:
     if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not 0 <= int(value) < 2**64:
         raise ValueError(f"seed: expected an int in [0, 2**64), got {value!r}")
@@ -561,11 +570,24 @@ class Scene:
     def __init__(self, dem: np.ndarray, cell_size: Tuple[float, float], periodic: bool, material: Material,
                  split: str, profile: Optional[dict] = None):
         self.profile = profile
+        # images returned by render_perspective (id -> weak reference): not maps, so
+        # save_image does not georeference them
+        self._perspective: Dict[int, weakref.ref] = {}
         self.dem = dem
         self.cell_size = cell_size
         self.periodic = periodic
         self.material = material
         self.split = split
+
+    def __getstate__(self) -> dict:
+        # the perspective images' weak references are per process: not pickled
+        state = dict(self.__dict__)
+        state["_perspective"] = {}
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self.__dict__.setdefault("_perspective", {})
 
     def __repr__(self) -> str:
         return (f"Scene({self.dem.shape[0]} x {self.dem.shape[1]} heights, cell_size={self.cell_size}, "
@@ -723,11 +745,11 @@ class Scene:
         sky = _sky(sky)
         if sky > 0.0:
             v, se, n = _core.radiometry_brf_sky(*args, _direction(sun, "sun"), _direction(view, "view"), sky,
-                                                check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed),
+                                                _spp(spp), _depth(max_depth), _seed(seed),
                                                 check_n_threads(n_threads))
             return Estimate(v, se, n)
         v, se, n = _core.radiometry_brf(*args, _direction(sun, "sun"), _direction(view, "view"),
-                                        check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed),
+                                        _spp(spp), _depth(max_depth), _seed(seed),
                                         check_n_threads(n_threads))
         return Estimate(v, se, n)
 
@@ -775,7 +797,7 @@ class Scene:
         albedo). F. E. Nicodemus et al., NBS Monograph 160, 1977
         (bi-hemispherical reflectance).
         """
-        v, se, n = _core.radiometry_bhr(*self._args(), check_positive_int(spp, "spp"), _depth(max_depth),
+        v, se, n = _core.radiometry_bhr(*self._args(), _spp(spp), _depth(max_depth),
                                         _seed(seed), check_n_threads(n_threads))
         return Estimate(v, se, n)
 
@@ -823,7 +845,7 @@ class Scene:
         83, 135-148, 2002, doi:10.1016/S0034-4257(02)00091-3.
         """
         v, se, n = _core.radiometry_albedo(*self._args(), _direction(sun, "sun"),
-                                           check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed),
+                                           _spp(spp), _depth(max_depth), _seed(seed),
                                            check_n_threads(n_threads))
         return Estimate(v, se, n)
 
@@ -1006,7 +1028,10 @@ class Scene:
         args = (*self._args(), _direction(sun, "sun"), _sky(sky), e, tgt, float(fov), (rows, cols),
                 check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed), check_n_threads(n_threads))
         with _progress.Steps(rows, "render", _progress.resolve(progress)) as steps:
-            return steps.counted(lambda counter: _core.radiometry_render_perspective(*args, progress=counter), rows)
+            img = steps.counted(lambda counter: _core.radiometry_render_perspective(*args, progress=counter), rows)
+        key = id(img)
+        self._perspective[key] = weakref.ref(img, lambda _r, k=key, d=self._perspective: d.pop(k, None))
+        return img
 
     def brf_sweep(self, sun_zenith=PAPER_SUN_ZENITHS, view_zenith=(0.0,), sun_azimuth: float = 0.0,
                   view_azimuth: float = 0.0, spp: int = 65536, max_depth: int = 10, seed: int = 0,
@@ -1059,7 +1084,7 @@ class Scene:
         views = _angles(view_zenith, "view_zenith")
         az_s = _azimuth(sun_azimuth, "sun_azimuth")
         az_v = _azimuth(view_azimuth, "view_azimuth")
-        spp = check_positive_int(spp, "spp")
+        spp = _spp(spp)
         depth, seed, n_threads = _depth(max_depth), _seed(seed), check_n_threads(n_threads)
         sky = _sky(sky)
         value = np.empty((suns.size, views.size))
@@ -1119,7 +1144,7 @@ class Scene:
         cells = self.dem.shape if self.periodic else (self.dem.shape[0] - 1, self.dem.shape[1] - 1)
         return t * Affine.translation(0.5, 0.5) * Affine.scale(cells[1] / cols, cells[0] / rows)
 
-    def save_image(self, path, image, white: float = 1.0 / math.pi) -> None:
+    def save_image(self, path, image, white: float = 1.0 / math.pi, georeference: Optional[bool] = None) -> None:
         """Write a rendered image, atomically (temporary file and rename).
 
         The format follows the extension: ``.exr`` (float32 radiance, through
@@ -1139,6 +1164,11 @@ class Scene:
             PNG only: the radiance shown as 255 (> 0). The default ``1 / pi``
             is a white Lambertian plane with the sun at zenith, so a series
             of sun zeniths keeps one scale.
+        georeference : bool, optional
+            Write the CRS and ``image_transform`` (GeoTIFF, PNG world file).
+            Default: yes for an orthographic image of ``render``, no for an
+            image returned by ``render_perspective`` (a camera view is not a
+            map); False for any image that is not on the scene's grid.
 
         Returns
         -------
@@ -1168,8 +1198,13 @@ class Scene:
         if img.dtype.kind not in "iuf":
             raise TypeError(f"image: expected real radiances, got dtype {img.dtype}")
         ext = os.path.splitext(os.fspath(path))[1].lower()
-        t = self.image_transform(img.shape)
-        crs = (self.profile or {}).get("crs")
+        if georeference is None:
+            ref = self._perspective.get(id(image))
+            georeference = not (ref is not None and ref() is image)
+        elif not isinstance(georeference, (bool, np.bool_)):
+            raise TypeError(f"georeference: expected True, False or None, got {georeference!r}")
+        t = self.image_transform(img.shape) if georeference else None
+        crs = (self.profile or {}).get("crs") if georeference else None
         if ext == ".png":
             w = check_positive_float(white, "white")
             with np.errstate(invalid="ignore"):
