@@ -354,6 +354,36 @@ def check_nodata(nodata) -> Optional[float]:
     return float(nodata)
 
 
+#: Values that DEM formats use for voids: SRTM's and GDAL's int16 ``-32768``
+#: and GDAL's float32 lowest (``-3.4028235e38``; anything below -1e30).
+VOID_SENTINEL = -32768.0
+
+
+def warn_void_sentinel(z, name: str = "dem", nodata=None, hint: str = "pass nodata=-32768") -> None:
+    """Warn when heights hold a void sentinel and ``nodata`` does not cover it.
+
+    SRTM and many GDAL int16 DEMs store voids as ``-32768`` and float DEMs as
+    the lowest float32; read without their nodata value they are taken as
+    real heights (a 30 km pit) and every result near them is garbage. One
+    ``RuntimeWarning`` names the parameter, the count and the remedy. Dask
+    arrays are not scanned (it would compute them)."""
+    if not isinstance(z, np.ndarray) or z.dtype.kind not in "iuf" or not z.size:
+        return
+    nd = None if nodata is None else float(nodata)
+    with np.errstate(invalid="ignore"):
+        lo = z.min()  # NaN when a NaN is present: then the cells are counted below
+    if lo > VOID_SENTINEL:
+        return
+    void = (z == VOID_SENTINEL) | (z < -1e30)
+    if nd is not None:
+        void &= z != nd
+    count = int(np.count_nonzero(void))
+    if count:
+        warnings.warn(f"{name}: {count} cell(s) hold a void value (-32768 or the lowest float32) that "
+                      f"no nodata covers; they are taken as real heights: {hint}",
+                      RuntimeWarning, stacklevel=user_stacklevel())
+
+
 def check_choice(value, name: str, choices) -> str:
     if value not in choices:
         opts = ", ".join(repr(c) for c in choices)

@@ -7,7 +7,14 @@ import numpy as np
 
 from fractalgeo_rs import _core
 from fractalgeo_rs._backend import array_kind, run_raster
-from fractalgeo_rs._validation import as_array, check_n_threads, check_nodata, check_real_array, check_z_factor
+from fractalgeo_rs._validation import (
+    as_array,
+    check_n_threads,
+    check_nodata,
+    check_real_array,
+    check_z_factor,
+    warn_void_sentinel,
+)
 
 __all__ = ["hillshade", "shade_to_byte", "metres_per_degree"]
 
@@ -176,6 +183,8 @@ def hillshade(dem, *, azimuth=315.0, altitude=45.0, cell_size=1.0, z_factor=1.0,
             raise TypeError(f"dem: complex data is not accepted (dtype {z.dtype}); pass a real array")
         raise TypeError(f"dem: expected a numeric array, got dtype {z.dtype}")
     nodata = check_nodata(nodata)
+    if not lazy:
+        warn_void_sentinel(z, "dem", nodata)
     for name, v in (("azimuth", azimuth), ("altitude", altitude)):
         if isinstance(v, bool) or not isinstance(v, numbers.Real) or not np.isfinite(v):
             raise ValueError(f"{name}: expected a finite number, got {v!r}")

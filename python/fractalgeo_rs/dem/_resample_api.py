@@ -9,7 +9,14 @@ import numbers
 
 from fractalgeo_rs._backend import array_kind
 from fractalgeo_rs._compat import renamed_parameters
-from fractalgeo_rs._validation import check_choice, check_n_threads, check_seed, check_window
+from fractalgeo_rs._validation import (
+    check_choice,
+    check_n_threads,
+    check_nodata,
+    check_seed,
+    check_window,
+    warn_void_sentinel,
+)
 from fractalgeo_rs.dem._resample import (
     cell_size_of,
     check_model,
@@ -201,6 +208,9 @@ def fractal_resample(dem, factor=2, *, hurst="local", sigma="local", window_size
     window = window_size
     if local_h or local_s:
         window = check_window(window_size, minimum=5, shape=np.shape(dem), cover=True)
+    heights = dem.data if array_kind(dem) == "xarray" else dem
+    if array_kind(heights) == "numpy":
+        warn_void_sentinel(np.asarray(heights), "dem", check_nodata(nodata))
     if array_kind(dem) == "xarray":
         return _run_xarray(dem, f, levels, hurst, sigma, window, detail, support, cell, nodata,
                            seed, n_threads, return_analysis, model, clip_min)

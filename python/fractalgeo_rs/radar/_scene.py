@@ -13,7 +13,7 @@ import numpy as np
 
 from fractalgeo_rs import _core
 from fractalgeo_rs._backend import array_kind
-from fractalgeo_rs._validation import check_n_threads, check_real_array
+from fractalgeo_rs._validation import check_n_threads, check_real_array, warn_void_sentinel
 from fractalgeo_rs._warn import user_stacklevel
 from fractalgeo_rs.radar._backscatter import MODELS, RadarValidityWarning, check_positive, backscatter, validity
 from fractalgeo_rs.radar._speckle import check_looks
@@ -337,6 +337,8 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
         raise ValueError(f"dem: expected a 2D array of at least 2 x 2, got shape {z.shape}")
     if z.dtype.kind not in "iuf":
         raise TypeError(f"dem: expected a numeric array, got dtype {z.dtype}")
+    if not lazy:
+        warn_void_sentinel(z, "dem", hint="set those cells to NaN or fill them before simulating")
     dy, dx = _cell_pair(cell_size, dem)
     if not (isinstance(correlation, str) and correlation == "fbm"):
         rms_height = 0.01 if rms_height is None else rms_height

@@ -16,6 +16,7 @@ from fractalgeo_rs._validation import (
     check_choice,
     check_n_threads,
     check_nodata,
+    warn_void_sentinel,
     check_positive_float,
     check_positive_int,
 )
@@ -390,6 +391,7 @@ def tin_from_dem(dem, *, max_error=None, max_triangles=None, transform=None, cel
         raise TypeError(f"dem: expected a real-valued array, got dtype {a.dtype}")
     z = np.array(a, dtype=np.float64, order="C", copy=True)
     nd = check_nodata(nodata)
+    warn_void_sentinel(a, "dem", nd)
     if nd is not None and not np.isnan(nd):
         z[z == nd] = np.nan
     if max_error is None:
