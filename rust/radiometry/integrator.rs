@@ -163,7 +163,7 @@ impl Scene {
             let (t, b) = basis(n);
             let wo = Self::local(n, t, b, -d);
             let cos_s = n.dot(s);
-            if cos_s > 0.0 && hf.intersect(p, s, Some(facet)).is_none() {
+            if cos_s > 0.0 && !hf.occluded(p, s, Some(facet), f64::INFINITY) {
                 let wi = Self::local(n, t, b, s);
                 l += throughput * self.material.eval(wi, wo) * cos_s;
             }
