@@ -2,7 +2,7 @@
 //!
 //! The scene is rebuilt from the DEM on every call (linear in the cells,
 //! negligible beside the rays), so nothing is kept between calls.
-use super::convert::{array1, array2, c_order, rows_in, run};
+use super::convert::{array1, array2, c_order, run};
 use super::progress::{counter, ProgressCounter};
 use crate::error::{CoreError, CoreResult};
 use crate::radiometry::{direction, material, Heightfield, Scene, Split};
@@ -161,8 +161,19 @@ fn ray_batch(
     directions: &PyReadonlyArray2<'_, f64>,
     skip: Option<&PyReadonlyArray1<'_, i64>>,
 ) -> PyResult<(Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<i64>)> {
-    let o: Vec<[f64; 3]> = rows_in(origins, "origins")?;
-    let d: Vec<[f64; 3]> = rows_in(directions, "directions")?;
+    let rows3 = |a: &PyReadonlyArray2<'_, f64>, name: &str| -> PyResult<Vec<[f64; 3]>> {
+        let c = c_order(a);
+        if c.shape[1] != 3 {
+            return Err(CoreError::invalid(
+                name,
+                format!("expected shape (n, 3), got {:?}", c.shape),
+            )
+            .into());
+        }
+        Ok(c.data.chunks_exact(3).map(|r| [r[0], r[1], r[2]]).collect())
+    };
+    let o = rows3(origins, "origins")?;
+    let d = rows3(directions, "directions")?;
     if d.len() != o.len() {
         return Err(CoreError::invalid(
             "directions",

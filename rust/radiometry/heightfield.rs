@@ -114,6 +114,26 @@ fn ifloor(v: f64) -> i64 {
     }
 }
 
+/// The larger of two finite values (one `maxsd`: no NaN handling).
+#[inline(always)]
+fn fmax(a: f64, b: f64) -> f64 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+/// The smaller of two finite values.
+#[inline(always)]
+fn fmin(a: f64, b: f64) -> f64 {
+    if a < b {
+        a
+    } else {
+        b
+    }
+}
+
 /// `i` modulo `n` in `0..n` (the division only when `i` is outside).
 #[inline(always)]
 fn wrap_index(i: i64, n: usize) -> usize {
@@ -221,14 +241,17 @@ impl Heightfield {
         } else {
             (rows - 1, cols - 1)
         };
-        let h = |r: usize, c: usize| z[(r % rows) * cols + (c % cols)];
+        // the sample after the last row (column) is the first (periodic)
+        let next = |i: usize, n: usize| if i + 1 == n { 0 } else { i + 1 };
         let mut cells: Vec<Cell> = crate::buffers::try_with_capacity(ncr * ncc, "dem")?;
         let (mut zmin, mut zmax) = (f64::INFINITY, f64::NEG_INFINITY);
         for r in 0..ncr {
+            let (top, bottom) = (&z[r * cols..(r + 1) * cols], &z[next(r, rows) * cols..][..cols]);
             for c in 0..ncc {
-                let cd = [h(r, c), h(r, c + 1), h(r + 1, c), h(r + 1, c + 1)];
-                zmin = zmin.min(cd[0].min(cd[1]).min(cd[2]).min(cd[3]));
-                zmax = zmax.max(cd[0].max(cd[1]).max(cd[2]).max(cd[3]));
+                let c1 = next(c, cols);
+                let cd = [top[c], top[c1], bottom[c], bottom[c1]];
+                zmin = fmin(zmin, fmin(fmin(cd[0], cd[1]), fmin(cd[2], cd[3])));
+                zmax = fmax(zmax, fmax(fmax(cd[0], cd[1]), fmax(cd[2], cd[3])));
                 cells.push(Cell(cd));
             }
         }
@@ -416,9 +439,9 @@ impl Heightfield {
     /// Index of a facet of the base tile, `2 (iy ncc + ix) + tri`, after
     /// moving it into the base tile (periodic).
     pub fn facet_index(&self, f: FacetId) -> i64 {
-        let ix = f.ix.rem_euclid(self.ncc as i64);
-        let iy = f.iy.rem_euclid(self.ncr as i64);
-        2 * (iy * self.ncc as i64 + ix) + f.tri as i64
+        let ix = wrap_index(f.ix, self.ncc);
+        let iy = wrap_index(f.iy, self.ncr);
+        (2 * (iy * self.ncc + ix)) as i64 + f.tri as i64
     }
 
     /// The facet of index `k` ([`Heightfield::facet_index`]); `None` for a
@@ -582,7 +605,7 @@ impl Heightfield {
         loop {
             let t_exit = tmx.min(tmy);
             let z_exit = o.z + t_exit * d.z;
-            if z_enter.min(z_exit) <= self.bmax[byw * self.nbc + bxw] {
+            if fmin(z_enter, z_exit) <= self.bmax[byw * self.nbc + bxw] {
                 let lo = (bx * bs, by * bs);
                 let mut hi = (lo.0 + bs - 1, lo.1 + bs - 1);
                 if !self.periodic {
@@ -669,7 +692,7 @@ impl Heightfield {
             let t_exit = tmx.min(tmy);
             let z_exit = o.z + t_exit * d.z;
             let cd = self.corners(cx, cy);
-            if z_enter.min(z_exit) <= cd[0].max(cd[1]).max(cd[2]).max(cd[3]) + self.zeps {
+            if fmin(z_enter, z_exit) <= fmax(fmax(cd[0], cd[1]), fmax(cd[2], cd[3])) + self.zeps {
                 if let Some((t, tri, b, c)) = self.test_cell::<ANY>(ray, ix, iy, &cd) {
                     return Walk::Hit(t, FacetId { ix, iy, tri }, b, c);
                 }
