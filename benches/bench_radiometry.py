@@ -125,13 +125,16 @@ def mitsuba_image_scene(mi, ply, z, cell, rho, sun_zen, shape, spp, max_depth):
 
 
 def ours_sweep(scene, target, depth, pilot=20_000):
-    """The nadir BRF at every zenith to a relative SE of ``target``: a pilot run, then the paths
-    it says are needed (at least the pilot's)."""
+    """The nadir BRF at every zenith to a relative SE of ``target``: a pilot run, then as many paths
+    as the last estimate says are needed, until its SE is at most ``target`` (the pilot's paths
+    are not reused; all runs are timed)."""
     out = []
     for zen in ZENITHS:
-        p = scene.brf(sun=(90.0, zen), spp=pilot, max_depth=depth, seed=3)
-        need = int(np.ceil(pilot * (p.se / (target * p.value)) ** 2 * 1.1))
-        out.append(scene.brf(sun=(90.0, zen), spp=max(need, pilot), max_depth=depth, seed=4))
+        e, seed = scene.brf(sun=(90.0, zen), spp=pilot, max_depth=depth, seed=3), 4
+        while e.se > target * e.value:
+            need = int(np.ceil(e.n * (e.se / (target * e.value)) ** 2 * 1.2))
+            e, seed = scene.brf(sun=(90.0, zen), spp=need, max_depth=depth, seed=seed), seed + 1
+        out.append(e)
     return out
 
 

@@ -186,9 +186,7 @@ fn ray_batch(
         return Err(CoreError::invalid("origins", "expected finite coordinates").into());
     }
     if bad(&d) || d.iter().any(|r| r == &[0.0; 3]) {
-        return Err(
-            CoreError::invalid("directions", "expected finite non-zero directions").into(),
-        );
+        return Err(CoreError::invalid("directions", "expected finite non-zero directions").into());
     }
     let k = match skip {
         Some(s) => {
@@ -196,7 +194,11 @@ fn ray_batch(
             if v.len() != o.len() {
                 return Err(CoreError::invalid(
                     "skip",
-                    format!("expected {} facet indices like origins, got {}", o.len(), v.len()),
+                    format!(
+                        "expected {} facet indices like origins, got {}",
+                        o.len(),
+                        v.len()
+                    ),
                 )
                 .into());
             }
@@ -213,7 +215,16 @@ fn heightfield(
     periodic: bool,
     split: &str,
 ) -> CoreResult<Heightfield> {
-    Ok(build(z.data.as_ref(), z.rows_cols(), cell_size, periodic, split, "lambertian", &[1.0])?.hf)
+    Ok(build(
+        z.data.as_ref(),
+        z.rows_cols(),
+        cell_size,
+        periodic,
+        split,
+        "lambertian",
+        &[1.0],
+    )?
+    .hf)
 }
 
 /// Nearest hits of rays with a DEM's facets: `(t, facet index, unit normal)`

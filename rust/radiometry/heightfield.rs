@@ -246,7 +246,10 @@ impl Heightfield {
         let mut cells: Vec<Cell> = crate::buffers::try_with_capacity(ncr * ncc, "dem")?;
         let (mut zmin, mut zmax) = (f64::INFINITY, f64::NEG_INFINITY);
         for r in 0..ncr {
-            let (top, bottom) = (&z[r * cols..(r + 1) * cols], &z[next(r, rows) * cols..][..cols]);
+            let (top, bottom) = (
+                &z[r * cols..(r + 1) * cols],
+                &z[next(r, rows) * cols..][..cols],
+            );
             for c in 0..ncc {
                 let c1 = next(c, cols);
                 let cd = [top[c], top[c1], bottom[c], bottom[c1]];
@@ -495,7 +498,12 @@ impl Heightfield {
 
     /// [`Heightfield::occluded`] of many rays in parallel (rayon), with no
     /// distance limit; arguments as in [`Heightfield::intersect_many`].
-    pub fn occluded_many(&self, origins: &[[f64; 3]], dirs: &[[f64; 3]], skip: &[i64]) -> Vec<bool> {
+    pub fn occluded_many(
+        &self,
+        origins: &[[f64; 3]],
+        dirs: &[[f64; 3]],
+        skip: &[i64],
+    ) -> Vec<bool> {
         use rayon::prelude::*;
         (0..origins.len())
             .into_par_iter()

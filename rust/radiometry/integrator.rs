@@ -88,7 +88,8 @@ const _: () = assert!(STRATA * STRATA == BLOCK);
 /// `(sum, sum of squares, n)`: full blocks are independent stratified
 /// samples, so the standard error comes from the spread of the block means
 /// (the per-path formula would overstate it); with fewer than 8 blocks, the
-/// per-path formula (conservative) is used.
+/// per-path formula (conservative) is used. The standard error is at least
+/// 1e-12 of the value (the rounding of the sums).
 fn finish_stratified(blocks: &[(f64, f64, u64)]) -> Estimate {
     let e = finish(blocks);
     let k = blocks.len();
@@ -102,8 +103,10 @@ fn finish_stratified(blocks: &[(f64, f64, u64)]) -> Estimate {
         v += (n as f64 * (m - e.value)).powi(2);
     }
     let var = v / (nf * nf) * k as f64 / (k as f64 - 1.0);
+    // when every block mean is the same (a closed-form case) what is left
+    // is the rounding of the sums: never report less than that
     Estimate {
-        se: var.sqrt(),
+        se: var.sqrt().max(1e-12 * e.value.abs()),
         ..e
     }
 }

@@ -176,7 +176,9 @@ fn traversal_case(rows: usize, cols: usize, bside: usize) {
                 (None, None) => {}
                 // the brute force sees only 13 x 13 tiles: a far hit it misses is fine
                 (Some(a), None) if periodic && a.t > 6.0 * 5.0 => {}
-                (a, b) => panic!("periodic={periodic} bside={bside} i={i}: {a:?} vs {b:?} o={o} d={d}"),
+                (a, b) => {
+                    panic!("periodic={periodic} bside={bside} i={i}: {a:?} vs {b:?} o={o} d={d}")
+                }
             }
         }
         assert!(hits > if periodic { 1000 } else { 300 }, "{hits}");
