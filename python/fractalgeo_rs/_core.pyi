@@ -77,6 +77,8 @@ __all__ = [
     "speckle_f64",
     "radiometry_albedo",
     "radiometry_brf",
+    "radiometry_intersect",
+    "radiometry_occluded",
     "radiometry_render",
     "radiometry_bhr",
     "radiometry_brf_sky",
@@ -582,6 +584,26 @@ def radiometry_brf(
     seed: int,
     n_threads: Optional[int] = None,
 ) -> Tuple[float, float, int]: ...
+def radiometry_intersect(
+    dem: npt.NDArray[np.float64],
+    cell_size: Tuple[float, float],
+    periodic: bool,
+    split: str,
+    origins: npt.NDArray[np.float64],
+    directions: npt.NDArray[np.float64],
+    skip: Optional[npt.NDArray[np.int64]] = None,
+    n_threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
+def radiometry_occluded(
+    dem: npt.NDArray[np.float64],
+    cell_size: Tuple[float, float],
+    periodic: bool,
+    split: str,
+    origins: npt.NDArray[np.float64],
+    directions: npt.NDArray[np.float64],
+    skip: Optional[npt.NDArray[np.int64]] = None,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.bool_]: ...
 def radiometry_albedo(
     dem: npt.NDArray[np.float64],
     cell_size: Tuple[float, float],

@@ -57,6 +57,7 @@ pub struct Scene {
 const TAG_BRF: u64 = 0x6272_6600_0000_0000;
 const TAG_ALBEDO: u64 = 0x616c_6200_0000_0000;
 const TAG_IMAGE: u64 = 0x696d_6700_0000_0000;
+const TAG_STRATA: u64 = 0x7374_7200_0000_0000;
 
 fn check_spp(spp: u64) -> CoreResult<()> {
     if spp == 0 {
@@ -76,6 +77,38 @@ fn check_depth(max_depth: u32) -> CoreResult<()> {
         ));
     }
     Ok(())
+}
+
+/// Strata of the BRF estimator: each full block of [`BLOCK`] paths puts one
+/// point in each of `STRATA x STRATA` equal cells of the tile.
+const STRATA: u64 = 32;
+const _: () = assert!(STRATA * STRATA == BLOCK);
+
+/// Mean and standard error of a stratified estimate from per-block
+/// `(sum, sum of squares, n)`: full blocks are independent stratified
+/// samples, so the standard error comes from the spread of the block means
+/// (the per-path formula would overstate it); with fewer than 8 blocks, the
+/// per-path formula (conservative) is used. The standard error is at least
+/// 1e-12 of the value (the rounding of the sums).
+fn finish_stratified(blocks: &[(f64, f64, u64)]) -> Estimate {
+    let e = finish(blocks);
+    let k = blocks.len();
+    if k < 8 {
+        return e;
+    }
+    let nf = e.n as f64;
+    let mut v = 0.0;
+    for &(s1, _, n) in blocks {
+        let m = s1 / n as f64;
+        v += (n as f64 * (m - e.value)).powi(2);
+    }
+    let var = v / (nf * nf) * k as f64 / (k as f64 - 1.0);
+    // when every block mean is the same (a closed-form case) what is left
+    // is the rounding of the sums: never report less than that
+    Estimate {
+        se: var.sqrt().max(1e-12 * e.value.abs()),
+        ..e
+    }
 }
 
 /// Mean and standard error from per-block `(sum, sum of squares, n)` added in order.
@@ -163,7 +196,7 @@ impl Scene {
             let (t, b) = basis(n);
             let wo = Self::local(n, t, b, -d);
             let cos_s = n.dot(s);
-            if cos_s > 0.0 && hf.intersect(p, s, Some(facet)).is_none() {
+            if cos_s > 0.0 && !hf.occluded(p, s, Some(facet), f64::INFINITY) {
                 let wi = Self::local(n, t, b, s);
                 l += throughput * self.material.eval(wi, wo) * cos_s;
             }
@@ -205,9 +238,16 @@ impl Scene {
             .map(|blk| {
                 let (mut s1, mut s2) = (0.0, 0.0);
                 let end = ((blk + 1) * BLOCK).min(spp);
+                // path j of the block takes stratum (797 j + b) mod 1024, an odd
+                // multiplier and a random offset per block: every stratum once
+                // in a full block, and each point uniform over the tile
+                let off = (StreamKey::new(seed, TAG_STRATA ^ blk).uniform(0) * BLOCK as f64) as u64;
                 for i in blk * BLOCK..end {
                     let key = StreamKey::new(seed, TAG_BRF ^ i);
-                    let (x, y) = (key.uniform(0) * w, -key.uniform(1) * h);
+                    let st = (797 * (i - blk * BLOCK) + off) % BLOCK;
+                    let (sx, sy) = ((st % STRATA) as f64, (st / STRATA) as f64);
+                    let x = (sx + key.uniform(0)) / STRATA as f64 * w;
+                    let y = -(sy + key.uniform(1)) / STRATA as f64 * h;
                     let o = self.sensor_ray(x, y, view);
                     let r = norm * self.radiance(o, view, sun, max_depth, key, 2);
                     s1 += r;
@@ -216,7 +256,7 @@ impl Scene {
                 (s1, s2, end - blk * BLOCK)
             })
             .collect();
-        Ok(finish(&blocks))
+        Ok(finish_stratified(&blocks))
     }
 
     /// Directional-hemispherical reflectance (black-sky albedo) for the sun
@@ -533,7 +573,7 @@ impl Scene {
             let (t, b) = basis(n);
             let wo = Self::local(n, t, b, -d);
             let cos_s = n.dot(s);
-            if cos_s > 0.0 && hf.intersect(p, s, Some(facet)).is_none() {
+            if cos_s > 0.0 && !hf.occluded(p, s, Some(facet), f64::INFINITY) {
                 let wi = Self::local(n, t, b, s);
                 l += throughput * self.material.eval(wi, wo) * cos_s;
             }
@@ -579,9 +619,13 @@ impl Scene {
             .map(|blk| {
                 let (mut s1, mut s2) = (0.0, 0.0);
                 let end = ((blk + 1) * BLOCK).min(spp);
+                let off = (StreamKey::new(seed, TAG_STRATA ^ blk).uniform(0) * BLOCK as f64) as u64;
                 for i in blk * BLOCK..end {
                     let key = StreamKey::new(seed, TAG_BRF ^ i);
-                    let (x, y) = (key.uniform(0) * w, -key.uniform(1) * h);
+                    let st = (797 * (i - blk * BLOCK) + off) % BLOCK;
+                    let (sx, sy) = ((st % STRATA) as f64, (st / STRATA) as f64);
+                    let x = (sx + key.uniform(0)) / STRATA as f64 * w;
+                    let y = -(sy + key.uniform(1)) / STRATA as f64 * h;
                     let o = self.sensor_ray(x, y, view);
                     let r = norm * self.radiance_sky(o, view, sun, sky_l, max_depth, key, 2);
                     s1 += r;
@@ -590,7 +634,7 @@ impl Scene {
                 (s1, s2, end - blk * BLOCK)
             })
             .collect();
-        Ok(finish(&blocks))
+        Ok(finish_stratified(&blocks))
     }
 
     /// [`Scene::render_progress`] with an isotropic sky of horizontal
