@@ -359,3 +359,81 @@ fn bad_meshes_and_materials_name_the_parameter() {
         .to_string();
     assert!(e.starts_with("materials:"), "{e}");
 }
+
+/// A two-sided leaf for the tests: reflectance `r` on the side the light
+/// comes from, transmittance `t` to the other, both Lambertian.
+#[derive(Debug)]
+struct TestLeaf {
+    r: f64,
+    t: f64,
+}
+
+impl Bsdf for TestLeaf {
+    fn eval(&self, wi: DVec3, wo: DVec3) -> f64 {
+        if wi.z * wo.z > 0.0 {
+            self.r / std::f64::consts::PI
+        } else {
+            self.t / std::f64::consts::PI
+        }
+    }
+    fn sample(&self, wo: DVec3, u: [f64; 2]) -> Option<material::BsdfSample> {
+        let p = self.r / (self.r + self.t);
+        let (reflect, u0) = if u[0] < p {
+            (true, u[0] / p)
+        } else {
+            (false, (u[0] - p) / (1.0 - p))
+        };
+        let mut wi = material::cosine_hemisphere([u0, u[1]]);
+        if !reflect {
+            wi.z = -wi.z;
+        }
+        let _ = wo;
+        let pdf = if reflect { p } else { 1.0 - p } * wi.z.abs() / std::f64::consts::PI;
+        Some(material::BsdfSample {
+            wi,
+            weight: self.r + self.t,
+            pdf,
+        })
+    }
+    fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
+        let p = self.r / (self.r + self.t);
+        let q = if wi.z * wo.z > 0.0 { p } else { 1.0 - p };
+        q * wi.z.abs() / std::f64::consts::PI
+    }
+    fn albedo(&self, _wo: DVec3) -> f64 {
+        self.r + self.t
+    }
+    fn transmits(&self) -> bool {
+        true
+    }
+}
+
+#[test]
+fn a_transmitting_leaf_layer_over_the_ground_matches_adding() {
+    // a horizontal leaf layer (r, t) 1 m above Lambertian ground (rho):
+    // BRF = albedo = r + t^2 rho / (1 - r rho) for every sun and view
+    // (diffuse adding of two layers); exercises transmitted sampling and
+    // next-event estimation through a leaf lit from behind
+    let leaf = tile_mesh(&[1.0; 16], 4, 4);
+    let ground = tile_mesh(&[0.0; 16], 4, 4);
+    let mut mesh = leaf.clone();
+    let k = mesh.vertices.len() as u32;
+    mesh.vertices.extend(&ground.vertices);
+    mesh.faces
+        .extend(ground.faces.iter().map(|f| f.map(|i| i + k)));
+    let ids: Vec<u32> = (0..mesh.faces.len())
+        .map(|i| (i >= leaf.faces.len()) as u32)
+        .collect();
+    let (r, t, rho) = (0.3, 0.5, 0.6);
+    let want = r + t * t * rho / (1.0 - r * rho);
+    let tr = MeshTracer::new(&mesh, true, tile_extent(4, 4)).unwrap();
+    let s = Scene::with_materials(tr, vec![Box::new(TestLeaf { r, t }), lam(rho)], ids).unwrap();
+    for (sun, view) in [((0.0, 0.0), (0.0, 0.0)), ((60.0, 50.0), (250.0, 35.0))] {
+        let e = s
+            .brf(dir(sun.0, sun.1), dir(view.0, view.1), 40000, 200, 1)
+            .unwrap();
+        assert!((e.value - want).abs() < 3.0 * e.se, "{e:?} vs {want}");
+        let a = s.albedo(dir(sun.0, sun.1), 40000, 200, 1).unwrap();
+        assert!((a.value - want).abs() < 3.0 * a.se, "{a:?} vs {want}");
+    }
+}

@@ -131,7 +131,7 @@ impl MeshTracer {
             let n = (b - a).cross(c - a);
             let len = n.length();
             let scale = (b - a).length() * (c - a).length();
-            if !(len > 1e-12 * scale) || len == 0.0 {
+            if len <= 1e-12 * scale {
                 return Err(CoreError::invalid(
                     "mesh",
                     format!("triangle {k} {f:?} is degenerate (zero area): {p:?}"),
