@@ -371,6 +371,7 @@ fn radiometry_render_perspective<'py>(
 }
 
 /// Rays of a batch: `(n, 3)` origins and directions, `(n,)` skipped facets.
+#[allow(clippy::type_complexity)]
 fn ray_batch(
     origins: &PyReadonlyArray2<'_, f64>,
     directions: &PyReadonlyArray2<'_, f64>,
