@@ -370,13 +370,15 @@ fn radiometry_render_perspective<'py>(
     array2(py, shape, img)
 }
 
+/// Origins, directions and skipped facet indices of a batch of rays.
+type RayBatch = (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<i64>);
+
 /// Rays of a batch: `(n, 3)` origins and directions, `(n,)` skipped facets.
-#[allow(clippy::type_complexity)]
 fn ray_batch(
     origins: &PyReadonlyArray2<'_, f64>,
     directions: &PyReadonlyArray2<'_, f64>,
     skip: Option<&PyReadonlyArray1<'_, i64>>,
-) -> PyResult<(Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<i64>)> {
+) -> PyResult<RayBatch> {
     let rows3 = |a: &PyReadonlyArray2<'_, f64>, name: &str| -> PyResult<Vec<[f64; 3]>> {
         let c = c_order(a);
         if c.shape[1] != 3 {
