@@ -193,3 +193,35 @@ def test_per_facet_path_with_one_material_is_the_plain_scene():
     m, ext = tile_mesh(z)
     s = Scene.from_mesh(m, extent=ext)
     assert s.extent == ext and s.render(sun=(0.0, 20.0), shape=(3, 5), spp=1).shape == (3, 5)
+
+
+def test_instances_match_the_concatenated_mesh():
+    # a periodic 4 x 4 piece placed 2 x 2 times (one of them mirrored onto
+    # itself by a 180 degree turn would change the surface: plain shifts)
+    z4 = periodic_surface(4, amp=1.0, seed=9, modes=1)
+    piece, _ = tile_mesh(z4)
+    whole, ext = tile_mesh(np.tile(z4, (2, 2)))
+    xf = np.zeros((4, 3, 4))
+    xf[:, 0, 0] = xf[:, 1, 1] = xf[:, 2, 2] = 1.0
+    xf[:, :2, 3] = [[0, 0], [4, 0], [0, -4], [4, -4]]
+    inst = Scene.from_instances([piece], [0, 0, 0, 0], xf, extent=ext, materials=Lambertian(0.8))
+    ref = Scene.from_mesh(whole, materials=Lambertian(0.8), extent=ext)
+    for sun, view in [((0.0, 30.0), "nadir"), ((135.0, 60.0), (20.0, 40.0))]:
+        a = ref.brf(sun=sun, view=view, spp=20000, max_depth=5)
+        b = inst.brf(sun=sun, view=view, spp=20000, max_depth=5)
+        assert abs(a.value - b.value) < 3 * a.se, (a, b)
+    # per-instance materials: instance k's facets are ids[32 k: 32 (k + 1)]
+    ids = np.repeat([0, 1, 1, 0], 32)
+    s = Scene.from_instances([piece], [0, 0, 0, 0], xf, extent=ext,
+                             materials=[Lambertian(0.2), Lambertian(0.6)], material_ids=ids)
+    assert s.render(sun=(0.0, 0.0), shape=(2, 2), spp=64, max_depth=1).shape == (2, 2)
+    with pytest.raises(ValueError, match="^transforms:"):
+        Scene.from_instances([piece], [0, 0], xf, extent=ext)
+    with pytest.raises(ValueError, match="^instance_shapes:"):
+        Scene.from_instances([piece], [0, 0, 0, 1], xf, extent=ext)
+    singular = xf.copy()
+    singular[0, 2, 2] = 0.0
+    with pytest.raises(ValueError, match="^instances:"):
+        Scene.from_instances([piece], [0, 0, 0, 0], singular, extent=ext)
+    with pytest.raises(ValueError, match="^extent:"):
+        Scene.from_instances([piece], [0, 0, 0, 0], xf, extent=(100.0, 100.0, 8.0, 8.0))

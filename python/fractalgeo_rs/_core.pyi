@@ -712,6 +712,16 @@ class RadiometryScene:
         extent: Optional[Tuple[float, float, float, float]] = None,
     ) -> RadiometryScene: ...
     @staticmethod
+    def from_instances(
+        shapes: Sequence[_MeshLike],
+        instance_shapes: npt.NDArray[np.uint32],
+        transforms: npt.NDArray[np.float64],
+        materials: Sequence[Tuple[str, Sequence[float]]],
+        material_ids: Optional[npt.NDArray[np.uint32]],
+        periodic: bool,
+        extent: Tuple[float, float, float, float],
+    ) -> RadiometryScene: ...
+    @staticmethod
     def from_dem(
         dem: npt.NDArray[np.float64],
         cell_size: Tuple[float, float],

@@ -7,8 +7,11 @@ use super::geometry::MeshIn;
 use super::progress::{counter, ProgressCounter};
 use crate::error::{CoreError, CoreResult};
 use crate::radiometry::integrator::{Pinhole, Psf};
-use crate::radiometry::{direction, material, Heightfield, MeshTracer, Scene, Split};
-use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use crate::radiometry::{
+    direction, material, Heightfield, InstancedTracer, MeshTracer, Scene, Split,
+};
+use glam::{DAffine3, DMat3, DVec3};
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::prelude::*;
 
 fn build(
@@ -506,6 +509,7 @@ fn radiometry_occluded<'py>(
 enum SceneKind {
     Dem(Scene<Heightfield>),
     Mesh(Scene<MeshTracer>),
+    Instanced(Scene<InstancedTracer>),
 }
 
 /// Dispatch `$body` on the scene's kind with `$s` bound to the scene.
@@ -514,6 +518,7 @@ macro_rules! with_scene {
         match $kind {
             SceneKind::Dem($s) => $body,
             SceneKind::Mesh($s) => $body,
+            SceneKind::Instanced($s) => $body,
         }
     };
 }
@@ -584,6 +589,68 @@ impl RadiometryScene {
         })?;
         Ok(RadiometryScene {
             kind: SceneKind::Mesh(s),
+        })
+    }
+
+    /// Instances of shapes: `instance_shapes[k]` is the shape of instance
+    /// `k` and `transforms[k]` (3 x 4, row-major `[R | t]`) takes the
+    /// shape's map coordinates to the world; `material_ids` one per facet
+    /// (instances in order, each over its shape's triangles).
+    #[staticmethod]
+    #[pyo3(signature = (shapes, instance_shapes, transforms, materials, material_ids, periodic, extent))]
+    #[allow(clippy::too_many_arguments)]
+    fn from_instances(
+        py: Python<'_>,
+        shapes: Vec<MeshIn<'_>>,
+        instance_shapes: PyReadonlyArray1<'_, u32>,
+        transforms: PyReadonlyArray3<'_, f64>,
+        materials: Vec<(String, Vec<f64>)>,
+        material_ids: Option<PyReadonlyArray1<'_, u32>>,
+        periodic: bool,
+        extent: [f64; 4],
+    ) -> PyResult<Self> {
+        let shapes: Vec<crate::geometry::Mesh> = shapes
+            .into_iter()
+            .map(|m| m.into_mesh())
+            .collect::<PyResult<_>>()?;
+        let which = instance_shapes.as_array();
+        let xf = transforms.as_array();
+        if xf.shape() != [which.len(), 3, 4] {
+            return Err(CoreError::invalid(
+                "transforms",
+                format!(
+                    "expected shape ({}, 3, 4), got {:?}",
+                    which.len(),
+                    xf.shape()
+                ),
+            )
+            .into());
+        }
+        let instances: Vec<(usize, DAffine3)> = (0..which.len())
+            .map(|k| {
+                let m = |r: usize, c: usize| xf[[k, r, c]];
+                let cols = DMat3::from_cols(
+                    DVec3::new(m(0, 0), m(1, 0), m(2, 0)),
+                    DVec3::new(m(0, 1), m(1, 1), m(2, 1)),
+                    DVec3::new(m(0, 2), m(1, 2), m(2, 2)),
+                );
+                (
+                    which[k] as usize,
+                    DAffine3::from_mat3_translation(cols, DVec3::new(m(0, 3), m(1, 3), m(2, 3))),
+                )
+            })
+            .collect();
+        let ids = ids_of(material_ids);
+        let s = run(py, Some(1), || {
+            let m = materials_of(&materials)?;
+            scene_with(
+                InstancedTracer::new(&shapes, &instances, periodic, extent)?,
+                m,
+                ids,
+            )
+        })?;
+        Ok(RadiometryScene {
+            kind: SceneKind::Instanced(s),
         })
     }
 

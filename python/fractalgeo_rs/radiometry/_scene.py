@@ -678,6 +678,9 @@ class Scene:
         self.split = split
 
     def __repr__(self) -> str:
+        if self.dem is None and self.mesh is None:
+            return (f"Scene(instances, extent={self.extent}, periodic={self.periodic}, "
+                    f"materials={list(self.materials)!r})")
         if self.mesh is not None:
             return (f"Scene(mesh of {len(self.mesh)} triangles, extent={self.extent}, periodic={self.periodic}, "
                     f"materials={list(self.materials)!r})")
@@ -950,6 +953,114 @@ class Scene:
         return cls.from_mesh(tin.to_mesh(), materials=materials, material_ids=material_ids, periodic=periodic,
                              extent=extent)
 
+    @classmethod
+    def from_instances(cls, shapes, instance_shapes, transforms, extent,
+                       materials: Union[None, Material, Sequence[Material]] = None,
+                       material_ids: Optional[MaterialIds] = None, periodic: bool = True) -> "Scene":
+        """A scene of many placed copies of a few meshes (trees, leaves).
+
+        Each shape gets its own BVH and a top-level BVH covers the
+        instances' boxes, so memory grows with the shapes, not the copies.
+        Facets are two-sided and periodic tiles work as in ``from_mesh``
+        (an instance whose box crosses a side of the tile is wrapped).
+
+        Parameters
+        ----------
+        shapes : list of fractalgeo_rs.geometry.Mesh
+            The meshes (map coordinates = origin + vertices).
+        instance_shapes : array_like of int, shape (k,)
+            Shape of every instance.
+        transforms : array_like of float, shape (k, 3, 4)
+            Affine transform ``[R | t]`` of every instance, from the shape's
+            map coordinates to the scene's (``x' = R x + t``; any invertible
+            ``R``: rotation, scale, mirror).
+        extent : (float, float, float, float)
+            ``(x0, y0, width, height)`` of the tile (periodic) or footprint,
+            scene coordinates; every instance's box centre must lie in it.
+        materials : material or list of materials, optional
+            Default ``Lambertian(0.5)``.
+        material_ids : array_like of int or callable, optional
+            One index per facet: instances in order, each over its shape's
+            triangles (length ``sum(len(shapes[s]) for s in
+            instance_shapes)``), or ``f(slope, height)``.
+        periodic : bool
+            As in ``from_mesh``.
+
+        Returns
+        -------
+        Scene
+
+        Examples
+        --------
+        Four copies of a unit square, scaled by 2, cover a 4 x 4 tile: a plane.
+
+        >>> import numpy as np
+        >>> from fractalgeo_rs.geometry import Mesh
+        >>> from fractalgeo_rs.radiometry import Lambertian, Scene
+        >>> sq = Mesh.from_triangles([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], [[0, 1, 2], [1, 3, 2]])
+        >>> xf = np.zeros((4, 3, 4)); xf[:, 0, 0] = xf[:, 1, 1] = 2.0; xf[:, 2, 2] = 1.0
+        >>> xf[:, :2, 3] = [[0, 0], [2, 0], [0, 2], [2, 2]]
+        >>> s = Scene.from_instances([sq], [0, 0, 0, 0], xf, extent=(0, 0, 4, 4), materials=Lambertian(0.3))
+        >>> round(s.brf(sun=(20.0, 40.0), view=(90.0, 30.0), spp=500).value, 9)
+        0.3
+
+        References
+        ----------
+        See ``from_mesh``.
+        """
+        from fractalgeo_rs.geometry import Mesh
+
+        if isinstance(shapes, Mesh) or not hasattr(shapes, "__iter__"):
+            raise TypeError(f"shapes: expected a list of fractalgeo_rs.geometry.Mesh, got {type(shapes).__name__}")
+        shapes = list(shapes)
+        for k, m in enumerate(shapes):
+            if not isinstance(m, Mesh):
+                raise TypeError(f"shapes: item {k} is not a fractalgeo_rs.geometry.Mesh: {type(m).__name__}")
+        shapes = [m._arrays() for m in shapes]
+        which = np.asarray(instance_shapes)
+        if which.ndim != 1 or which.dtype.kind not in "iu":
+            raise TypeError(f"instance_shapes: expected a 1D integer array, got shape {which.shape}, dtype {which.dtype}")
+        if which.size and (which.min() < 0 or which.max() >= len(shapes)):
+            raise ValueError(f"instance_shapes: expected shape indices in [0, {len(shapes)}), got "
+                             f"{int(which.min())}..{int(which.max())}")
+        xf = np.asarray(transforms, dtype=np.float64)
+        if xf.shape != (which.size, 3, 4):
+            raise ValueError(f"transforms: expected shape ({which.size}, 3, 4), got {xf.shape}")
+        if not np.isfinite(xf).all():
+            raise ValueError("transforms: expected finite values")
+        ext = _extent(extent)
+        if ext is None:
+            raise TypeError("extent: expected (x0, y0, width, height), got None")
+        if not isinstance(periodic, (bool, np.bool_)):
+            raise TypeError(f"periodic: expected True or False, got {periodic!r}")
+        mats = _materials(Lambertian(0.5) if materials is None else materials, "materials")
+        n_facets = int(sum(len(shapes[int(s)]) for s in which))
+        facets: dict = {}
+
+        def geometry(i: int) -> np.ndarray:
+            if not facets:
+                parts = []
+                for s, t in zip(which, xf):
+                    m = shapes[int(s)]
+                    v = np.asarray(m.vertices, np.float64) + np.asarray(m.origin)
+                    w = v @ t[:, :3].T + t[:, 3]
+                    f = np.asarray(m.faces, np.int64)
+                    p0, p1, p2 = w[f[:, 0]], w[f[:, 1]], w[f[:, 2]]
+                    n = np.cross(p1 - p0, p2 - p0)
+                    ln = np.linalg.norm(n, axis=1)
+                    cos = np.divide(np.abs(n[:, 2]), ln, out=np.ones_like(ln), where=ln > 0)
+                    parts.append((np.degrees(np.arccos(np.clip(cos, 0, 1))), (p0[:, 2] + p1[:, 2] + p2[:, 2]) / 3))
+                facets["v"] = (np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]))
+            return facets["v"][i]
+
+        ids = _material_ids(material_ids, len(mats), lambda: geometry(0), lambda: geometry(1), (n_facets,))
+        if ids is not None:
+            ids.setflags(write=False)
+        core = _core.RadiometryScene.from_instances(shapes, np.ascontiguousarray(which, dtype=np.uint32), xf,
+                                                    [m._spec() for m in mats], ids, bool(periodic), ext)
+        return cls(None, None, bool(periodic), mats[0], "ne-sw", materials=mats, material_ids=ids, extent=ext,
+                   core=core)
+
     def _raw_brf(self, sun, view, sky: float, spp: int, depth: int, seed: int,
                  n_threads) -> Tuple[float, float, int]:
         if self._core is not None:
@@ -966,7 +1077,7 @@ class Scene:
         return self.dem
 
     def _default_shape(self) -> Tuple[int, int]:
-        if self.mesh is not None:
+        if self.dem is None:
             return (128, 128)
         dem = self._dem()
         cells = dem.shape if self.periodic else (dem.shape[0] - 1, dem.shape[1] - 1)
@@ -1307,9 +1418,10 @@ class Scene:
             raise TypeError(f"shape: expected (rows, cols), got {shape!r}") from None
         rows, cols = check_positive_int(rows, "shape"), check_positive_int(cols, "shape")
         check_memory(rows * cols * 4, "shape", max_memory=max_memory, what=f"a {rows} x {cols} float32 image")
-        if self._core is not None and self.mesh is not None:
+        if self.dem is None and self._core is not None:
+            # mesh (its frame: the mesh's origin) or instanced scene
             x0, y0, w, h = self._core.footprint
-            zc = float(np.asarray(self.mesh.vertices, dtype=np.float64)[:, 2].mean())
+            zc = float(np.asarray(self.mesh.vertices, dtype=np.float64)[:, 2].mean()) if self.mesh is not None else 0.0
             centre = (x0 + 0.5 * w, y0 + 0.5 * h, zc)
         else:
             dem = self._dem()
