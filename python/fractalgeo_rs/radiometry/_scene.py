@@ -1384,8 +1384,11 @@ class Scene:
         eye, target : (float, float, float), optional
             Positions in the scene's frame: ``x`` east and ``y`` north of
             the DEM's first sample (the tile spans ``y`` from 0 to ``-rows
-            * dy``), ``z`` the height. The camera should be above the
-            surface.
+            * dy``), ``z`` the height; for a mesh scene, the mesh's frame
+            (map coordinates minus ``mesh.origin``; default target the
+            footprint's centre at the mean vertex height), for an instanced
+            scene the scene's coordinates (default target height 0). The
+            camera should be above the surface.
         fov : float
             Vertical field of view, degrees in (0, 180).
         shape : (int, int)
