@@ -140,6 +140,12 @@ CASES = {
         a, (1.0, 2.0), False, "ne-sw", "lambertian", [0.5], (30.0, 40.0), (200.0, 20.0), 500, 3, 1)),
     "radiometry_albedo": (IMG[:9, :7], lambda a: _core.radiometry_albedo(
         a, (1.0, 2.0), False, "ne-sw", "lambertian", [0.5], (30.0, 40.0), 500, 3, 1)),
+    "radiometry_intersect": (IMG[:9, :7], lambda a: _core.radiometry_intersect(
+        a, (1.0, 2.0), False, "ne-sw", np.array([[2.0, -3.0, 99.0], [1.5, -9.0, 99.0]]),
+        np.array([[0.1, 0.2, -1.0], [0.0, 0.0, -1.0]]))),
+    "radiometry_occluded": (IMG[:9, :7], lambda a: _core.radiometry_occluded(
+        a, (1.0, 2.0), True, "ne-sw", np.array([[2.0, -3.0, -99.0], [1.5, -9.0, 99.0]]),
+        np.array([[0.1, 0.2, 1.0], [0.0, 0.3, 1.0]]))),
     "radiometry_render": (IMG[:9, :7], lambda a: _core.radiometry_render(
         a, (1.0, 2.0), False, "nw-se", "lambertian", [0.5], (30.0, 40.0), (0.0, 0.0), (5, 4), 4, 3, 1)),
     "radiometry_brf_sky": (IMG[:9, :7], lambda a: _core.radiometry_brf_sky(
@@ -152,6 +158,9 @@ CASES = {
     "radiometry_render_psf": (IMG[:9, :7], lambda a: _core.radiometry_render_psf(
         a, (1.0, 2.0), False, "nw-se", "lambertian", [0.5], (30.0, 40.0), (0.0, 0.0), 0.3, (5, 4), 4, 3, 1,
         "table", [0.5], np.abs(IMG[:3, :5]))),
+    "RadiometryScene.from_dem": (IMG[:9, :7], lambda a: _core.RadiometryScene.from_dem(
+        a, (1.0, 2.0), True, "ne-sw", [("lambertian", [0.2]), ("lambertian", [0.9])],
+        (np.arange(126) % 2).astype(np.uint32)).render((30.0, 40.0), (0.0, 0.0), (5, 4), 4, 3, 1)),
 }
 # functions whose array arguments are not data laid out by the caller
 NOT_LAYOUT = {

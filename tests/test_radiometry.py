@@ -483,3 +483,36 @@ def test_specular_flat_mirror_reflects_the_fresnel_fraction():
         Specular(0.0)
     with pytest.raises(ValueError, match="^k: "):
         Specular(1.5, k=-1.0)
+
+
+def test_ray_batches_hit_a_flat_plane_exactly():
+    """The ray-batch bindings of the benches: a flat plane at z = 2 is hit at t = 8 / cos(zenith)
+    from z = 10, with the upward normal; rays going up from it are never occluded, rays going
+    down always are; bad shapes name the parameter."""
+    from fractalgeo_rs import _core
+
+    z = np.full((6, 5), 2.0)
+    rng = np.random.default_rng(3)
+    n = 500
+    o = np.column_stack([rng.random(n) * 5, -rng.random(n) * 6, np.full(n, 10.0)])
+    zen = rng.random(n) * 1.4
+    az = rng.random(n) * 2 * np.pi
+    d = np.column_stack([np.sin(az) * np.sin(zen), np.cos(az) * np.sin(zen), -np.cos(zen)])
+    for periodic in (True, False):
+        t, facet, normal = _core.radiometry_intersect(z, (1.0, 1.0), periodic, "ne-sw", o, d)
+        hit = facet >= 0
+        if periodic:
+            assert hit.all()
+        np.testing.assert_allclose(t[hit], 8.0 / np.cos(zen[hit]), rtol=1e-12)
+        np.testing.assert_array_equal(normal[hit], np.tile([0.0, 0.0, 1.0], (hit.sum(), 1)))
+        p = o[hit] + t[hit, None] * d[hit]
+        up = _core.radiometry_occluded(z, (1.0, 1.0), periodic, "ne-sw", p, -d[hit], facet[hit])
+        assert not up.any()
+        down = _core.radiometry_occluded(z, (1.0, 1.0), periodic, "ne-sw", o[hit], d[hit])
+        assert down.all()
+    with pytest.raises(ValueError, match="origins"):
+        _core.radiometry_intersect(z, (1.0, 1.0), True, "ne-sw", o[:, :2], d)
+    with pytest.raises(ValueError, match="directions"):
+        _core.radiometry_intersect(z, (1.0, 1.0), True, "ne-sw", o, d[:3])
+    with pytest.raises(ValueError, match="skip"):
+        _core.radiometry_occluded(z, (1.0, 1.0), True, "ne-sw", o, d, np.zeros(3, dtype=np.int64))

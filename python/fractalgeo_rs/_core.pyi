@@ -12,6 +12,7 @@ __all__ = [
     "LSystemCore",
     "ModuleString",
     "ProgressCounter",
+    "RadiometryScene",
     "__version__",
     "additions_refine_2d",
     "blanket_areas_image",
@@ -78,6 +79,8 @@ __all__ = [
     "speckle_f64",
     "radiometry_albedo",
     "radiometry_brf",
+    "radiometry_intersect",
+    "radiometry_occluded",
     "radiometry_render",
     "radiometry_bhr",
     "radiometry_brf_sky",
@@ -588,6 +591,26 @@ def radiometry_brf(
     seed: int,
     n_threads: Optional[int] = None,
 ) -> Tuple[float, float, int]: ...
+def radiometry_intersect(
+    dem: npt.NDArray[np.float64],
+    cell_size: Tuple[float, float],
+    periodic: bool,
+    split: str,
+    origins: npt.NDArray[np.float64],
+    directions: npt.NDArray[np.float64],
+    skip: Optional[npt.NDArray[np.int64]] = None,
+    n_threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
+def radiometry_occluded(
+    dem: npt.NDArray[np.float64],
+    cell_size: Tuple[float, float],
+    periodic: bool,
+    split: str,
+    origins: npt.NDArray[np.float64],
+    directions: npt.NDArray[np.float64],
+    skip: Optional[npt.NDArray[np.int64]] = None,
+    n_threads: Optional[int] = None,
+) -> npt.NDArray[np.bool_]: ...
 def radiometry_albedo(
     dem: npt.NDArray[np.float64],
     cell_size: Tuple[float, float],
@@ -683,3 +706,101 @@ def radiometry_render_psf(
     n_threads: Optional[int] = None,
     progress: Optional[ProgressCounter] = None,
 ) -> npt.NDArray[np.float32]: ...
+
+@final
+class RadiometryScene:
+    @staticmethod
+    def from_mesh(
+        mesh: _MeshLike,
+        materials: Sequence[Tuple[str, Sequence[float]]],
+        material_ids: Optional[npt.NDArray[np.uint32]],
+        periodic: bool,
+        extent: Optional[Tuple[float, float, float, float]] = None,
+    ) -> RadiometryScene: ...
+    @staticmethod
+    def from_instances(
+        shapes: Sequence[_MeshLike],
+        instance_shapes: npt.NDArray[np.uint32],
+        transforms: npt.NDArray[np.float64],
+        materials: Sequence[Tuple[str, Sequence[float]]],
+        material_ids: Optional[npt.NDArray[np.uint32]],
+        periodic: bool,
+        extent: Tuple[float, float, float, float],
+    ) -> RadiometryScene: ...
+    @staticmethod
+    def from_dem(
+        dem: npt.NDArray[np.float64],
+        cell_size: Tuple[float, float],
+        periodic: bool,
+        split: str,
+        materials: Sequence[Tuple[str, Sequence[float]]],
+        material_ids: Optional[npt.NDArray[np.uint32]],
+    ) -> RadiometryScene: ...
+    def brf(
+        self,
+        sun: Tuple[float, float],
+        view: Tuple[float, float],
+        spp: int,
+        max_depth: int,
+        seed: int,
+        n_threads: Optional[int] = None,
+    ) -> Tuple[float, float, int]: ...
+    def albedo(
+        self, sun: Tuple[float, float], spp: int, max_depth: int, seed: int, n_threads: Optional[int] = None
+    ) -> Tuple[float, float, int]: ...
+    def render(
+        self,
+        sun: Tuple[float, float],
+        view: Tuple[float, float],
+        shape: Tuple[int, int],
+        spp: int,
+        max_depth: int,
+        seed: int,
+        n_threads: Optional[int] = None,
+        progress: Optional[ProgressCounter] = None,
+    ) -> npt.NDArray[np.float32]: ...
+    def brf_sky(
+        self,
+        sun: Tuple[float, float],
+        view: Tuple[float, float],
+        sky: float,
+        spp: int,
+        max_depth: int,
+        seed: int,
+        n_threads: Optional[int] = None,
+    ) -> Tuple[float, float, int]: ...
+    def bhr(
+        self, spp: int, max_depth: int, seed: int, n_threads: Optional[int] = None
+    ) -> Tuple[float, float, int]: ...
+    def render_psf(
+        self,
+        sun: Tuple[float, float],
+        view: Tuple[float, float],
+        sky: float,
+        shape: Tuple[int, int],
+        spp: int,
+        max_depth: int,
+        seed: int,
+        psf: str,
+        psf_params: Sequence[float],
+        psf_table: Optional[npt.NDArray[np.float64]] = None,
+        n_threads: Optional[int] = None,
+        progress: Optional[ProgressCounter] = None,
+    ) -> npt.NDArray[np.float32]: ...
+    def render_perspective(
+        self,
+        sun: Tuple[float, float],
+        sky: float,
+        eye: Tuple[float, float, float],
+        target: Tuple[float, float, float],
+        fov: float,
+        shape: Tuple[int, int],
+        spp: int,
+        max_depth: int,
+        seed: int,
+        n_threads: Optional[int] = None,
+        progress: Optional[ProgressCounter] = None,
+    ) -> npt.NDArray[np.float32]: ...
+    def facets(self) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+    @property
+    def footprint(self) -> Tuple[float, float, float, float]: ...

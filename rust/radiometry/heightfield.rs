@@ -50,14 +50,27 @@ pub struct Hit {
     pub facet: FacetId,
 }
 
-/// Per cell: corner heights NW, NE, SW, SE, then the lowest and highest.
-type CellData = [f64; 6];
+/// Per cell: corner heights NW, NE, SW, SE.
+type Corners = [f64; 4];
+
+/// A cell's corners on one half cache line: a cell visited costs one load.
+#[derive(Debug, Clone, Copy)]
+#[repr(C, align(32))]
+struct Cell(Corners);
 
 /// A triangulated DEM ready for ray casting.
 #[derive(Debug, Clone)]
 pub struct Heightfield {
-    cells: Vec<CellData>,
-    /// Cell rows and columns.
+    /// Corner heights of every cell, `ncr x ncc` row-major.
+    cells: Vec<Cell>,
+    /// Side of a block of the coarse level, in cells (0: no coarse level).
+    bside: usize,
+    /// Block rows and columns of the coarse level.
+    nbr: usize,
+    nbc: usize,
+    /// Highest corner of every block plus the traversal tolerance.
+    bmax: Vec<f64>,
+    /// Cell rows.
     pub ncr: usize,
     /// Cell columns.
     pub ncc: usize,
@@ -75,6 +88,8 @@ pub struct Heightfield {
     pub zmax: f64,
     /// Mean vertex height (metres): the reference plane of the sensor.
     pub zmean: f64,
+    /// Height tolerance of the culling tests (metres).
+    zeps: f64,
 }
 
 /// Upper bound on cells visited by one ray (guards near-horizontal rays in
@@ -84,6 +99,93 @@ const MAX_STEPS: usize = 1 << 22;
 
 /// Tolerance of the point-in-facet test, in cell units.
 const EDGE_EPS: f64 = 1e-12;
+
+/// Grids with at least this many cells get the coarse (block) level.
+const BLOCK_MIN_CELLS: usize = 96 * 96;
+
+/// `floor(v)` as an integer (no libm call on baseline x86-64).
+#[inline(always)]
+fn ifloor(v: f64) -> i64 {
+    let i = v as i64;
+    if (i as f64) > v {
+        i - 1
+    } else {
+        i
+    }
+}
+
+/// The larger of two finite values (one `maxsd`: no NaN handling).
+#[inline(always)]
+fn fmax(a: f64, b: f64) -> f64 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+/// The smaller of two finite values.
+#[inline(always)]
+fn fmin(a: f64, b: f64) -> f64 {
+    if a < b {
+        a
+    } else {
+        b
+    }
+}
+
+/// `i` modulo `n` in `0..n` (the division only when `i` is outside).
+#[inline(always)]
+fn wrap_index(i: i64, n: usize) -> usize {
+    if (i as u64) < n as u64 {
+        i as usize
+    } else {
+        i.rem_euclid(n as i64) as usize
+    }
+}
+
+/// A ray in grid coordinates with its stepping constants.
+struct GridRay {
+    o: DVec3,
+    d: DVec3,
+    skip: Option<FacetId>,
+    t_max: f64,
+    sx: i64,
+    sy: i64,
+    /// `1 / |d.x|`, `1 / |d.y|` (infinite for 0).
+    idx: f64,
+    idy: f64,
+}
+
+impl GridRay {
+    /// Ray parameter where the ray crosses the grid line `x = k` (`y = k`).
+    #[inline(always)]
+    fn cross_x(&self, k: i64) -> f64 {
+        if self.d.x == 0.0 {
+            f64::INFINITY
+        } else {
+            (k as f64 - self.o.x) / self.d.x
+        }
+    }
+    #[inline(always)]
+    fn cross_y(&self, k: i64) -> f64 {
+        if self.d.y == 0.0 {
+            f64::INFINITY
+        } else {
+            (k as f64 - self.o.y) / self.d.y
+        }
+    }
+}
+
+/// Outcome of walking the cells of one block.
+enum Walk {
+    /// A facet hit: `t`, the facet and its plane slopes `(b, c)`.
+    Hit(f64, FacetId, f64, f64),
+    /// The ray is done (escaped, lost, left the patch or passed `t_max`).
+    Stop,
+    /// The ray left the block.
+    Next,
+}
 
 impl Heightfield {
     /// Build from heights `z` (row-major, `rows x cols`, metres) with cells
@@ -139,22 +241,33 @@ impl Heightfield {
         } else {
             (rows - 1, cols - 1)
         };
-        let h = |r: usize, c: usize| z[(r % rows) * cols + (c % cols)];
-        let mut cells: Vec<CellData> = crate::buffers::try_with_capacity(ncr * ncc, "dem")?;
+        // the sample after the last row (column) is the first (periodic)
+        let next = |i: usize, n: usize| if i + 1 == n { 0 } else { i + 1 };
+        let mut cells: Vec<Cell> = crate::buffers::try_with_capacity(ncr * ncc, "dem")?;
         let (mut zmin, mut zmax) = (f64::INFINITY, f64::NEG_INFINITY);
         for r in 0..ncr {
+            let (top, bottom) = (
+                &z[r * cols..(r + 1) * cols],
+                &z[next(r, rows) * cols..][..cols],
+            );
             for c in 0..ncc {
-                let (nw, ne, sw, se) = (h(r, c), h(r, c + 1), h(r + 1, c), h(r + 1, c + 1));
-                let lo = nw.min(ne).min(sw).min(se);
-                let hi = nw.max(ne).max(sw).max(se);
-                zmin = zmin.min(lo);
-                zmax = zmax.max(hi);
-                cells.push([nw, ne, sw, se, lo, hi]);
+                let c1 = next(c, cols);
+                let cd = [top[c], top[c1], bottom[c], bottom[c1]];
+                zmin = fmin(zmin, fmin(fmin(cd[0], cd[1]), fmin(cd[2], cd[3])));
+                zmax = fmax(zmax, fmax(fmax(cd[0], cd[1]), fmax(cd[2], cd[3])));
+                cells.push(Cell(cd));
             }
         }
+        // absolute tolerance of the culling tests: far above the rounding
+        // of `o.z + t d.z` at these heights
+        let zeps = 1e-9 * (1.0 + zmin.abs().max(zmax.abs()));
         let zmean = z.iter().sum::<f64>() / z.len() as f64;
-        Ok(Heightfield {
+        let mut hf = Heightfield {
             cells,
+            bside: 0,
+            nbr: 0,
+            nbc: 0,
+            bmax: Vec::new(),
             ncr,
             ncc,
             periodic,
@@ -164,21 +277,60 @@ impl Heightfield {
             zmin,
             zmax,
             zmean,
-        })
+            zeps,
+        };
+        if ncr * ncc >= BLOCK_MIN_CELLS {
+            // periodic: blocks must tile the period
+            let side = [16usize, 8, 4]
+                .into_iter()
+                .find(|b| !periodic || (ncr % b == 0 && ncc % b == 0));
+            if let Some(b) = side {
+                hf.set_block_side(b);
+            }
+        }
+        Ok(hf)
+    }
+
+    /// Build the coarse level with blocks of `b x b` cells (0: none).
+    /// Periodic grids need `b` to divide both sides; otherwise no coarse level
+    /// is built. The results of ray casting do not depend on it.
+    pub fn set_block_side(&mut self, b: usize) {
+        if b == 0 || (self.periodic && (self.ncr % b != 0 || self.ncc % b != 0)) {
+            self.bside = 0;
+            self.bmax = Vec::new();
+            return;
+        }
+        let (nbr, nbc) = (self.ncr.div_ceil(b), self.ncc.div_ceil(b));
+        let mut bmax = vec![f64::NEG_INFINITY; nbr * nbc];
+        for r in 0..self.ncr {
+            for c in 0..self.ncc {
+                let m = &mut bmax[(r / b) * nbc + c / b];
+                let [a, b, c, d] = self.cells[r * self.ncc + c].0;
+                *m = m.max(a.max(b).max(c).max(d) + self.zeps);
+            }
+        }
+        self.bside = b;
+        self.nbr = nbr;
+        self.nbc = nbc;
+        self.bmax = bmax;
+    }
+
+    /// Corner heights (NW, NE, SW, SE) of the cell at wrapped indices.
+    #[inline(always)]
+    fn corners(&self, cx: usize, cy: usize) -> Corners {
+        self.cells[cy * self.ncc + cx].0
     }
 
     #[inline(always)]
-    fn cell(&self, ix: i64, iy: i64) -> &CellData {
-        let c = ix.rem_euclid(self.ncc as i64) as usize;
-        let r = iy.rem_euclid(self.ncr as i64) as usize;
-        &self.cells[r * self.ncc + c]
+    fn cell(&self, ix: i64, iy: i64) -> Corners {
+        self.corners(wrap_index(ix, self.ncc), wrap_index(iy, self.ncr))
     }
 
     /// The plane of facet `tri` of a cell as `z = a + b fx + c fy` in the
     /// cell's coordinates `fx, fy` in [0, 1], and the facet's region test.
     #[inline(always)]
-    fn plane(&self, cd: &CellData, tri: u8) -> (f64, f64, f64) {
-        let [nw, ne, sw, se, _, _] = *cd;
+    fn plane(&self, cd: &Corners, tri: u8) -> (f64, f64, f64) {
+        let [nw, ne, sw, se] = *cd;
         match (self.split, tri) {
             // (NW, NE, SW): fx + fy <= 1
             (Split::NeSw, 0) => (nw, ne - nw, sw - nw),
@@ -213,7 +365,7 @@ impl Heightfield {
 
     /// Unit upward normal of a facet (world frame).
     pub fn facet_normal(&self, f: FacetId) -> DVec3 {
-        let (_, b, c) = self.plane(self.cell(f.ix, f.iy), f.tri);
+        let (_, b, c) = self.plane(&self.cell(f.ix, f.iy), f.tri);
         self.normal_of(b, c).normalize()
     }
 
@@ -221,10 +373,10 @@ impl Heightfield {
     /// the order (row, column, facet).
     pub fn facets(&self) -> Vec<(f64, DVec3)> {
         let mut out = Vec::with_capacity(2 * self.ncr * self.ncc);
-        for iy in 0..self.ncr as i64 {
-            for ix in 0..self.ncc as i64 {
+        for iy in 0..self.ncr {
+            for ix in 0..self.ncc {
                 for tri in 0..2u8 {
-                    let (_, b, c) = self.plane(self.cell(ix, iy), tri);
+                    let (_, b, c) = self.plane(&self.corners(ix, iy), tri);
                     let n = self.normal_of(b, c);
                     // a facet projects onto half a cell: area = 0.5 dx dy / nz
                     out.push((0.5 * self.dx * self.dy * n.length(), n.normalize()));
@@ -246,8 +398,12 @@ impl Heightfield {
         if !self.periodic {
             return (p, f);
         }
-        let kx = f.ix.div_euclid(self.ncc as i64);
-        let ky = f.iy.div_euclid(self.ncr as i64);
+        let (ncc, ncr) = (self.ncc as i64, self.ncr as i64);
+        if (0..ncc).contains(&f.ix) && (0..ncr).contains(&f.iy) {
+            return (p, f);
+        }
+        let kx = f.ix.div_euclid(ncc);
+        let ky = f.iy.div_euclid(ncr);
         (
             DVec3::new(
                 p.x - (kx * self.ncc as i64) as f64 * self.dx,
@@ -265,6 +421,112 @@ impl Heightfield {
     /// The first facet hit by the ray `o + t d` (world frame, `d` a unit
     /// vector) with `t > 0`, ignoring facet `skip` (the one the ray starts on).
     pub fn intersect(&self, o: DVec3, d: DVec3, skip: Option<FacetId>) -> Option<Hit> {
+        match self.trace::<false>(o, d, skip, f64::INFINITY) {
+            Walk::Hit(t, facet, b, c) => Some(Hit {
+                t,
+                normal: self.normal_of(b, c).normalize(),
+                facet,
+            }),
+            _ => None,
+        }
+    }
+
+    /// Whether the ray `o + t d` (world frame, `d` a unit vector) hits a
+    /// facet other than `skip` at some `0 < t <= t_max`: the shadow-ray test,
+    /// which stops at the first facet found. `occluded(o, d, skip, inf)` is
+    /// `intersect(o, d, skip).is_some()`.
+    pub fn occluded(&self, o: DVec3, d: DVec3, skip: Option<FacetId>, t_max: f64) -> bool {
+        matches!(self.trace::<true>(o, d, skip, t_max), Walk::Hit(..))
+    }
+
+    /// Index of a facet of the base tile, `2 (iy ncc + ix) + tri`, after
+    /// moving it into the base tile (periodic).
+    pub fn facet_index(&self, f: FacetId) -> i64 {
+        let ix = wrap_index(f.ix, self.ncc);
+        let iy = wrap_index(f.iy, self.ncr);
+        (2 * (iy * self.ncc + ix)) as i64 + f.tri as i64
+    }
+
+    /// The facet of index `k` ([`Heightfield::facet_index`]); `None` for a
+    /// negative or out-of-range index.
+    pub fn facet_at(&self, k: i64) -> Option<FacetId> {
+        let n = 2 * (self.ncr * self.ncc) as i64;
+        (0..n).contains(&k).then(|| {
+            let cell = k / 2;
+            FacetId {
+                ix: cell % self.ncc as i64,
+                iy: cell / self.ncc as i64,
+                tri: (k % 2) as u8,
+            }
+        })
+    }
+
+    /// [`Heightfield::intersect`] of many rays in parallel (rayon): origins
+    /// and unit directions as `[x, y, z]` rows, the facet index each ray
+    /// ignores (negative: none). Returns per ray `t` (infinite for a miss),
+    /// the facet index hit (-1 for a miss) and the unit normal (zero for a miss).
+    pub fn intersect_many(
+        &self,
+        origins: &[[f64; 3]],
+        dirs: &[[f64; 3]],
+        skip: &[i64],
+    ) -> (Vec<f64>, Vec<i64>, Vec<[f64; 3]>) {
+        use rayon::prelude::*;
+        let one = |i: usize| {
+            let o = DVec3::from_array(origins[i]);
+            let d = DVec3::from_array(dirs[i]);
+            match self.intersect(o, d, self.facet_at(skip[i])) {
+                Some(h) => (h.t, self.facet_index(h.facet), h.normal.to_array()),
+                None => (f64::INFINITY, -1, [0.0; 3]),
+            }
+        };
+        let out: Vec<(f64, i64, [f64; 3])> = (0..origins.len())
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(one)
+            .collect();
+        let mut t = Vec::with_capacity(out.len());
+        let mut f = Vec::with_capacity(out.len());
+        let mut n = Vec::with_capacity(out.len());
+        for (a, b, c) in out {
+            t.push(a);
+            f.push(b);
+            n.push(c);
+        }
+        (t, f, n)
+    }
+
+    /// [`Heightfield::occluded`] of many rays in parallel (rayon), with no
+    /// distance limit; arguments as in [`Heightfield::intersect_many`].
+    pub fn occluded_many(
+        &self,
+        origins: &[[f64; 3]],
+        dirs: &[[f64; 3]],
+        skip: &[i64],
+    ) -> Vec<bool> {
+        use rayon::prelude::*;
+        (0..origins.len())
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|i| {
+                let o = DVec3::from_array(origins[i]);
+                let d = DVec3::from_array(dirs[i]);
+                self.occluded(o, d, self.facet_at(skip[i]), f64::INFINITY)
+            })
+            .collect()
+    }
+
+    /// The traversal: clip (non-periodic), then walk the blocks of the
+    /// coarse level, and the cells of every block the ray may touch; without
+    /// a coarse level, walk the cells directly. `ANY`: stop at the first hit.
+    #[inline(always)]
+    fn trace<const ANY: bool>(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        skip: Option<FacetId>,
+        t_max: f64,
+    ) -> Walk {
         // grid coordinates: the same t
         let o = DVec3::new(o.x / self.dx, -o.y / self.dy, o.z);
         let d = DVec3::new(d.x / self.dx, -d.y / self.dy, d.z);
@@ -276,7 +538,7 @@ impl Heightfield {
             for (oa, da, hi) in [(o.x, d.x, w), (o.y, d.y, h)] {
                 if da == 0.0 {
                     if oa < 0.0 || oa > hi {
-                        return None;
+                        return Walk::Stop;
                     }
                 } else {
                     let (a, b) = ((0.0 - oa) / da, (hi - oa) / da);
@@ -285,114 +547,250 @@ impl Heightfield {
                 }
             }
             if t0 > t1 {
-                return None;
+                return Walk::Stop;
             }
             t_start = t0;
         }
-        let p = o + t_start * d;
-        let mut ix = p.x.floor() as i64;
-        let mut iy = p.y.floor() as i64;
-        if !self.periodic {
-            ix = ix.clamp(0, self.ncc as i64 - 1);
-            iy = iy.clamp(0, self.ncr as i64 - 1);
-        }
-        let (sx, sy) = (
-            if d.x > 0.0 { 1 } else { -1 },
-            if d.y > 0.0 { 1 } else { -1 },
-        );
-        let next_x = |ix: i64| -> f64 {
-            if d.x == 0.0 {
+        let ray = GridRay {
+            o,
+            d,
+            skip,
+            t_max,
+            sx: if d.x > 0.0 { 1 } else { -1 },
+            sy: if d.y > 0.0 { 1 } else { -1 },
+            idx: if d.x == 0.0 {
                 f64::INFINITY
             } else {
-                ((ix + (d.x > 0.0) as i64) as f64 - o.x) / d.x
+                1.0 / d.x.abs()
+            },
+            idy: if d.y == 0.0 {
+                f64::INFINITY
+            } else {
+                1.0 / d.y.abs()
+            },
+        };
+        if d.x == 0.0 && d.y == 0.0 {
+            // a vertical ray meets only the cell under its origin
+            let (mut ix, mut iy) = (ifloor(o.x), ifloor(o.y));
+            if !self.periodic {
+                ix = ix.clamp(0, self.ncc as i64 - 1);
+                iy = iy.clamp(0, self.ncr as i64 - 1);
             }
-        };
-        let next_y = |iy: i64| -> f64 {
-            if d.y == 0.0 {
-                f64::INFINITY
-            } else {
-                ((iy + (d.y > 0.0) as i64) as f64 - o.y) / d.y
-            }
-        };
-        let dtx = if d.x == 0.0 {
-            f64::INFINITY
-        } else {
-            1.0 / d.x.abs()
-        };
-        let dty = if d.y == 0.0 {
-            f64::INFINITY
-        } else {
-            1.0 / d.y.abs()
-        };
-        let mut tmx = next_x(ix);
-        let mut tmy = next_y(iy);
-        let mut t_enter = t_start;
-        for _ in 0..MAX_STEPS {
-            let t_exit = tmx.min(tmy);
-            let z_enter = o.z + t_enter * d.z;
-            let z_exit = if t_exit.is_finite() {
-                o.z + t_exit * d.z
-            } else if d.z < 0.0 {
-                f64::NEG_INFINITY
-            } else if d.z > 0.0 {
-                f64::INFINITY
-            } else {
-                o.z
+            return match self.test_cell::<ANY>(&ray, ix, iy, &self.cell(ix, iy)) {
+                Some((t, tri, b, c)) => Walk::Hit(t, FacetId { ix, iy, tri }, b, c),
+                None => Walk::Stop,
             };
-            let cd = self.cell(ix, iy);
-            if z_enter.min(z_exit) <= cd[5] + 1e-9 {
-                let mut best: Option<Hit> = None;
-                for tri in 0..2u8 {
-                    let id = FacetId { ix, iy, tri };
-                    if skip == Some(id) {
-                        continue;
-                    }
-                    let (a, b, c) = self.plane(cd, tri);
-                    let fx0 = o.x - ix as f64;
-                    let fy0 = o.y - iy as f64;
-                    let denom = d.z - b * d.x - c * d.y;
-                    if denom == 0.0 {
-                        continue;
-                    }
-                    let t = (a + b * fx0 + c * fy0 - o.z) / denom;
-                    if t.is_nan() || t <= 1e-10 || best.is_some_and(|h| h.t <= t) {
-                        continue;
-                    }
-                    let (fx, fy) = (fx0 + t * d.x, fy0 + t * d.y);
-                    if self.inside(tri, fx, fy) {
-                        best = Some(Hit {
-                            t,
-                            normal: self.normal_of(b, c).normalize(),
-                            facet: id,
-                        });
-                    }
+        }
+        let mut steps = 0usize;
+        if self.bside == 0 {
+            let (lo, hi) = if self.periodic {
+                ((i64::MIN, i64::MIN), (i64::MAX, i64::MAX))
+            } else {
+                ((0, 0), (self.ncc as i64 - 1, self.ncr as i64 - 1))
+            };
+            return match self.walk_cells::<ANY>(&ray, t_start, lo, hi, &mut steps) {
+                Walk::Next => Walk::Stop,
+                w => w,
+            };
+        }
+        // the coarse level: blocks of bs x bs cells
+        let bs = self.bside as i64;
+        let (nbc, nbr) = (self.nbc as i64, self.nbr as i64);
+        let p = o + t_start * d;
+        let mut bx = ifloor(p.x / bs as f64);
+        let mut by = ifloor(p.y / bs as f64);
+        if !self.periodic {
+            bx = bx.clamp(0, nbc - 1);
+            by = by.clamp(0, nbr - 1);
+        }
+        let mut bxw = wrap_index(bx, self.nbc);
+        let mut byw = wrap_index(by, self.nbr);
+        let mut tmx = ray.cross_x((bx + (d.x > 0.0) as i64) * bs);
+        let mut tmy = ray.cross_y((by + (d.y > 0.0) as i64) * bs);
+        let (dtx, dty) = (bs as f64 * ray.idx, bs as f64 * ray.idy);
+        let mut t_enter = t_start;
+        let mut z_enter = o.z + t_start * d.z;
+        loop {
+            let t_exit = tmx.min(tmy);
+            let z_exit = o.z + t_exit * d.z;
+            if fmin(z_enter, z_exit) <= self.bmax[byw * self.nbc + bxw] {
+                let lo = (bx * bs, by * bs);
+                let mut hi = (lo.0 + bs - 1, lo.1 + bs - 1);
+                if !self.periodic {
+                    hi = (hi.0.min(self.ncc as i64 - 1), hi.1.min(self.ncr as i64 - 1));
                 }
-                if best.is_some() {
-                    return best;
+                match self.walk_cells::<ANY>(&ray, t_enter, lo, hi, &mut steps) {
+                    Walk::Next => {}
+                    w => return w,
+                }
+            }
+            if (d.z >= 0.0 && z_exit > self.zmax)
+                || (d.z < 0.0 && z_enter < self.zmin - self.zeps)
+                || t_exit > t_max
+            {
+                return Walk::Stop;
+            }
+            if tmx < tmy {
+                bx += ray.sx;
+                tmx += dtx;
+                bxw = if ray.sx > 0 {
+                    if bxw + 1 == self.nbc {
+                        0
+                    } else {
+                        bxw + 1
+                    }
+                } else if bxw == 0 {
+                    self.nbc - 1
+                } else {
+                    bxw - 1
+                };
+                if !self.periodic && (bx < 0 || bx >= nbc) {
+                    return Walk::Stop;
+                }
+            } else {
+                by += ray.sy;
+                tmy += dty;
+                byw = if ray.sy > 0 {
+                    if byw + 1 == self.nbr {
+                        0
+                    } else {
+                        byw + 1
+                    }
+                } else if byw == 0 {
+                    self.nbr - 1
+                } else {
+                    byw - 1
+                };
+                if !self.periodic && (by < 0 || by >= nbr) {
+                    return Walk::Stop;
+                }
+            }
+            steps += 1;
+            if steps > MAX_STEPS {
+                return Walk::Stop;
+            }
+            t_enter = t_exit;
+            z_enter = z_exit;
+        }
+    }
+
+    /// Walk the cells from ray parameter `t0` while the cell indices stay
+    /// within `lo..=hi` (a block, or the patch), testing the facets of every
+    /// cell whose highest corner the ray segment does not pass above.
+    #[inline(always)]
+    fn walk_cells<const ANY: bool>(
+        &self,
+        ray: &GridRay,
+        t0: f64,
+        lo: (i64, i64),
+        hi: (i64, i64),
+        steps: &mut usize,
+    ) -> Walk {
+        let (o, d) = (ray.o, ray.d);
+        let p = o + t0 * d;
+        let mut ix = ifloor(p.x).clamp(lo.0, hi.0);
+        let mut iy = ifloor(p.y).clamp(lo.1, hi.1);
+        let (ncc, ncr) = (self.ncc, self.ncr);
+        let mut cx = wrap_index(ix, ncc);
+        let mut cy = wrap_index(iy, ncr);
+        let mut tmx = ray.cross_x(ix + (d.x > 0.0) as i64);
+        let mut tmy = ray.cross_y(iy + (d.y > 0.0) as i64);
+        let mut z_enter = o.z + t0 * d.z;
+        loop {
+            let t_exit = tmx.min(tmy);
+            let z_exit = o.z + t_exit * d.z;
+            let cd = self.corners(cx, cy);
+            if fmin(z_enter, z_exit) <= fmax(fmax(cd[0], cd[1]), fmax(cd[2], cd[3])) + self.zeps {
+                if let Some((t, tri, b, c)) = self.test_cell::<ANY>(ray, ix, iy, &cd) {
+                    return Walk::Hit(t, FacetId { ix, iy, tri }, b, c);
                 }
             }
             // leave the slab of the surface: above it going up, or below it
             // (a ray that slipped through; counted as lost)
-            if (d.z >= 0.0 && z_exit > self.zmax) || (d.z < 0.0 && z_enter < self.zmin - 1e-9) {
-                return None;
+            if (d.z >= 0.0 && z_exit > self.zmax)
+                || (d.z < 0.0 && z_enter < self.zmin - self.zeps)
+                || t_exit > ray.t_max
+            {
+                return Walk::Stop;
             }
-            if !t_exit.is_finite() {
-                return None;
+            *steps += 1;
+            if *steps > MAX_STEPS {
+                return Walk::Stop;
             }
             if tmx < tmy {
-                ix += sx;
-                tmx += dtx;
+                ix += ray.sx;
+                tmx += ray.idx;
+                if ix < lo.0 || ix > hi.0 {
+                    return Walk::Next;
+                }
+                cx = if ray.sx > 0 {
+                    if cx + 1 == ncc {
+                        0
+                    } else {
+                        cx + 1
+                    }
+                } else if cx == 0 {
+                    ncc - 1
+                } else {
+                    cx - 1
+                };
             } else {
-                iy += sy;
-                tmy += dty;
+                iy += ray.sy;
+                tmy += ray.idy;
+                if iy < lo.1 || iy > hi.1 {
+                    return Walk::Next;
+                }
+                cy = if ray.sy > 0 {
+                    if cy + 1 == ncr {
+                        0
+                    } else {
+                        cy + 1
+                    }
+                } else if cy == 0 {
+                    ncr - 1
+                } else {
+                    cy - 1
+                };
             }
-            if !self.periodic
-                && (ix < 0 || iy < 0 || ix >= self.ncc as i64 || iy >= self.ncr as i64)
-            {
-                return None;
-            }
-            t_enter = t_exit;
+            z_enter = z_exit;
         }
-        None
+    }
+
+    /// The nearest hit (`ANY`: the first found) of the ray with the two
+    /// facets of cell `(ix, iy)` with corners `cd`: `(t, facet, b, c)`.
+    #[inline(always)]
+    fn test_cell<const ANY: bool>(
+        &self,
+        ray: &GridRay,
+        ix: i64,
+        iy: i64,
+        cd: &Corners,
+    ) -> Option<(f64, u8, f64, f64)> {
+        let (o, d) = (ray.o, ray.d);
+        let fx0 = o.x - ix as f64;
+        let fy0 = o.y - iy as f64;
+        let mut best: Option<(f64, u8, f64, f64)> = None;
+        for tri in 0..2u8 {
+            if ray.skip == Some(FacetId { ix, iy, tri }) {
+                continue;
+            }
+            let (a, b, c) = self.plane(cd, tri);
+            let denom = d.z - b * d.x - c * d.y;
+            if denom == 0.0 {
+                continue;
+            }
+            let t = (a + b * fx0 + c * fy0 - o.z) / denom;
+            if t.is_nan() || t <= 1e-10 || t > ray.t_max || best.is_some_and(|h| h.0 <= t) {
+                continue;
+            }
+            let (fx, fy) = (fx0 + t * d.x, fy0 + t * d.y);
+            if self.inside(tri, fx, fy) {
+                best = Some((t, tri, b, c));
+                if ANY {
+                    return best;
+                }
+            }
+        }
+        best
     }
 }

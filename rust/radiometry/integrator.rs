@@ -6,8 +6,12 @@
 //! and goes against the view direction. At each facet hit the sun's direct
 //! contribution is added when the shadow ray towards the sun escapes; then a
 //! new direction is drawn from the facet's reflectance model, up to
-//! `max_depth` scattering events (1 = single scattering). There is no sky:
-//! rays that escape carry no light.
+//! `max_depth` scattering events (1 = single scattering). An optional
+//! isotropic sky lights paths that leave upwards after scattering; without
+//! it, rays that escape carry no light. The same walk serves the BRF (HDRF
+//! with a sky), the orthographic images (any point-spread function) and the
+//! perspective camera; the geometry is any [`Tracer`] (heightfield or mesh)
+//! with per-facet materials.
 //!
 //! BRF = `pi * L / cos(sun zenith)` with `L` the radiance averaged over the
 //! horizontal reference area (unit irradiance normal to the beam). The
@@ -17,8 +21,9 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::heightfield::{FacetId, Heightfield};
+use super::heightfield::Heightfield;
 use super::material::{basis, Bsdf};
+use super::tracer::Tracer;
 use crate::error::{CoreError, CoreResult};
 use crate::rng::StreamKey;
 use std::f64::consts::PI;
@@ -43,13 +48,24 @@ pub struct Estimate {
     pub n: u64,
 }
 
-/// A heightfield with one reflectance model.
+/// A surface (a [`Heightfield`] by default, or any [`Tracer`] such as a
+/// [`super::MeshTracer`]) with its reflectance models.
+///
+/// Facet `k` of the tile ([`Tracer::facet_index`]) has material
+/// `material_ids[k]`: 0 is [`Scene::material`], `i >= 1` is
+/// `more_materials[i - 1]`. Empty `material_ids`: every facet has
+/// material 0.
 #[derive(Debug)]
-pub struct Scene {
+pub struct Scene<G: Tracer = Heightfield> {
     /// The geometry.
-    pub hf: Heightfield,
-    /// The reflectance model of every facet.
+    pub hf: G,
+    /// Material 0 (the reflectance model of every facet when
+    /// `material_ids` is empty).
     pub material: Box<dyn Bsdf>,
+    /// Materials 1, 2, ...
+    pub more_materials: Vec<Box<dyn Bsdf>>,
+    /// Material of every facet of the tile (empty: all 0).
+    pub material_ids: Vec<u32>,
 }
 
 /// Streams: the stream of path `i` of an experiment is `(seed, i)` mixed with
@@ -57,6 +73,7 @@ pub struct Scene {
 const TAG_BRF: u64 = 0x6272_6600_0000_0000;
 const TAG_ALBEDO: u64 = 0x616c_6200_0000_0000;
 const TAG_IMAGE: u64 = 0x696d_6700_0000_0000;
+const TAG_STRATA: u64 = 0x7374_7200_0000_0000;
 
 fn check_spp(spp: u64) -> CoreResult<()> {
     if spp == 0 {
@@ -76,6 +93,38 @@ fn check_depth(max_depth: u32) -> CoreResult<()> {
         ));
     }
     Ok(())
+}
+
+/// Strata of the BRF estimator: each full block of [`BLOCK`] paths puts one
+/// point in each of `STRATA x STRATA` equal cells of the tile.
+const STRATA: u64 = 32;
+const _: () = assert!(STRATA * STRATA == BLOCK);
+
+/// Mean and standard error of a stratified estimate from per-block
+/// `(sum, sum of squares, n)`: full blocks are independent stratified
+/// samples, so the standard error comes from the spread of the block means
+/// (the per-path formula would overstate it); with fewer than 8 blocks, the
+/// per-path formula (conservative) is used. The standard error is at least
+/// 1e-12 of the value (the rounding of the sums).
+fn finish_stratified(blocks: &[(f64, f64, u64)]) -> Estimate {
+    let e = finish(blocks);
+    let k = blocks.len();
+    if k < 8 {
+        return e;
+    }
+    let nf = e.n as f64;
+    let mut v = 0.0;
+    for &(s1, _, n) in blocks {
+        let m = s1 / n as f64;
+        v += (n as f64 * (m - e.value)).powi(2);
+    }
+    let var = v / (nf * nf) * k as f64 / (k as f64 - 1.0);
+    // when every block mean is the same (a closed-form case) what is left
+    // is the rounding of the sums: never report less than that
+    Estimate {
+        se: var.sqrt().max(1e-12 * e.value.abs()),
+        ..e
+    }
 }
 
 /// Mean and standard error from per-block `(sum, sum of squares, n)` added in order.
@@ -100,7 +149,74 @@ fn finish(blocks: &[(f64, f64, u64)]) -> Estimate {
     }
 }
 
-impl Scene {
+impl<G: Tracer> Scene<G> {
+    /// One material on every facet.
+    pub fn new(hf: G, material: Box<dyn Bsdf>) -> Self {
+        Scene {
+            hf,
+            material,
+            more_materials: Vec::new(),
+            material_ids: Vec::new(),
+        }
+    }
+
+    /// Per-facet materials: `material_ids[k]` (one per facet of the tile,
+    /// [`Tracer::facet_index`] order) indexes `materials`. Errors name
+    /// `materials` (empty) or `material_ids` (wrong length, index out of
+    /// range).
+    pub fn with_materials(
+        hf: G,
+        materials: Vec<Box<dyn Bsdf>>,
+        material_ids: Vec<u32>,
+    ) -> CoreResult<Self> {
+        let mut it = materials.into_iter();
+        let Some(first) = it.next() else {
+            return Err(CoreError::invalid(
+                "materials",
+                "expected at least one material, got none",
+            ));
+        };
+        let more: Vec<Box<dyn Bsdf>> = it.collect();
+        let nf = hf.facet_count();
+        if material_ids.len() != nf {
+            return Err(CoreError::invalid(
+                "material_ids",
+                format!(
+                    "expected one material index per facet ({nf}), got {}",
+                    material_ids.len()
+                ),
+            ));
+        }
+        let nm = more.len() + 1;
+        if let Some(k) = material_ids.iter().position(|&i| i as usize >= nm) {
+            return Err(CoreError::invalid(
+                "material_ids",
+                format!(
+                    "facet {k} has material index {}, but there are {nm} materials",
+                    material_ids[k]
+                ),
+            ));
+        }
+        Ok(Scene {
+            hf,
+            material: first,
+            more_materials: more,
+            material_ids,
+        })
+    }
+
+    /// The reflectance model of a facet.
+    #[inline(always)]
+    pub fn bsdf(&self, f: G::Facet) -> &dyn Bsdf {
+        if self.material_ids.is_empty() {
+            return &*self.material;
+        }
+        match self.material_ids[self.hf.facet_index(f)] {
+            0 => &*self.material,
+            i => &*self.more_materials[i as usize - 1],
+        }
+    }
+
     /// World-to-local of `w` in the frame of normal `n`.
     #[inline]
     fn local(n: DVec3, t: DVec3, b: DVec3, w: DVec3) -> DVec3 {
@@ -112,7 +228,7 @@ impl Scene {
     /// weight, from the uniforms `dim`, `dim + 1` of `key` (`dim` advances).
     #[inline]
     fn scatter(
-        &self,
+        m: &dyn Bsdf,
         (t, b, n): (DVec3, DVec3, DVec3),
         wo: DVec3,
         key: StreamKey,
@@ -120,7 +236,7 @@ impl Scene {
     ) -> Option<(DVec3, f64)> {
         let u = [key.uniform(*dim), key.uniform(*dim + 1)];
         *dim += 2;
-        let smp = self.material.sample(wo, u)?;
+        let smp = m.sample(wo, u)?;
         Some((smp.wi.x * t + smp.wi.y * b + smp.wi.z * n, smp.weight))
     }
 
@@ -128,33 +244,50 @@ impl Scene {
     /// against `v` (from above the highest facet).
     #[inline]
     fn sensor_ray(&self, x: f64, y: f64, v: DVec3) -> DVec3 {
-        let hf = &self.hf;
-        let top = hf.zmax + 1e-6 * (1.0 + hf.zmax.abs());
-        let lift = (top - hf.zmean).max(0.0) / v.z;
-        DVec3::new(x, y, hf.zmean) + lift * v
+        let (_, zmax, zref) = self.hf.z_range();
+        let top = zmax + 1e-6 * (1.0 + zmax.abs());
+        let lift = (top - zref).max(0.0) / v.z;
+        DVec3::new(x, y, zref) + lift * v
     }
 
     /// Radiance along the ray `o - t v` (towards the surface) for unit sun
-    /// irradiance normal to `s`, up to `max_depth` scattering events; `key`
-    /// supplies uniforms from index `dim` on.
+    /// irradiance normal to `s` plus an isotropic sky of radiance `sky_l`
+    /// over the upper hemisphere, up to `max_depth` scattering events;
+    /// `key` supplies uniforms from index `dim` on.
+    ///
+    /// At each facet hit the sun is added when the shadow ray escapes (also
+    /// behind a transmitting facet); a path that leaves upwards after `k >= 1`
+    /// scattering events (`k <= max_depth`) adds `throughput * sky_l`. With
+    /// `sky_l = 0` the walk stops after the `max_depth`-th sun estimate (no
+    /// further draw), so sky-free results do not depend on the sky code.
+    #[allow(clippy::too_many_arguments)]
     fn radiance(
         &self,
         mut o: DVec3,
         v: DVec3,
         s: DVec3,
+        sky_l: f64,
         max_depth: u32,
         key: StreamKey,
         mut dim: u64,
     ) -> f64 {
         let hf = &self.hf;
         let mut d = -v;
-        let mut skip: Option<FacetId> = None;
+        let mut skip: Option<G::Facet> = None;
         let mut throughput = 1.0;
         let mut l = 0.0;
-        for depth in 1..=max_depth {
-            let Some(hit) = hf.intersect(o, d, skip) else {
+        let mut depth = 0u32;
+        loop {
+            let Some(hit) = hf.trace(o, d, skip) else {
+                if depth > 0 && d.z > 0.0 {
+                    l += throughput * sky_l; // escaped into the sky
+                }
                 break;
             };
+            if depth == max_depth {
+                break;
+            }
+            depth += 1;
             let n = hit.normal;
             if n.dot(d) >= 0.0 {
                 break; // reached a facet from below: numerically lost
@@ -162,15 +295,16 @@ impl Scene {
             let (p, facet) = hf.wrap(o + hit.t * d, hit.facet);
             let (t, b) = basis(n);
             let wo = Self::local(n, t, b, -d);
+            let m = self.bsdf(facet);
             let cos_s = n.dot(s);
-            if cos_s > 0.0 && hf.intersect(p, s, Some(facet)).is_none() {
+            if (cos_s > 0.0 || (cos_s < 0.0 && m.transmits())) && !hf.occluded(p, s, Some(facet)) {
                 let wi = Self::local(n, t, b, s);
-                l += throughput * self.material.eval(wi, wo) * cos_s;
+                l += throughput * m.eval(wi, wo) * cos_s.abs();
             }
-            if depth == max_depth {
+            if depth == max_depth && sky_l == 0.0 {
                 break;
             }
-            let Some((wi, weight)) = self.scatter((t, b, n), wo, key, &mut dim) else {
+            let Some((wi, weight)) = Self::scatter(m, (t, b, n), wo, key, &mut dim) else {
                 break;
             };
             throughput *= weight;
@@ -187,7 +321,7 @@ impl Scene {
     /// Bidirectional reflectance factor for the sun towards `sun` and the
     /// sensor towards `view` (unit vectors (east, north, up) from
     /// [`super::direction`]), over `spp` paths of at most `max_depth`
-    /// scattering events.
+    /// scattering events: [`Scene::brf_sky`] with no sky.
     pub fn brf(
         &self,
         sun: DVec3,
@@ -196,20 +330,123 @@ impl Scene {
         max_depth: u32,
         seed: u64,
     ) -> CoreResult<Estimate> {
+        self.brf_sky(sun, view, 0.0, spp, max_depth, seed)
+    }
+
+    /// The reflectance factor under the sun towards `sun` (irradiance 1
+    /// normal to the beam) plus an isotropic sky whose irradiance on a
+    /// horizontal plane is `sky` (same unit): `pi L / (cos(sun zenith) +
+    /// sky)`, the hemispherical-directional reflectance factor (HDRF); the
+    /// BRF for `sky = 0`. Sensor points are stratified over the footprint
+    /// (one per cell of a 32 x 32 division in each full block of 1024 paths).
+    pub fn brf_sky(
+        &self,
+        sun: DVec3,
+        view: DVec3,
+        sky: f64,
+        spp: u64,
+        max_depth: u32,
+        seed: u64,
+    ) -> CoreResult<Estimate> {
         check_spp(spp)?;
         check_depth(max_depth)?;
-        let (w, h) = self.hf.extent();
-        let norm = PI / sun.z;
+        check_sky(sky)?;
+        let (x0, y0, w, h) = self.hf.footprint();
+        let ytop = y0 + h;
+        let norm = PI / (sun.z + sky);
+        let sky_l = sky / PI;
+        let blocks: Vec<(f64, f64, u64)> = (0..spp.div_ceil(BLOCK))
+            .into_par_iter()
+            .map(|blk| {
+                let (mut s1, mut s2) = (0.0, 0.0);
+                let end = ((blk + 1) * BLOCK).min(spp);
+                // path j of the block takes stratum (797 j + b) mod 1024, an odd
+                // multiplier and a random offset per block: every stratum once
+                // in a full block, and each point uniform over the tile
+                let off = (StreamKey::new(seed, TAG_STRATA ^ blk).uniform(0) * BLOCK as f64) as u64;
+                for i in blk * BLOCK..end {
+                    let key = StreamKey::new(seed, TAG_BRF ^ i);
+                    let st = (797 * (i - blk * BLOCK) + off) % BLOCK;
+                    let (sx, sy) = ((st % STRATA) as f64, (st / STRATA) as f64);
+                    let x = x0 + (sx + key.uniform(0)) / STRATA as f64 * w;
+                    let y = ytop - (sy + key.uniform(1)) / STRATA as f64 * h;
+                    let o = self.sensor_ray(x, y, view);
+                    let r = norm * self.radiance(o, view, sun, sky_l, max_depth, key, 2);
+                    s1 += r;
+                    s2 += r * r;
+                }
+                (s1, s2, end - blk * BLOCK)
+            })
+            .collect();
+        Ok(finish_stratified(&blocks))
+    }
+
+    /// The fraction of light arriving along `-sun` at the reference-plane
+    /// point `(x, y)` that leaves (upwards, or through a side of a finite
+    /// patch; [`Tracer::escapes`]) after at most `max_depth` scattering
+    /// events: one path of [`Scene::albedo`], uniforms from `dim`.
+    fn albedo_path(
+        &self,
+        sun: DVec3,
+        (x, y): (f64, f64),
+        max_depth: u32,
+        key: StreamKey,
+        mut dim: u64,
+    ) -> f64 {
+        let hf = &self.hf;
+        let mut o = self.sensor_ray(x, y, sun);
+        let mut d = -sun;
+        let mut skip = None;
+        let mut throughput = 1.0;
+        for depth in 0..=max_depth {
+            let Some(hit) = hf.trace(o, d, skip) else {
+                // escaped after scattering (not counted before the first hit)
+                return if depth > 0 && hf.escapes(d) {
+                    throughput
+                } else {
+                    0.0
+                };
+            };
+            if depth == max_depth || hit.normal.dot(d) >= 0.0 {
+                return 0.0; // still trapped (or lost): not counted
+            }
+            let n = hit.normal;
+            let (p, facet) = hf.wrap(o + hit.t * d, hit.facet);
+            let (t, b) = basis(n);
+            let wo = Self::local(n, t, b, -d);
+            // reciprocity: sample the reflected direction as an incident
+            // one for the light's arrival direction
+            let m = self.bsdf(facet);
+            let Some((wi, weight)) = Self::scatter(m, (t, b, n), wo, key, &mut dim) else {
+                return 0.0;
+            };
+            throughput *= weight;
+            if throughput == 0.0 {
+                return 0.0;
+            }
+            d = wi;
+            o = p;
+            skip = Some(facet);
+        }
+        0.0
+    }
+
+    /// Directional-hemispherical reflectance (black-sky albedo) for the sun
+    /// towards `sun`, over `spp` rays of at most `max_depth` scattering events.
+    pub fn albedo(&self, sun: DVec3, spp: u64, max_depth: u32, seed: u64) -> CoreResult<Estimate> {
+        check_spp(spp)?;
+        check_depth(max_depth)?;
+        let (x0, y0, w, h) = self.hf.footprint();
+        let ytop = y0 + h;
         let blocks: Vec<(f64, f64, u64)> = (0..spp.div_ceil(BLOCK))
             .into_par_iter()
             .map(|blk| {
                 let (mut s1, mut s2) = (0.0, 0.0);
                 let end = ((blk + 1) * BLOCK).min(spp);
                 for i in blk * BLOCK..end {
-                    let key = StreamKey::new(seed, TAG_BRF ^ i);
-                    let (x, y) = (key.uniform(0) * w, -key.uniform(1) * h);
-                    let o = self.sensor_ray(x, y, view);
-                    let r = norm * self.radiance(o, view, sun, max_depth, key, 2);
+                    let key = StreamKey::new(seed, TAG_ALBEDO ^ i);
+                    let (x, y) = (x0 + key.uniform(0) * w, ytop - key.uniform(1) * h);
+                    let r = self.albedo_path(sun, (x, y), max_depth, key, 2);
                     s1 += r;
                     s2 += r * r;
                 }
@@ -219,54 +456,29 @@ impl Scene {
         Ok(finish(&blocks))
     }
 
-    /// Directional-hemispherical reflectance (black-sky albedo) for the sun
-    /// towards `sun`, over `spp` rays of at most `max_depth` scattering events.
-    pub fn albedo(&self, sun: DVec3, spp: u64, max_depth: u32, seed: u64) -> CoreResult<Estimate> {
+    /// Bi-hemispherical reflectance (white-sky albedo): the albedo under a
+    /// uniform sky, `(1/pi) * integral of albedo(s) cos(s) ds` over the
+    /// upper hemisphere. Each of the `spp` paths draws its sun direction
+    /// cosine-weighted, then follows it as [`Scene::albedo`] does.
+    pub fn bhr(&self, spp: u64, max_depth: u32, seed: u64) -> CoreResult<Estimate> {
         check_spp(spp)?;
         check_depth(max_depth)?;
-        let (w, h) = self.hf.extent();
-        let hf = &self.hf;
+        let (x0, y0, w, h) = self.hf.footprint();
+        let ytop = y0 + h;
         let blocks: Vec<(f64, f64, u64)> = (0..spp.div_ceil(BLOCK))
             .into_par_iter()
             .map(|blk| {
                 let (mut s1, mut s2) = (0.0, 0.0);
                 let end = ((blk + 1) * BLOCK).min(spp);
                 for i in blk * BLOCK..end {
-                    let key = StreamKey::new(seed, TAG_ALBEDO ^ i);
-                    let (x, y) = (key.uniform(0) * w, -key.uniform(1) * h);
-                    let mut o = self.sensor_ray(x, y, sun);
-                    let mut d = -sun;
-                    let mut skip = None;
-                    let mut throughput = 1.0;
-                    let mut r = 0.0;
-                    let mut dim = 2u64;
-                    for depth in 0..=max_depth {
-                        let Some(hit) = hf.intersect(o, d, skip) else {
-                            if depth > 0 {
-                                r = throughput; // escaped after scattering
-                            }
-                            break;
-                        };
-                        if depth == max_depth || hit.normal.dot(d) >= 0.0 {
-                            break; // still trapped (or lost): not counted
-                        }
-                        let n = hit.normal;
-                        let (p, facet) = hf.wrap(o + hit.t * d, hit.facet);
-                        let (t, b) = basis(n);
-                        let wo = Self::local(n, t, b, -d);
-                        // reciprocity: sample the reflected direction as an
-                        // incident one for the light's arrival direction
-                        let Some((wi, weight)) = self.scatter((t, b, n), wo, key, &mut dim) else {
-                            break;
-                        };
-                        throughput *= weight;
-                        if throughput == 0.0 {
-                            break;
-                        }
-                        d = wi;
-                        o = p;
-                        skip = Some(facet);
-                    }
+                    let key = StreamKey::new(seed, TAG_BHR ^ i);
+                    let (x, y) = (x0 + key.uniform(0) * w, ytop - key.uniform(1) * h);
+                    let sun = super::material::cosine_hemisphere([key.uniform(2), key.uniform(3)]);
+                    let r = if sun.z > 0.0 {
+                        self.albedo_path(sun, (x, y), max_depth, key, 4)
+                    } else {
+                        0.0
+                    };
                     s1 += r;
                     s2 += r * r;
                 }
@@ -289,7 +501,7 @@ impl Scene {
         max_depth: u32,
         seed: u64,
     ) -> CoreResult<Vec<f32>> {
-        self.render_progress(sun, view, shape, spp, max_depth, seed, None)
+        self.render_psf(sun, view, 0.0, shape, spp, max_depth, seed, &Psf::Box, None)
     }
 
     /// [`Scene::render`], ticking `progress` once per image row (the image
@@ -305,28 +517,44 @@ impl Scene {
         seed: u64,
         progress: Option<&crate::progress::Progress>,
     ) -> CoreResult<Vec<f32>> {
-        check_spp(spp)?;
-        check_depth(max_depth)?;
+        self.render_psf(
+            sun,
+            view,
+            0.0,
+            shape,
+            spp,
+            max_depth,
+            seed,
+            &Psf::Box,
+            progress,
+        )
+    }
+
+    /// [`Scene::render_progress`] with an isotropic sky of horizontal
+    /// irradiance `sky` and the point-spread function `psf`: each path's
+    /// footprint point is drawn from the PSF around the pixel's centre
+    /// (it may fall outside the pixel, and outside a finite patch, where
+    /// nothing is seen). `Psf::Box` and `sky = 0` is [`Scene::render`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_psf(
+        &self,
+        sun: DVec3,
+        view: DVec3,
+        sky: f64,
+        shape: (usize, usize),
+        spp: u64,
+        max_depth: u32,
+        seed: u64,
+        psf: &Psf,
+        progress: Option<&crate::progress::Progress>,
+    ) -> CoreResult<Vec<f32>> {
+        check_sky(sky)?;
+        let mut img = image_buffer(shape, spp, max_depth, progress)?;
         let (rows, cols) = shape;
-        if rows == 0 || cols == 0 {
-            return Err(CoreError::invalid(
-                "shape",
-                format!("expected a positive number of rows and columns, got ({rows}, {cols})"),
-            ));
-        }
-        let npix = rows as u128 * cols as u128;
-        if npix > MAX_PIXELS as u128 {
-            return Err(CoreError::OutOfMemory {
-                param: "shape".into(),
-                bytes: npix * 4,
-            });
-        }
-        let mut img: Vec<f32> = crate::buffers::try_filled(rows * cols, 0.0f32, "shape")?;
-        if let Some(p) = progress {
-            p.add_total(rows as u64);
-        }
-        let (w, h) = self.hf.extent();
+        let (x0, y0, w, h) = self.hf.footprint();
+        let ytop = y0 + h;
         let (pw, ph) = (w / cols as f64, h / rows as f64);
+        let sky_l = sky / PI;
         img.par_chunks_mut(cols).enumerate().for_each(|(i, line)| {
             for (j, px) in line.iter_mut().enumerate() {
                 let pixel = (i * cols + j) as u64;
@@ -334,10 +562,72 @@ impl Scene {
                 for k in 0..spp {
                     let key =
                         StreamKey::new(seed, TAG_IMAGE ^ pixel.wrapping_mul(spp).wrapping_add(k));
-                    let x = (j as f64 + key.uniform(0)) * pw;
-                    let y = -(i as f64 + key.uniform(1)) * ph;
+                    let (fx, fy) = psf.position([key.uniform(0), key.uniform(1)]);
+                    let x = x0 + (j as f64 + fx) * pw;
+                    let y = ytop - (i as f64 + fy) * ph;
                     let o = self.sensor_ray(x, y, view);
-                    s += self.radiance(o, view, sun, max_depth, key, 2);
+                    s += self.radiance(o, view, sun, sky_l, max_depth, key, 2);
+                }
+                *px = (s / spp as f64) as f32;
+            }
+            if let Some(p) = progress {
+                p.tick(1);
+            }
+        });
+        Ok(img)
+    }
+
+    /// A `rows x cols` radiance image seen by the pinhole camera `cam`
+    /// (box pixels, `spp` paths each), the sun towards `sun` and an
+    /// isotropic sky of horizontal irradiance `sky`. Rays that miss the
+    /// surface see the sky radiance `sky / pi` above the horizon and 0
+    /// below it.
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_perspective(
+        &self,
+        sun: DVec3,
+        sky: f64,
+        cam: &Pinhole,
+        shape: (usize, usize),
+        spp: u64,
+        max_depth: u32,
+        seed: u64,
+        progress: Option<&crate::progress::Progress>,
+    ) -> CoreResult<Vec<f32>> {
+        check_sky(sky)?;
+        let mut img = image_buffer(shape, spp, max_depth, progress)?;
+        let cols = shape.1;
+        let hf = &self.hf;
+        let (_, zmax, _) = hf.z_range();
+        let top = zmax + 1e-6 * (1.0 + zmax.abs());
+        let sky_l = sky / PI;
+        img.par_chunks_mut(cols).enumerate().for_each(|(i, line)| {
+            for (j, px) in line.iter_mut().enumerate() {
+                let pixel = (i * cols + j) as u64;
+                let mut s = 0.0;
+                for k in 0..spp {
+                    let key = StreamKey::new(
+                        seed,
+                        TAG_PERSPECTIVE ^ pixel.wrapping_mul(spp).wrapping_add(k),
+                    );
+                    let d = cam.ray(i as f64 + key.uniform(1), j as f64 + key.uniform(0), shape);
+                    // start on the plane just above the highest facet
+                    let o = if cam.eye.z > top {
+                        if d.z < 0.0 {
+                            Some(cam.eye + ((cam.eye.z - top) / -d.z) * d)
+                        } else {
+                            None
+                        }
+                    } else {
+                        Some(cam.eye)
+                    };
+                    s += match o {
+                        Some(o) if hf.trace(o, d, None).is_some() => {
+                            self.radiance(o, -d, sun, sky_l, max_depth, key, 2)
+                        }
+                        _ if d.z > 0.0 => sky_l,
+                        _ => 0.0,
+                    };
                 }
                 *px = (s / spp as f64) as f32;
             }
@@ -349,8 +639,37 @@ impl Scene {
     }
 }
 
-// ---- Sky light, sensor point-spread functions and the bi-hemispherical
-// reflectance (new entry points beside the ones above; those are unchanged).
+/// The checked, zeroed `rows x cols` image of a renderer (errors name
+/// `spp`, `max_depth` or `shape`); `progress` gets one unit per row.
+fn image_buffer(
+    (rows, cols): (usize, usize),
+    spp: u64,
+    max_depth: u32,
+    progress: Option<&crate::progress::Progress>,
+) -> CoreResult<Vec<f32>> {
+    check_spp(spp)?;
+    check_depth(max_depth)?;
+    if rows == 0 || cols == 0 {
+        return Err(CoreError::invalid(
+            "shape",
+            format!("expected a positive number of rows and columns, got ({rows}, {cols})"),
+        ));
+    }
+    let npix = rows as u128 * cols as u128;
+    if npix > MAX_PIXELS as u128 {
+        return Err(CoreError::OutOfMemory {
+            param: "shape".into(),
+            bytes: npix * 4,
+        });
+    }
+    let img: Vec<f32> = crate::buffers::try_filled(rows * cols, 0.0f32, "shape")?;
+    if let Some(p) = progress {
+        p.add_total(rows as u64);
+    }
+    Ok(img)
+}
+
+// ---- Sky light and sensor point-spread functions.
 
 const TAG_BHR: u64 = 0x6268_7200_0000_0000;
 
@@ -491,246 +810,6 @@ impl Psf {
     }
 }
 
-impl Scene {
-    /// [`Scene::radiance`] with an isotropic sky of radiance `sky_l` over
-    /// the upper hemisphere: a path that leaves upwards after `k >= 1`
-    /// scattering events (`k <= max_depth`) adds `throughput * sky_l`. With
-    /// `sky_l = 0` it draws the same numbers and returns the same value as
-    /// [`Scene::radiance`].
-    #[allow(clippy::too_many_arguments)]
-    fn radiance_sky(
-        &self,
-        mut o: DVec3,
-        v: DVec3,
-        s: DVec3,
-        sky_l: f64,
-        max_depth: u32,
-        key: StreamKey,
-        mut dim: u64,
-    ) -> f64 {
-        let hf = &self.hf;
-        let mut d = -v;
-        let mut skip: Option<FacetId> = None;
-        let mut throughput = 1.0;
-        let mut l = 0.0;
-        let mut depth = 0u32;
-        loop {
-            let Some(hit) = hf.intersect(o, d, skip) else {
-                if depth > 0 && d.z > 0.0 {
-                    l += throughput * sky_l; // escaped into the sky
-                }
-                break;
-            };
-            if depth == max_depth {
-                break;
-            }
-            depth += 1;
-            let n = hit.normal;
-            if n.dot(d) >= 0.0 {
-                break; // reached a facet from below: numerically lost
-            }
-            let (p, facet) = hf.wrap(o + hit.t * d, hit.facet);
-            let (t, b) = basis(n);
-            let wo = Self::local(n, t, b, -d);
-            let cos_s = n.dot(s);
-            if cos_s > 0.0 && hf.intersect(p, s, Some(facet)).is_none() {
-                let wi = Self::local(n, t, b, s);
-                l += throughput * self.material.eval(wi, wo) * cos_s;
-            }
-            if depth == max_depth && sky_l == 0.0 {
-                break;
-            }
-            let Some((wi, weight)) = self.scatter((t, b, n), wo, key, &mut dim) else {
-                break;
-            };
-            throughput *= weight;
-            if throughput == 0.0 {
-                break;
-            }
-            d = wi;
-            o = p;
-            skip = Some(facet);
-        }
-        l
-    }
-
-    /// The reflectance factor under the sun towards `sun` (irradiance 1
-    /// normal to the beam) plus an isotropic sky whose irradiance on a
-    /// horizontal plane is `sky` (same unit): `pi L / (cos(sun zenith) +
-    /// sky)`, the hemispherical-directional reflectance factor (HDRF). With
-    /// `sky = 0` it equals [`Scene::brf`] bit for bit (same paths).
-    pub fn brf_sky(
-        &self,
-        sun: DVec3,
-        view: DVec3,
-        sky: f64,
-        spp: u64,
-        max_depth: u32,
-        seed: u64,
-    ) -> CoreResult<Estimate> {
-        check_spp(spp)?;
-        check_depth(max_depth)?;
-        check_sky(sky)?;
-        let (w, h) = self.hf.extent();
-        let norm = PI / (sun.z + sky);
-        let sky_l = sky / PI;
-        let blocks: Vec<(f64, f64, u64)> = (0..spp.div_ceil(BLOCK))
-            .into_par_iter()
-            .map(|blk| {
-                let (mut s1, mut s2) = (0.0, 0.0);
-                let end = ((blk + 1) * BLOCK).min(spp);
-                for i in blk * BLOCK..end {
-                    let key = StreamKey::new(seed, TAG_BRF ^ i);
-                    let (x, y) = (key.uniform(0) * w, -key.uniform(1) * h);
-                    let o = self.sensor_ray(x, y, view);
-                    let r = norm * self.radiance_sky(o, view, sun, sky_l, max_depth, key, 2);
-                    s1 += r;
-                    s2 += r * r;
-                }
-                (s1, s2, end - blk * BLOCK)
-            })
-            .collect();
-        Ok(finish(&blocks))
-    }
-
-    /// [`Scene::render_progress`] with an isotropic sky of horizontal
-    /// irradiance `sky` and the point-spread function `psf`: each path's
-    /// footprint point is drawn from the PSF around the pixel's centre
-    /// (it may fall outside the pixel, and outside a finite patch, where
-    /// nothing is seen). With `Psf::Box` and `sky = 0` the image equals
-    /// [`Scene::render`] bit for bit.
-    #[allow(clippy::too_many_arguments)]
-    pub fn render_psf(
-        &self,
-        sun: DVec3,
-        view: DVec3,
-        sky: f64,
-        shape: (usize, usize),
-        spp: u64,
-        max_depth: u32,
-        seed: u64,
-        psf: &Psf,
-        progress: Option<&crate::progress::Progress>,
-    ) -> CoreResult<Vec<f32>> {
-        check_spp(spp)?;
-        check_depth(max_depth)?;
-        check_sky(sky)?;
-        let (rows, cols) = shape;
-        if rows == 0 || cols == 0 {
-            return Err(CoreError::invalid(
-                "shape",
-                format!("expected a positive number of rows and columns, got ({rows}, {cols})"),
-            ));
-        }
-        let npix = rows as u128 * cols as u128;
-        if npix > MAX_PIXELS as u128 {
-            return Err(CoreError::OutOfMemory {
-                param: "shape".into(),
-                bytes: npix * 4,
-            });
-        }
-        let mut img: Vec<f32> = crate::buffers::try_filled(rows * cols, 0.0f32, "shape")?;
-        if let Some(p) = progress {
-            p.add_total(rows as u64);
-        }
-        let (w, h) = self.hf.extent();
-        let (pw, ph) = (w / cols as f64, h / rows as f64);
-        let sky_l = sky / PI;
-        img.par_chunks_mut(cols).enumerate().for_each(|(i, line)| {
-            for (j, px) in line.iter_mut().enumerate() {
-                let pixel = (i * cols + j) as u64;
-                let mut s = 0.0;
-                for k in 0..spp {
-                    let key =
-                        StreamKey::new(seed, TAG_IMAGE ^ pixel.wrapping_mul(spp).wrapping_add(k));
-                    let (fx, fy) = psf.position([key.uniform(0), key.uniform(1)]);
-                    let x = (j as f64 + fx) * pw;
-                    let y = -(i as f64 + fy) * ph;
-                    let o = self.sensor_ray(x, y, view);
-                    s += self.radiance_sky(o, view, sun, sky_l, max_depth, key, 2);
-                }
-                *px = (s / spp as f64) as f32;
-            }
-            if let Some(p) = progress {
-                p.tick(1);
-            }
-        });
-        Ok(img)
-    }
-
-    /// The fraction of light arriving along `-sun` at the reference-plane
-    /// point `(x, y)` that leaves upwards after at most `max_depth`
-    /// scattering events (one path of [`Scene::albedo`]), uniforms from `dim`.
-    fn albedo_path(
-        &self,
-        sun: DVec3,
-        (x, y): (f64, f64),
-        max_depth: u32,
-        key: StreamKey,
-        mut dim: u64,
-    ) -> f64 {
-        let hf = &self.hf;
-        let mut o = self.sensor_ray(x, y, sun);
-        let mut d = -sun;
-        let mut skip = None;
-        let mut throughput = 1.0;
-        for depth in 0..=max_depth {
-            let Some(hit) = hf.intersect(o, d, skip) else {
-                return if depth > 0 { throughput } else { 0.0 };
-            };
-            if depth == max_depth || hit.normal.dot(d) >= 0.0 {
-                return 0.0;
-            }
-            let n = hit.normal;
-            let (p, facet) = hf.wrap(o + hit.t * d, hit.facet);
-            let (t, b) = basis(n);
-            let wo = Self::local(n, t, b, -d);
-            let Some((wi, weight)) = self.scatter((t, b, n), wo, key, &mut dim) else {
-                return 0.0;
-            };
-            throughput *= weight;
-            if throughput == 0.0 {
-                return 0.0;
-            }
-            d = wi;
-            o = p;
-            skip = Some(facet);
-        }
-        0.0
-    }
-
-    /// Bi-hemispherical reflectance (white-sky albedo): the albedo under a
-    /// uniform sky, `(1/pi) * integral of albedo(s) cos(s) ds` over the
-    /// upper hemisphere. Each of the `spp` paths draws its sun direction
-    /// cosine-weighted, then follows it as [`Scene::albedo`] does.
-    pub fn bhr(&self, spp: u64, max_depth: u32, seed: u64) -> CoreResult<Estimate> {
-        check_spp(spp)?;
-        check_depth(max_depth)?;
-        let (w, h) = self.hf.extent();
-        let blocks: Vec<(f64, f64, u64)> = (0..spp.div_ceil(BLOCK))
-            .into_par_iter()
-            .map(|blk| {
-                let (mut s1, mut s2) = (0.0, 0.0);
-                let end = ((blk + 1) * BLOCK).min(spp);
-                for i in blk * BLOCK..end {
-                    let key = StreamKey::new(seed, TAG_BHR ^ i);
-                    let (x, y) = (key.uniform(0) * w, -key.uniform(1) * h);
-                    let sun = super::material::cosine_hemisphere([key.uniform(2), key.uniform(3)]);
-                    let r = if sun.z > 0.0 {
-                        self.albedo_path(sun, (x, y), max_depth, key, 4)
-                    } else {
-                        0.0
-                    };
-                    s1 += r;
-                    s2 += r * r;
-                }
-                (s1, s2, end - blk * BLOCK)
-            })
-            .collect();
-        Ok(finish(&blocks))
-    }
-}
-
 fn check_sky(sky: f64) -> CoreResult<()> {
     if !(sky.is_finite() && sky >= 0.0) {
         return Err(CoreError::invalid(
@@ -804,85 +883,5 @@ impl Pinhole {
         let sx = (2.0 * col / cols as f64 - 1.0) * self.tan_half * aspect;
         let sy = (1.0 - 2.0 * row / rows as f64) * self.tan_half;
         (self.fwd + sx * self.right + sy * self.up).normalize()
-    }
-}
-
-impl Scene {
-    /// A `rows x cols` radiance image seen by the pinhole camera `cam`
-    /// (box pixels, `spp` paths each), the sun towards `sun` and an
-    /// isotropic sky of horizontal irradiance `sky`. Rays that miss the
-    /// surface see the sky radiance `sky / pi` above the horizon and 0
-    /// below it.
-    #[allow(clippy::too_many_arguments)]
-    pub fn render_perspective(
-        &self,
-        sun: DVec3,
-        sky: f64,
-        cam: &Pinhole,
-        shape: (usize, usize),
-        spp: u64,
-        max_depth: u32,
-        seed: u64,
-        progress: Option<&crate::progress::Progress>,
-    ) -> CoreResult<Vec<f32>> {
-        check_spp(spp)?;
-        check_depth(max_depth)?;
-        check_sky(sky)?;
-        let (rows, cols) = shape;
-        if rows == 0 || cols == 0 {
-            return Err(CoreError::invalid(
-                "shape",
-                format!("expected a positive number of rows and columns, got ({rows}, {cols})"),
-            ));
-        }
-        let npix = rows as u128 * cols as u128;
-        if npix > MAX_PIXELS as u128 {
-            return Err(CoreError::OutOfMemory {
-                param: "shape".into(),
-                bytes: npix * 4,
-            });
-        }
-        let mut img: Vec<f32> = crate::buffers::try_filled(rows * cols, 0.0f32, "shape")?;
-        if let Some(p) = progress {
-            p.add_total(rows as u64);
-        }
-        let hf = &self.hf;
-        let top = hf.zmax + 1e-6 * (1.0 + hf.zmax.abs());
-        let sky_l = sky / PI;
-        img.par_chunks_mut(cols).enumerate().for_each(|(i, line)| {
-            for (j, px) in line.iter_mut().enumerate() {
-                let pixel = (i * cols + j) as u64;
-                let mut s = 0.0;
-                for k in 0..spp {
-                    let key = StreamKey::new(
-                        seed,
-                        TAG_PERSPECTIVE ^ pixel.wrapping_mul(spp).wrapping_add(k),
-                    );
-                    let d = cam.ray(i as f64 + key.uniform(1), j as f64 + key.uniform(0), shape);
-                    // start on the plane just above the highest facet
-                    let o = if cam.eye.z > top {
-                        if d.z < 0.0 {
-                            Some(cam.eye + ((cam.eye.z - top) / -d.z) * d)
-                        } else {
-                            None
-                        }
-                    } else {
-                        Some(cam.eye)
-                    };
-                    s += match o {
-                        Some(o) if hf.intersect(o, d, None).is_some() => {
-                            self.radiance_sky(o, -d, sun, sky_l, max_depth, key, 2)
-                        }
-                        _ if d.z > 0.0 => sky_l,
-                        _ => 0.0,
-                    };
-                }
-                *px = (s / spp as f64) as f32;
-            }
-            if let Some(p) = progress {
-                p.tick(1);
-            }
-        });
-        Ok(img)
     }
 }

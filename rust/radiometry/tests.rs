@@ -37,10 +37,10 @@ fn rough(n: usize, amp: f64, seed: u64) -> Vec<f64> {
 }
 
 fn scene(z: &[f64], rows: usize, cols: usize, periodic: bool, mat: &str, p: &[f64]) -> Scene {
-    Scene {
-        hf: Heightfield::new(z, rows, cols, (1.0, 1.0), periodic, Split::NeSw).unwrap(),
-        material: material::from_name(mat, p).unwrap(),
-    }
+    Scene::new(
+        Heightfield::new(z, rows, cols, (1.0, 1.0), periodic, Split::NeSw).unwrap(),
+        material::from_name(mat, p).unwrap(),
+    )
 }
 
 fn dir(az: f64, zen: f64) -> DVec3 {
@@ -126,11 +126,18 @@ fn brute(
 
 #[test]
 fn traversal_agrees_with_brute_force_periodic_and_not() {
-    let (rows, cols) = (5, 7);
+    // (6, 8) with blocks of 2 x 2 cells exercises the coarse level
+    for (rows, cols, bside) in [(5, 7, 0), (6, 8, 2), (6, 8, 4)] {
+        traversal_case(rows, cols, bside);
+    }
+}
+
+fn traversal_case(rows: usize, cols: usize, bside: usize) {
     let z = rough(7, 3.0, 4)[..rows * cols].to_vec();
     let key = StreamKey::new(11, 1);
     for periodic in [true, false] {
-        let hf = Heightfield::new(&z, rows, cols, (1.0, 1.0), periodic, Split::NeSw).unwrap();
+        let mut hf = Heightfield::new(&z, rows, cols, (1.0, 1.0), periodic, Split::NeSw).unwrap();
+        hf.set_block_side(bside);
         let mut hits = 0;
         for i in 0..3000u64 {
             let u = |k: u64| key.uniform(10 * i + k);
@@ -142,6 +149,11 @@ fn traversal_agrees_with_brute_force_periodic_and_not() {
             // directions mostly downward but some climbing, some grazing
             let d = DVec3::new(u(3) - 0.5, u(4) - 0.5, -0.9 * u(5) + 0.25).normalize();
             let mine = hf.intersect(o, d, None);
+            // the shadow-ray test agrees, and stops at t_max
+            assert_eq!(hf.occluded(o, d, None, f64::INFINITY), mine.is_some());
+            if let Some(h) = mine {
+                assert!(hf.occluded(o, d, None, h.t * (1.0 + 1e-9)));
+            }
             let theirs = brute(&z, rows, cols, periodic, o, d, 6);
             // origin below the surface: both may disagree on which side; skip
             let below = {
@@ -164,10 +176,48 @@ fn traversal_agrees_with_brute_force_periodic_and_not() {
                 (None, None) => {}
                 // the brute force sees only 13 x 13 tiles: a far hit it misses is fine
                 (Some(a), None) if periodic && a.t > 6.0 * 5.0 => {}
-                (a, b) => panic!("periodic={periodic} i={i}: {a:?} vs {b:?} o={o} d={d}"),
+                (a, b) => {
+                    panic!("periodic={periodic} bside={bside} i={i}: {a:?} vs {b:?} o={o} d={d}")
+                }
             }
         }
         assert!(hits > if periodic { 1000 } else { 300 }, "{hits}");
+    }
+}
+
+/// On a grid large enough for the coarse level, every ray (long and
+/// shallow ones included) finds the same facet at the same `t` as the plain
+/// cell walk, and the shadow-ray test agrees.
+#[test]
+fn coarse_level_changes_no_hit() {
+    let n = 128;
+    let z = rough(n, 12.0, 9);
+    let key = StreamKey::new(5, 2);
+    for periodic in [true, false] {
+        let fast = Heightfield::new(&z, n, n, (1.0, 1.5), periodic, Split::NwSe).unwrap();
+        let mut plain = fast.clone();
+        plain.set_block_side(0);
+        let mut hits = 0;
+        for i in 0..20_000u64 {
+            let u = |k: u64| key.uniform(10 * i + k);
+            let o = DVec3::new(
+                u(0) * n as f64,
+                -u(1) * 1.5 * n as f64,
+                fast.zmin + u(2) * (fast.zmax - fast.zmin) * 1.2,
+            );
+            let d = DVec3::new(u(3) - 0.5, u(4) - 0.5, 0.6 * (u(5) - 0.6)).normalize();
+            let (a, b) = (fast.intersect(o, d, None), plain.intersect(o, d, None));
+            match (a, b) {
+                (Some(a), Some(b)) => {
+                    hits += 1;
+                    assert_eq!((a.t, a.facet), (b.t, b.facet), "periodic={periodic} i={i}");
+                }
+                (None, None) => {}
+                (a, b) => panic!("periodic={periodic} i={i}: {a:?} vs {b:?}"),
+            }
+            assert_eq!(fast.occluded(o, d, None, f64::INFINITY), b.is_some());
+        }
+        assert!(hits > 5000, "{hits}");
     }
 }
 
@@ -595,10 +645,7 @@ fn rectangular_cells_give_world_normals_and_exact_nadir_brf() {
             assert!((area - 0.5 * dx * dy / n.z).abs() < 1e-12 && (nn - n).length() < 1e-12);
         }
         // nadir sun and view on a plane: BRF = rho n_z exactly
-        let s = Scene {
-            hf,
-            material: material::from_name("lambertian", &[0.6]).unwrap(),
-        };
+        let s = Scene::new(hf, material::from_name("lambertian", &[0.6]).unwrap());
         let e = s.brf(DVec3::Z, DVec3::Z, 1000, 3, 0).unwrap();
         assert!((e.value - 0.6 * n.z).abs() < 1e-9, "{e:?}");
     }
