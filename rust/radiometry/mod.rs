@@ -5,7 +5,8 @@
 //! * [`heightfield`]: a DEM as two facets per cell and its ray caster
 //!   (cell stepping with wrap-around for periodic tiles).
 //! * [`material`]: the reflectance-model trait, with [`lambertian`],
-//!   [`oren_nayar`], [`phong`], [`hapke`] and [`specular`].
+//!   [`oren_nayar`], [`phong`], [`hapke`], [`specular`] and the two-sided
+//!   [`bilambertian`] leaf.
 //! * [`integrator`]: path tracing with next-event estimation to the sun,
 //!   and the BRF, albedo and image estimators.
 //!
@@ -17,6 +18,7 @@
 //! every path is keyed by `(seed, path index)`, and sums are formed per fixed
 //! block of paths then added in order, so results are bit-identical for any
 //! number of threads.
+pub mod bilambertian;
 pub mod hapke;
 pub mod heightfield;
 pub mod integrator;

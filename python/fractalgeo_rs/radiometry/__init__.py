@@ -16,6 +16,7 @@ Examples
 >>> round(scene.brf(sun=(135.0, 30.0), spp=1000).value, 6)  # a flat plane: rho
 0.3
 """
+from fractalgeo_rs.radiometry._leaf import BiLambertian
 from fractalgeo_rs.radiometry._scene import (
     PAPER_SUN_ZENITHS,
     BrfSweep,
@@ -28,4 +29,4 @@ from fractalgeo_rs.radiometry._scene import (
     Specular,
 )
 
-__all__ = ["BrfSweep", "Estimate", "Hapke", "Lambertian", "OrenNayar", "PAPER_SUN_ZENITHS", "Phong", "Scene", "Specular"]
+__all__ = ["BiLambertian", "BrfSweep", "Estimate", "Hapke", "Lambertian", "OrenNayar", "PAPER_SUN_ZENITHS", "Phong", "Scene", "Specular"]
