@@ -97,9 +97,12 @@ def test_leaves_are_area_matched_polygons_with_the_drawn_normals():
     f = np.asarray(c.mesh.faces, dtype=np.int64)
     leaf = c.material_ids == 1
     area = np.bincount(c.mesh.part_ids[leaf], weights=_tri_areas(v, f[leaf]), minlength=c.n_leaves)
-    # originals plus wrapped copies: each leaf's area times its number of copies
-    copies = np.bincount(c.mesh.part_ids[leaf], minlength=c.n_leaves) // 5
-    assert np.allclose(area / copies, np.pi * 0.08 ** 2, rtol=1e-5)
+    assert np.allclose(area, np.pi * 0.08 ** 2, rtol=1e-5)
+    # one period: every triangle's centroid in the tile, and some leaves cut across an edge
+    cen = v[f].mean(axis=1)
+    assert np.all((cen[:, :2] >= 0) & (cen[:, :2] <= [2.0, 1.5]))
+    span = np.ptp(v[f[leaf]][..., 0], axis=1)
+    assert span.max() < 2 * 0.08 * 1.1 and np.any(np.abs(v[f[leaf]][..., 0] - c.centres[c.mesh.part_ids[leaf]][:, None, 0]) > 1.0)
     assert c.n_leaves == round(1.5 * 3.0 / (np.pi * 0.08 ** 2))
     assert c.lai == pytest.approx(c.n_leaves * np.pi * 0.08 ** 2 / 3.0)
     fn = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])

@@ -5,8 +5,7 @@
 //! * [`heightfield`]: a DEM as two facets per cell and its ray caster
 //!   (cell stepping with wrap-around for periodic tiles).
 //! * [`material`]: the reflectance-model trait, with [`lambertian`],
-//!   [`oren_nayar`], [`phong`], [`hapke`], [`specular`] and the two-sided
-//!   [`bilambertian`] leaf.
+//!   [`oren_nayar`], [`phong`], [`hapke`] and [`specular`].
 //! * [`integrator`]: path tracing with next-event estimation to the sun,
 //!   and the BRF, albedo and image estimators.
 //!
