@@ -286,3 +286,19 @@ def test_the_kernel_knows_bilambertian_by_name():
     with pytest.raises(ValueError, match="transmittance"):
         _core.radiometry_brf(np.zeros((4, 4)), (1.0, 1.0), True, "ne-sw", "bilambertian", [0.7, 0.5],
                              (0.0, 30.0), (0.0, 0.0), 1000, 5, 1, 1)
+
+
+def test_cli_writes_the_mesh_and_the_table(tmp_path, capsys):
+    from fractalgeo_rs import cli
+
+    out = tmp_path / "c.ply"
+    assert cli.main(["canopy", str(out), "--lai", "2", "--leaf-radius", "0.05", "--extent", "2", "2",
+                     "--height", "0.1", "1", "--lad", "erectophile", "--seed", "3", "--zenith", "0,60"]) == 0
+    text = capsys.readouterr().out
+    assert out.stat().st_size > 0 and "1019 leaves" in text
+    rows = [r.split(",") for r in text.splitlines() if r and r[0].isdigit()]
+    assert [float(r[0]) for r in rows] == [0.0, 60.0]
+    assert float(rows[0][1]) == pytest.approx(4 / (3 * np.pi), abs=1e-6)
+    assert cli.main(["canopy", "--lai", "-1", "--leaf-radius", "0.05", "--extent", "2", "2",
+                     "--height", "0.1", "1"]) == 1
+    assert "--lai:" in capsys.readouterr().err
