@@ -139,6 +139,9 @@ CASES = {
         a, (1.0, 2.0), False, "ne-sw", "lambertian", [0.5], (30.0, 40.0), 500, 3, 1)),
     "radiometry_render": (IMG[:9, :7], lambda a: _core.radiometry_render(
         a, (1.0, 2.0), False, "nw-se", "lambertian", [0.5], (30.0, 40.0), (0.0, 0.0), (5, 4), 4, 3, 1)),
+    "RadiometryScene.from_dem": (IMG[:9, :7], lambda a: _core.RadiometryScene.from_dem(
+        a, (1.0, 2.0), True, "ne-sw", [("lambertian", [0.2]), ("lambertian", [0.9])],
+        (np.arange(126) % 2).astype(np.uint32)).render((30.0, 40.0), (0.0, 0.0), (5, 4), 4, 3, 1)),
 }
 # functions whose array arguments are not data laid out by the caller
 NOT_LAYOUT = {

@@ -600,3 +600,49 @@ def radiometry_render(
     n_threads: Optional[int] = None,
     progress: Optional[ProgressCounter] = None,
 ) -> npt.NDArray[np.float32]: ...
+
+@final
+class RadiometryScene:
+    @staticmethod
+    def from_mesh(
+        mesh: _MeshLike,
+        materials: Sequence[Tuple[str, Sequence[float]]],
+        material_ids: Optional[npt.NDArray[np.uint32]],
+        periodic: bool,
+        extent: Optional[Tuple[float, float, float, float]] = None,
+    ) -> RadiometryScene: ...
+    @staticmethod
+    def from_dem(
+        dem: npt.NDArray[np.float64],
+        cell_size: Tuple[float, float],
+        periodic: bool,
+        split: str,
+        materials: Sequence[Tuple[str, Sequence[float]]],
+        material_ids: Optional[npt.NDArray[np.uint32]],
+    ) -> RadiometryScene: ...
+    def brf(
+        self,
+        sun: Tuple[float, float],
+        view: Tuple[float, float],
+        spp: int,
+        max_depth: int,
+        seed: int,
+        n_threads: Optional[int] = None,
+    ) -> Tuple[float, float, int]: ...
+    def albedo(
+        self, sun: Tuple[float, float], spp: int, max_depth: int, seed: int, n_threads: Optional[int] = None
+    ) -> Tuple[float, float, int]: ...
+    def render(
+        self,
+        sun: Tuple[float, float],
+        view: Tuple[float, float],
+        shape: Tuple[int, int],
+        spp: int,
+        max_depth: int,
+        seed: int,
+        n_threads: Optional[int] = None,
+        progress: Optional[ProgressCounter] = None,
+    ) -> npt.NDArray[np.float32]: ...
+    def facets(self) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+    @property
+    def footprint(self) -> Tuple[float, float, float, float]: ...

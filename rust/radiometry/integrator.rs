@@ -17,8 +17,9 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::heightfield::{FacetId, Heightfield};
+use super::heightfield::Heightfield;
 use super::material::{basis, Bsdf};
+use super::tracer::Tracer;
 use crate::error::{CoreError, CoreResult};
 use crate::rng::StreamKey;
 use std::f64::consts::PI;
@@ -43,13 +44,24 @@ pub struct Estimate {
     pub n: u64,
 }
 
-/// A heightfield with one reflectance model.
+/// A surface (a [`Heightfield`] by default, or any [`Tracer`] such as a
+/// [`super::MeshTracer`]) with its reflectance models.
+///
+/// Facet `k` of the tile ([`Tracer::facet_index`]) has material
+/// `material_ids[k]`: 0 is [`Scene::material`], `i >= 1` is
+/// `more_materials[i - 1]`. Empty `material_ids`: every facet has
+/// material 0.
 #[derive(Debug)]
-pub struct Scene {
+pub struct Scene<G: Tracer = Heightfield> {
     /// The geometry.
-    pub hf: Heightfield,
-    /// The reflectance model of every facet.
+    pub hf: G,
+    /// Material 0 (the reflectance model of every facet when
+    /// `material_ids` is empty).
     pub material: Box<dyn Bsdf>,
+    /// Materials 1, 2, ...
+    pub more_materials: Vec<Box<dyn Bsdf>>,
+    /// Material of every facet of the tile (empty: all 0).
+    pub material_ids: Vec<u32>,
 }
 
 /// Streams: the stream of path `i` of an experiment is `(seed, i)` mixed with
@@ -100,7 +112,74 @@ fn finish(blocks: &[(f64, f64, u64)]) -> Estimate {
     }
 }
 
-impl Scene {
+impl<G: Tracer> Scene<G> {
+    /// One material on every facet.
+    pub fn new(hf: G, material: Box<dyn Bsdf>) -> Self {
+        Scene {
+            hf,
+            material,
+            more_materials: Vec::new(),
+            material_ids: Vec::new(),
+        }
+    }
+
+    /// Per-facet materials: `material_ids[k]` (one per facet of the tile,
+    /// [`Tracer::facet_index`] order) indexes `materials`. Errors name
+    /// `materials` (empty) or `material_ids` (wrong length, index out of
+    /// range).
+    pub fn with_materials(
+        hf: G,
+        materials: Vec<Box<dyn Bsdf>>,
+        material_ids: Vec<u32>,
+    ) -> CoreResult<Self> {
+        let mut it = materials.into_iter();
+        let Some(first) = it.next() else {
+            return Err(CoreError::invalid(
+                "materials",
+                "expected at least one material, got none",
+            ));
+        };
+        let more: Vec<Box<dyn Bsdf>> = it.collect();
+        let nf = hf.facet_count();
+        if material_ids.len() != nf {
+            return Err(CoreError::invalid(
+                "material_ids",
+                format!(
+                    "expected one material index per facet ({nf}), got {}",
+                    material_ids.len()
+                ),
+            ));
+        }
+        let nm = more.len() + 1;
+        if let Some(k) = material_ids.iter().position(|&i| i as usize >= nm) {
+            return Err(CoreError::invalid(
+                "material_ids",
+                format!(
+                    "facet {k} has material index {}, but there are {nm} materials",
+                    material_ids[k]
+                ),
+            ));
+        }
+        Ok(Scene {
+            hf,
+            material: first,
+            more_materials: more,
+            material_ids,
+        })
+    }
+
+    /// The reflectance model of a facet.
+    #[inline(always)]
+    pub fn bsdf(&self, f: G::Facet) -> &dyn Bsdf {
+        if self.material_ids.is_empty() {
+            return &*self.material;
+        }
+        match self.material_ids[self.hf.facet_index(f)] {
+            0 => &*self.material,
+            i => &*self.more_materials[i as usize - 1],
+        }
+    }
+
     /// World-to-local of `w` in the frame of normal `n`.
     #[inline]
     fn local(n: DVec3, t: DVec3, b: DVec3, w: DVec3) -> DVec3 {
@@ -112,7 +191,7 @@ impl Scene {
     /// weight, from the uniforms `dim`, `dim + 1` of `key` (`dim` advances).
     #[inline]
     fn scatter(
-        &self,
+        m: &dyn Bsdf,
         (t, b, n): (DVec3, DVec3, DVec3),
         wo: DVec3,
         key: StreamKey,
@@ -120,7 +199,7 @@ impl Scene {
     ) -> Option<(DVec3, f64)> {
         let u = [key.uniform(*dim), key.uniform(*dim + 1)];
         *dim += 2;
-        let smp = self.material.sample(wo, u)?;
+        let smp = m.sample(wo, u)?;
         Some((smp.wi.x * t + smp.wi.y * b + smp.wi.z * n, smp.weight))
     }
 
@@ -128,10 +207,10 @@ impl Scene {
     /// against `v` (from above the highest facet).
     #[inline]
     fn sensor_ray(&self, x: f64, y: f64, v: DVec3) -> DVec3 {
-        let hf = &self.hf;
-        let top = hf.zmax + 1e-6 * (1.0 + hf.zmax.abs());
-        let lift = (top - hf.zmean).max(0.0) / v.z;
-        DVec3::new(x, y, hf.zmean) + lift * v
+        let (_, zmax, zref) = self.hf.z_range();
+        let top = zmax + 1e-6 * (1.0 + zmax.abs());
+        let lift = (top - zref).max(0.0) / v.z;
+        DVec3::new(x, y, zref) + lift * v
     }
 
     /// Radiance along the ray `o - t v` (towards the surface) for unit sun
@@ -148,11 +227,11 @@ impl Scene {
     ) -> f64 {
         let hf = &self.hf;
         let mut d = -v;
-        let mut skip: Option<FacetId> = None;
+        let mut skip: Option<G::Facet> = None;
         let mut throughput = 1.0;
         let mut l = 0.0;
         for depth in 1..=max_depth {
-            let Some(hit) = hf.intersect(o, d, skip) else {
+            let Some(hit) = hf.trace(o, d, skip) else {
                 break;
             };
             let n = hit.normal;
@@ -162,15 +241,16 @@ impl Scene {
             let (p, facet) = hf.wrap(o + hit.t * d, hit.facet);
             let (t, b) = basis(n);
             let wo = Self::local(n, t, b, -d);
+            let m = self.bsdf(facet);
             let cos_s = n.dot(s);
-            if cos_s > 0.0 && hf.intersect(p, s, Some(facet)).is_none() {
+            if (cos_s > 0.0 || (cos_s < 0.0 && m.transmits())) && !hf.occluded(p, s, Some(facet)) {
                 let wi = Self::local(n, t, b, s);
-                l += throughput * self.material.eval(wi, wo) * cos_s;
+                l += throughput * m.eval(wi, wo) * cos_s.abs();
             }
             if depth == max_depth {
                 break;
             }
-            let Some((wi, weight)) = self.scatter((t, b, n), wo, key, &mut dim) else {
+            let Some((wi, weight)) = Self::scatter(m, (t, b, n), wo, key, &mut dim) else {
                 break;
             };
             throughput *= weight;
@@ -198,7 +278,8 @@ impl Scene {
     ) -> CoreResult<Estimate> {
         check_spp(spp)?;
         check_depth(max_depth)?;
-        let (w, h) = self.hf.extent();
+        let (x0, y0, w, h) = self.hf.footprint();
+        let ytop = y0 + h;
         let norm = PI / sun.z;
         let blocks: Vec<(f64, f64, u64)> = (0..spp.div_ceil(BLOCK))
             .into_par_iter()
@@ -207,7 +288,7 @@ impl Scene {
                 let end = ((blk + 1) * BLOCK).min(spp);
                 for i in blk * BLOCK..end {
                     let key = StreamKey::new(seed, TAG_BRF ^ i);
-                    let (x, y) = (key.uniform(0) * w, -key.uniform(1) * h);
+                    let (x, y) = (x0 + key.uniform(0) * w, ytop - key.uniform(1) * h);
                     let o = self.sensor_ray(x, y, view);
                     let r = norm * self.radiance(o, view, sun, max_depth, key, 2);
                     s1 += r;
@@ -224,7 +305,8 @@ impl Scene {
     pub fn albedo(&self, sun: DVec3, spp: u64, max_depth: u32, seed: u64) -> CoreResult<Estimate> {
         check_spp(spp)?;
         check_depth(max_depth)?;
-        let (w, h) = self.hf.extent();
+        let (x0, y0, w, h) = self.hf.footprint();
+        let ytop = y0 + h;
         let hf = &self.hf;
         let blocks: Vec<(f64, f64, u64)> = (0..spp.div_ceil(BLOCK))
             .into_par_iter()
@@ -233,7 +315,7 @@ impl Scene {
                 let end = ((blk + 1) * BLOCK).min(spp);
                 for i in blk * BLOCK..end {
                     let key = StreamKey::new(seed, TAG_ALBEDO ^ i);
-                    let (x, y) = (key.uniform(0) * w, -key.uniform(1) * h);
+                    let (x, y) = (x0 + key.uniform(0) * w, ytop - key.uniform(1) * h);
                     let mut o = self.sensor_ray(x, y, sun);
                     let mut d = -sun;
                     let mut skip = None;
@@ -241,8 +323,8 @@ impl Scene {
                     let mut r = 0.0;
                     let mut dim = 2u64;
                     for depth in 0..=max_depth {
-                        let Some(hit) = hf.intersect(o, d, skip) else {
-                            if depth > 0 {
+                        let Some(hit) = hf.trace(o, d, skip) else {
+                            if depth > 0 && hf.escapes(d) {
                                 r = throughput; // escaped after scattering
                             }
                             break;
@@ -256,7 +338,9 @@ impl Scene {
                         let wo = Self::local(n, t, b, -d);
                         // reciprocity: sample the reflected direction as an
                         // incident one for the light's arrival direction
-                        let Some((wi, weight)) = self.scatter((t, b, n), wo, key, &mut dim) else {
+                        let m = self.bsdf(facet);
+                        let Some((wi, weight)) = Self::scatter(m, (t, b, n), wo, key, &mut dim)
+                        else {
                             break;
                         };
                         throughput *= weight;
@@ -325,7 +409,8 @@ impl Scene {
         if let Some(p) = progress {
             p.add_total(rows as u64);
         }
-        let (w, h) = self.hf.extent();
+        let (x0, y0, w, h) = self.hf.footprint();
+        let ytop = y0 + h;
         let (pw, ph) = (w / cols as f64, h / rows as f64);
         img.par_chunks_mut(cols).enumerate().for_each(|(i, line)| {
             for (j, px) in line.iter_mut().enumerate() {
@@ -334,8 +419,8 @@ impl Scene {
                 for k in 0..spp {
                     let key =
                         StreamKey::new(seed, TAG_IMAGE ^ pixel.wrapping_mul(spp).wrapping_add(k));
-                    let x = (j as f64 + key.uniform(0)) * pw;
-                    let y = -(i as f64 + key.uniform(1)) * ph;
+                    let x = x0 + (j as f64 + key.uniform(0)) * pw;
+                    let y = ytop - (i as f64 + key.uniform(1)) * ph;
                     let o = self.sensor_ray(x, y, view);
                     s += self.radiance(o, view, sun, max_depth, key, 2);
                 }

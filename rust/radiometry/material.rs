@@ -31,6 +31,13 @@ pub trait Bsdf: Send + Sync + std::fmt::Debug {
     /// Directional-hemispherical reflectance for light leaving along `wo`
     /// (by reciprocity, also the albedo for light arriving from `wo`).
     fn albedo(&self, wo: DVec3) -> f64;
+    /// Whether light also leaves through the facet (two-sided facets such
+    /// as leaves): then `eval` and `sample` accept `wi` below the facet
+    /// (`wi.z < 0`, transmission), the sampling weight taking `|wi.z|`, and
+    /// the integrator adds the sun behind the facet. Default `false`.
+    fn transmits(&self) -> bool {
+        false
+    }
 }
 
 /// Cosine-weighted direction on the upper hemisphere (Malley's method:

@@ -6,6 +6,8 @@
 //!   (cell stepping with wrap-around for periodic tiles).
 //! * [`material`]: the reflectance-model trait, with [`lambertian`],
 //!   [`oren_nayar`], [`phong`], [`hapke`] and [`specular`].
+//! * [`mesh_tracer`]: a triangle mesh through a BVH (two-sided facets,
+//!   periodic tiles); [`tracer`]: the geometry trait both implement.
 //! * [`integrator`]: path tracing with next-event estimation to the sun,
 //!   and the BRF, albedo and image estimators.
 //!
@@ -23,15 +25,21 @@ pub mod heightfield;
 pub mod integrator;
 pub mod lambertian;
 pub mod material;
+pub mod mesh_tracer;
 pub mod oren_nayar;
 pub mod phong;
 pub mod specular;
+pub mod tracer;
 
+#[cfg(test)]
+mod mesh_tests;
 #[cfg(test)]
 mod tests;
 
 pub use heightfield::{Heightfield, Split};
 pub use integrator::{Estimate, Scene};
+pub use mesh_tracer::MeshTracer;
+pub use tracer::{TraceHit, Tracer};
 
 use crate::error::{CoreError, CoreResult};
 use glam::DVec3;

@@ -37,10 +37,10 @@ fn rough(n: usize, amp: f64, seed: u64) -> Vec<f64> {
 }
 
 fn scene(z: &[f64], rows: usize, cols: usize, periodic: bool, mat: &str, p: &[f64]) -> Scene {
-    Scene {
-        hf: Heightfield::new(z, rows, cols, (1.0, 1.0), periodic, Split::NeSw).unwrap(),
-        material: material::from_name(mat, p).unwrap(),
-    }
+    Scene::new(
+        Heightfield::new(z, rows, cols, (1.0, 1.0), periodic, Split::NeSw).unwrap(),
+        material::from_name(mat, p).unwrap(),
+    )
 }
 
 fn dir(az: f64, zen: f64) -> DVec3 {
@@ -595,10 +595,7 @@ fn rectangular_cells_give_world_normals_and_exact_nadir_brf() {
             assert!((area - 0.5 * dx * dy / n.z).abs() < 1e-12 && (nn - n).length() < 1e-12);
         }
         // nadir sun and view on a plane: BRF = rho n_z exactly
-        let s = Scene {
-            hf,
-            material: material::from_name("lambertian", &[0.6]).unwrap(),
-        };
+        let s = Scene::new(hf, material::from_name("lambertian", &[0.6]).unwrap());
         let e = s.brf(DVec3::Z, DVec3::Z, 1000, 3, 0).unwrap();
         assert!((e.value - 0.6 * n.z).abs() < 1e-9, "{e:?}");
     }

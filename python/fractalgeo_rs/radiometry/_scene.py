@@ -7,7 +7,7 @@ import numbers
 import os
 import warnings
 from dataclasses import dataclass
-from typing import List, Optional, Tuple, Union
+from typing import Any, Callable, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -305,6 +305,104 @@ class Specular:
 
 
 Material = Union[Lambertian, OrenNayar, Phong, Hapke, Specular]
+_MATERIAL_TYPES = (Lambertian, OrenNayar, Phong, Hapke, Specular)
+
+#: Per-facet material choice: an integer array (one index into the material
+#: list per facet) or a function ``f(slope, height)`` of the facets' slopes
+#: (degrees) and centroid heights returning one.
+MaterialIds = Union[np.ndarray, Sequence[int], Callable[[np.ndarray, np.ndarray], Any]]
+
+
+def _materials(value, name: str = "material") -> Tuple[Material, ...]:
+    """One material or a non-empty sequence of them, as a tuple."""
+    if isinstance(value, _MATERIAL_TYPES):
+        return (value,)
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
+        raise TypeError(f"{name}: expected a material (Lambertian(...), OrenNayar(...), Phong(...), Hapke(...) "
+                        f"or Specular(...)) or a list of them, got {value!r}")
+    out = tuple(value)
+    if not out:
+        raise ValueError(f"{name}: expected at least one material, got an empty list")
+    for k, m in enumerate(out):
+        if not isinstance(m, _MATERIAL_TYPES):
+            raise TypeError(f"{name}: item {k} is not a material (Lambertian(...), OrenNayar(...), Phong(...), "
+                            f"Hapke(...) or Specular(...)): {m!r}")
+    return out
+
+
+def _material_ids(value, n_materials: int, slope: Callable[[], np.ndarray], height: Callable[[], np.ndarray],
+                  shape: Tuple[int, ...]) -> Optional[np.ndarray]:
+    """``material_ids`` as a flat uint32 array of one index per facet (None:
+    every facet material 0). ``slope`` and ``height`` compute the facets'
+    slopes (degrees) and centroid heights, arrays of ``shape``, for a
+    callable."""
+    if value is None:
+        if n_materials > 1:
+            raise ValueError(f"material_ids: {n_materials} materials need material_ids (an index per facet, or "
+                             "a function of slope and height), got None")
+        return None
+    if callable(value):
+        value = value(slope(), height())
+    a = np.asarray(value)
+    if a.dtype.kind == "b":
+        a = a.astype(np.int64)
+    if a.dtype.kind not in "iu":
+        raise TypeError(f"material_ids: expected integer material indices, got dtype {a.dtype}")
+    n = int(np.prod(shape))
+    if a.size != n or (a.ndim > 1 and a.shape != shape):
+        raise ValueError(f"material_ids: expected one index per facet, shape {shape} ({n} facets), got shape "
+                         f"{a.shape}")
+    a = a.reshape(-1)
+    bad = (a < 0) | (a >= n_materials)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise ValueError(f"material_ids: facet {k} has material index {int(a[k])}, but there are {n_materials} "
+                         f"material(s) (indices 0 to {n_materials - 1})")
+    return np.ascontiguousarray(a, dtype=np.uint32)
+
+
+def _dem_facets(z: np.ndarray, cell_size: Tuple[float, float], periodic: bool,
+                split: str) -> Tuple[np.ndarray, np.ndarray]:
+    """Slope (degrees) and centroid height of every facet of a DEM scene,
+    shape ``(cell rows, cell cols, 2)`` in the kernel's facet order."""
+    zz = np.pad(z, ((0, 1), (0, 1)), mode="wrap") if periodic else z
+    nw, ne, sw, se = zz[:-1, :-1], zz[:-1, 1:], zz[1:, :-1], zz[1:, 1:]
+    if split == "ne-sw":
+        tris = ((nw, ne, sw), (ne, se, sw))
+        grads = ((ne - nw, sw - nw), (se - sw, se - ne))
+    else:
+        tris = ((nw, ne, se), (nw, se, sw))
+        grads = ((ne - nw, se - ne), (se - sw, sw - nw))
+    dx, dy = cell_size
+    slope = np.stack([np.degrees(np.arctan(np.hypot(b / dx, c / dy))) for b, c in grads], axis=-1)
+    height = np.stack([(a + b + c) / 3.0 for a, b, c in tris], axis=-1)
+    return slope, height
+
+
+def _mesh_facets(mesh) -> Tuple[np.ndarray, np.ndarray]:
+    """Slope (degrees, of the unoriented facet) and centroid height (map
+    z) of every triangle of a mesh."""
+    v = np.asarray(mesh.vertices, dtype=np.float64)
+    f = np.asarray(mesh.faces, dtype=np.int64)
+    p0, p1, p2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    n = np.cross(p1 - p0, p2 - p0)
+    length = np.linalg.norm(n, axis=1)
+    cos = np.divide(np.abs(n[:, 2]), length, out=np.ones_like(length), where=length > 0)
+    slope = np.degrees(np.arccos(np.clip(cos, 0.0, 1.0)))
+    height = (p0[:, 2] + p1[:, 2] + p2[:, 2]) / 3.0 + float(mesh.origin[2])
+    return slope, height
+
+
+def _extent(value) -> Optional[Tuple[float, float, float, float]]:
+    if value is None:
+        return None
+    try:
+        x0, y0, w, h = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise TypeError(f"extent: expected (x0, y0, width, height) in map coordinates, got {value!r}") from None
+    if not all(math.isfinite(v) for v in (x0, y0, w, h)) or w <= 0 or h <= 0:
+        raise ValueError(f"extent: expected finite (x0, y0, width, height) with width, height > 0, got {value!r}")
+    return (x0, y0, w, h)
 
 
 @dataclass(frozen=True)
@@ -492,23 +590,41 @@ class Scene:
     tracing", *Eurographics '87*, 3-10, 1987.
     """
 
-    def __init__(self, dem: np.ndarray, cell_size: Tuple[float, float], periodic: bool, material: Material,
-                 split: str, profile: Optional[dict] = None):
+    def __init__(self, dem: Optional[np.ndarray], cell_size: Optional[Tuple[float, float]], periodic: bool,
+                 material: Material, split: str, profile: Optional[dict] = None, *,
+                 materials: Optional[Tuple[Material, ...]] = None, material_ids: Optional[np.ndarray] = None,
+                 mesh=None, extent: Optional[Tuple[float, float, float, float]] = None, core=None):
         self.profile = profile
         self.dem = dem
         self.cell_size = cell_size
         self.periodic = periodic
         self.material = material
+        #: All materials (``material`` is the first); facet ``k`` has
+        #: ``materials[material_ids[k]]``.
+        self.materials = materials if materials is not None else (material,)
+        #: One material index per facet (uint32), or None (all ``material``).
+        self.material_ids = material_ids
+        #: The :class:`~fractalgeo_rs.geometry.Mesh` of a mesh scene, else None.
+        self.mesh = mesh
+        #: ``(x0, y0, width, height)``: a mesh scene's tile or footprint, map coordinates.
+        self.extent = extent
+        self._core = core
         self.split = split
 
     def __repr__(self) -> str:
+        if self.mesh is not None:
+            return (f"Scene(mesh of {len(self.mesh)} triangles, extent={self.extent}, periodic={self.periodic}, "
+                    f"materials={list(self.materials)!r})")
+        if len(self.materials) > 1:
+            return (f"Scene({self.dem.shape[0]} x {self.dem.shape[1]} heights, cell_size={self.cell_size}, "
+                    f"periodic={self.periodic}, materials={list(self.materials)!r}, split={self.split!r})")
         return (f"Scene({self.dem.shape[0]} x {self.dem.shape[1]} heights, cell_size={self.cell_size}, "
                 f"periodic={self.periodic}, material={self.material!r}, split={self.split!r})")
 
     @classmethod
     def from_dem(cls, dem, cell_size: Union[float, Tuple[float, float]] = 1.0, periodic: bool = True,
-                 material: Optional[Material] = None, split: str = "ne-sw",
-                 profile: Optional[dict] = None) -> "Scene":
+                 material: Union[None, Material, Sequence[Material]] = None, split: str = "ne-sw",
+                 profile: Optional[dict] = None, material_ids: Optional[MaterialIds] = None) -> "Scene":
         """A scene of two triangular facets per DEM cell.
 
         Vertex ``(r, c)`` sits at ``x = c * dx`` east, ``y = -r * dy``
@@ -534,14 +650,22 @@ class Scene:
             ``np.block([[z, z[:, ::-1]], [z[::-1], z[::-1, ::-1]]])``.
             False: a finite patch of ``(rows - 1) x (cols - 1)`` cells; rays
             that leave it escape.
-        material : Lambertian, OrenNayar, Phong, Hapke or Specular, optional
+        material : Lambertian, OrenNayar, Phong, Hapke or Specular, or a list of them, optional
             Reflectance model of every facet; default ``Lambertian(0.5)``.
+            A list: per-facet materials chosen by ``material_ids``.
         split : {"ne-sw", "nw-se"}
             The diagonal splitting each cell.
         profile : dict, optional
             Georeferencing of the DEM as :func:`fractalgeo_rs.read_raster`
             returns it (``crs``, ``transform``: heights at pixel centres);
             ``save_image`` then writes georeferenced GeoTIFF and PNG.
+        material_ids : array_like of int or callable, optional
+            The material (index into ``material``) of every facet: an array
+            of shape ``(cell rows, cell cols, 2)`` (the two facets of each
+            cell, as ordered by ``split``; cell rows and columns as in
+            ``periodic``), or a function ``f(slope, height)`` of arrays of
+            that shape (facet slope in degrees, centroid height) returning
+            one. Required with several materials.
 
         Returns
         -------
@@ -553,6 +677,15 @@ class Scene:
         >>> from fractalgeo_rs.radiometry import Scene
         >>> Scene.from_dem(np.zeros((4, 5)), cell_size=30.0)
         Scene(4 x 5 heights, cell_size=(30.0, 30.0), periodic=True, material=Lambertian(rho=0.5), split='ne-sw')
+
+        Dark facets steeper than 20 degrees, bright ones elsewhere:
+
+        >>> from fractalgeo_rs.radiometry import Lambertian
+        >>> z = np.add.outer(np.zeros(8), np.abs(np.arange(8) - 4.0))  # V-valley, 45 degree sides
+        >>> s = Scene.from_dem(z, material=[Lambertian(0.8), Lambertian(0.1)],
+        ...                    material_ids=lambda slope, height: slope > 20, periodic=False)
+        >>> s.material_ids.reshape(7, 7, 2)[0, :, 0].tolist()
+        [1, 1, 1, 1, 1, 1, 1]
 
         References
         ----------
@@ -578,7 +711,11 @@ class Scene:
         cell_size = _cell_size(cell_size)
         if material is None:
             material = Lambertian(0.5)
-        if not isinstance(material, (Lambertian, OrenNayar, Phong, Hapke, Specular)):
+        per_facet = isinstance(material, (list, tuple)) or material_ids is not None
+        if per_facet:
+            materials = _materials(material)
+            material = materials[0]
+        elif not isinstance(material, (Lambertian, OrenNayar, Phong, Hapke, Specular)):
             raise TypeError("material: expected Lambertian(...), OrenNayar(...), Phong(...), Hapke(...) or Specular(...), "
                             f"got {material!r}")
         split = check_choice(split, "split", ("ne-sw", "nw-se"))
@@ -591,7 +728,171 @@ class Scene:
         if profile is not None and not isinstance(profile, dict):
             raise TypeError(f"profile: expected a dict (a rasterio profile) or None, got {type(profile).__name__}")
         z.setflags(write=False)
-        return cls(z, cell_size, periodic, material, split, profile=dict(profile) if profile else None)
+        profile = dict(profile) if profile else None
+        if not per_facet:
+            return cls(z, cell_size, periodic, material, split, profile=profile)
+        cells = z.shape if periodic else (z.shape[0] - 1, z.shape[1] - 1)
+        facets: dict = {}
+
+        def geometry(i: int) -> np.ndarray:
+            if not facets:
+                facets["v"] = _dem_facets(z, cell_size, periodic, split)
+            return facets["v"][i]
+
+        ids = _material_ids(material_ids, len(materials), lambda: geometry(0), lambda: geometry(1),
+                            (cells[0], cells[1], 2))
+        if ids is not None:
+            ids.setflags(write=False)
+        core = _core.RadiometryScene.from_dem(z, cell_size, periodic, split, [m._spec() for m in materials], ids)
+        return cls(z, cell_size, periodic, material, split, profile=profile, materials=materials,
+                   material_ids=ids, core=core)
+
+    @classmethod
+    def from_mesh(cls, mesh, materials: Union[None, Material, Sequence[Material]] = None,
+                  material_ids: Optional[MaterialIds] = None, periodic: bool = True,
+                  extent=None) -> "Scene":
+        """A scene of the triangles of a mesh: terrain, TINs, plants.
+
+        Facets are two-sided: the normal used for shading faces the
+        incoming ray, so leaves are lit and seen from both sides. Rays are
+        cast through a bounding volume hierarchy (the ``obvhs`` crate's
+        compressed wide BVH) with exact double-precision triangle tests.
+        The BVH is built once, here.
+
+        Parameters
+        ----------
+        mesh : fractalgeo_rs.geometry.Mesh
+            The triangles (map coordinates = ``origin`` + vertices). Every
+            triangle must have a positive area and finite vertices.
+        materials : material or list of materials, optional
+            Reflectance models; default ``Lambertian(0.5)``. A material
+            whose model transmits light lights both sides.
+        material_ids : array_like of int or callable, optional
+            The material (index into ``materials``) of every triangle, shape
+            ``(len(mesh),)``, or a function ``f(slope, height)`` of the
+            triangles' slopes (degrees, 0 for horizontal, of either side)
+            and centroid heights (map z) returning one. Required with
+            several materials; e.g. ``mesh.kinds`` (0 branch, 1 leaf).
+        periodic : bool
+            True: the mesh is one tile of an infinite surface over
+            ``extent``; a ray that leaves a side of the tile re-enters from
+            the opposite one. Triangles may cross the tile's sides (they are
+            wrapped), but no triangle may be wider or taller than the tile,
+            and the mesh must tile seamlessly for the result to mean an
+            infinite surface. False: a finite patch; rays that miss it escape.
+        extent : (float, float, float, float), optional
+            ``(x0, y0, width, height)`` in map coordinates: the periodic
+            tile, and the area the sensor sees (BRF, albedo and images are
+            per unit of this horizontal area). Default: the mesh's
+            horizontal bounding box. Every triangle's centroid must lie in
+            it.
+
+        Returns
+        -------
+        Scene
+
+        Raises
+        ------
+        ValueError
+            Naming ``mesh`` (no triangles, NaN or degenerate triangles),
+            ``extent`` (not covering the mesh), ``material_ids`` (wrong
+            length, index out of range) or ``materials``.
+
+        Examples
+        --------
+        A flat Lambertian plane gives BRF = albedo = rho:
+
+        >>> import numpy as np
+        >>> from fractalgeo_rs.geometry import Mesh
+        >>> from fractalgeo_rs.radiometry import Lambertian, Scene
+        >>> plane = Mesh.from_triangles([[0, 0, 0], [4, 0, 0], [0, 4, 0], [4, 4, 0]], [[0, 1, 2], [1, 3, 2]])
+        >>> s = Scene.from_mesh(plane, materials=Lambertian(0.3))
+        >>> round(s.brf(sun=(40.0, 50.0), view=(200.0, 30.0), spp=1000).value, 9)
+        0.3
+
+        References
+        ----------
+        T. Möller and B. Trumbore, "Fast, minimum storage ray-triangle
+        intersection", *Journal of Graphics Tools* 2(1), 21-28, 1997.
+        S. Ylitie, T. Karras and S. Laine, "Efficient incoherent ray
+        traversal on GPUs through compressed wide BVHs", *High Performance
+        Graphics*, 2017 (the CWBVH of ``obvhs``).
+        """
+        from fractalgeo_rs.geometry import Mesh
+
+        if not isinstance(mesh, Mesh):
+            raise TypeError(f"mesh: expected a fractalgeo_rs.geometry.Mesh, got {type(mesh).__name__}")
+        if not isinstance(periodic, (bool, np.bool_)):
+            raise TypeError(f"periodic: expected True or False, got {periodic!r}")
+        periodic = bool(periodic)
+        mesh = mesh._arrays()
+        mats = _materials(Lambertian(0.5) if materials is None else materials, "materials")
+        ext = _extent(extent)
+        facets: dict = {}
+
+        def geometry(i: int) -> np.ndarray:
+            if not facets:
+                facets["v"] = _mesh_facets(mesh)
+            return facets["v"][i]
+
+        ids = _material_ids(material_ids, len(mats), lambda: geometry(0), lambda: geometry(1), (len(mesh),))
+        if ids is not None:
+            ids.setflags(write=False)
+        core = _core.RadiometryScene.from_mesh(mesh, [m._spec() for m in mats], ids, periodic, ext)
+        x0, y0, w, h = core.footprint
+        ext = (x0 + float(mesh.origin[0]), y0 + float(mesh.origin[1]), w, h)
+        return cls(None, None, periodic, mats[0], "ne-sw", materials=mats, material_ids=ids, mesh=mesh,
+                   extent=ext, core=core)
+
+    @classmethod
+    def from_tin(cls, tin, materials: Union[None, Material, Sequence[Material]] = None,
+                 material_ids: Optional[MaterialIds] = None, periodic: bool = False,
+                 extent=None) -> "Scene":
+        """A scene of the triangles of a TIN (``fractalgeo_rs.tin_from_dem``).
+
+        ``Scene.from_mesh(tin.to_mesh(), ...)``; a TIN of a real DEM is
+        rarely tileable, so ``periodic`` defaults to False here.
+
+        Parameters
+        ----------
+        tin : fractalgeo_rs.tin.TIN
+            The triangulated surface.
+        materials, material_ids, periodic, extent
+            As in ``from_mesh`` (``material_ids`` one per TIN triangle).
+
+        Returns
+        -------
+        Scene
+
+        Examples
+        --------
+        >>> import numpy as np, fractalgeo_rs as fg
+        >>> from fractalgeo_rs.radiometry import Lambertian, Scene
+        >>> i, j = np.indices((9, 9))
+        >>> s = Scene.from_tin(fg.tin_from_dem(0.1 * i, max_error=0.01), materials=Lambertian(0.5))
+        >>> e = s.brf(sun=(0.0, 0.0), spp=200, max_depth=1)  # rho n_z on a plane
+        >>> bool(abs(e.value - 0.5 / np.sqrt(1.01)) < 1e-6)
+        True
+
+        References
+        ----------
+        See ``from_mesh``.
+        """
+        if not hasattr(tin, "to_mesh"):
+            raise TypeError(f"tin: expected a fractalgeo_rs.tin.TIN, got {type(tin).__name__}")
+        return cls.from_mesh(tin.to_mesh(), materials=materials, material_ids=material_ids, periodic=periodic,
+                             extent=extent)
+
+    def _raw_brf(self, sun, view, spp: int, depth: int, seed: int, n_threads) -> Tuple[float, float, int]:
+        if self._core is not None:
+            return self._core.brf(sun, view, spp, depth, seed, n_threads)
+        return _core.radiometry_brf(*self._args(), sun, view, spp, depth, seed, n_threads)
+
+    def _default_shape(self) -> Tuple[int, int]:
+        if self.mesh is not None:
+            return (128, 128)
+        cells = self.dem.shape if self.periodic else (self.dem.shape[0] - 1, self.dem.shape[1] - 1)
+        return (int(cells[0]), int(cells[1]))
 
     def _args(self) -> Tuple[np.ndarray, Tuple[float, float], bool, str, str, List[float]]:
         name, params = self.material._spec()
@@ -645,10 +946,8 @@ class Scene:
         F. E. Nicodemus et al., *Geometrical Considerations and Nomenclature
         for Reflectance*, NBS Monograph 160, 1977 (reflectance factor).
         """
-        args = self._args()
-        v, se, n = _core.radiometry_brf(*args, _direction(sun, "sun"), _direction(view, "view"),
-                                        check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed),
-                                        check_n_threads(n_threads))
+        v, se, n = self._raw_brf(_direction(sun, "sun"), _direction(view, "view"), check_positive_int(spp, "spp"),
+                                 _depth(max_depth), _seed(seed), check_n_threads(n_threads))
         return Estimate(v, se, n)
 
     def albedo(self, sun, spp: int = 65536, max_depth: int = 100, seed: int = 0,
@@ -694,9 +993,12 @@ class Scene:
         reflectance products from MODIS", *Remote Sensing of Environment*
         83, 135-148, 2002, doi:10.1016/S0034-4257(02)00091-3.
         """
-        v, se, n = _core.radiometry_albedo(*self._args(), _direction(sun, "sun"),
-                                           check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed),
-                                           check_n_threads(n_threads))
+        args = (_direction(sun, "sun"), check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed),
+                check_n_threads(n_threads))
+        if self._core is not None:
+            v, se, n = self._core.albedo(*args)
+        else:
+            v, se, n = _core.radiometry_albedo(*self._args(), *args)
         return Estimate(v, se, n)
 
     def render(self, sun, view="nadir", shape: Optional[Tuple[int, int]] = None, spp: int = 16,
@@ -753,8 +1055,7 @@ class Scene:
         3rd ed., 2016 (path tracing with next-event estimation).
         """
         if shape is None:
-            cells = self.dem.shape if self.periodic else (self.dem.shape[0] - 1, self.dem.shape[1] - 1)
-            shape = (int(cells[0]), int(cells[1]))
+            shape = self._default_shape()
         try:
             rows, cols = shape
         except (TypeError, ValueError):
@@ -763,10 +1064,14 @@ class Scene:
         check_memory(rows * cols * 4, "shape", max_memory=max_memory, what=f"a {rows} x {cols} float32 image")
         from fractalgeo_rs import _progress
 
-        args = (*self._args(), _direction(sun, "sun"), _direction(view, "view"), (rows, cols),
+        args = (_direction(sun, "sun"), _direction(view, "view"), (rows, cols),
                 check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed), check_n_threads(n_threads))
+        core = self._core
         with _progress.Steps(rows, "render", _progress.resolve(progress)) as steps:
-            return steps.counted(lambda counter: _core.radiometry_render(*args, progress=counter), rows)
+            if core is not None:
+                return steps.counted(lambda counter: core.render(*args, progress=counter), rows)
+            dem_args = self._args()
+            return steps.counted(lambda counter: _core.radiometry_render(*dem_args, *args, progress=counter), rows)
 
     def brf_sweep(self, sun_zenith=PAPER_SUN_ZENITHS, view_zenith=(0.0,), sun_azimuth: float = 0.0,
                   view_azimuth: float = 0.0, spp: int = 65536, max_depth: int = 10, seed: int = 0,
@@ -820,12 +1125,11 @@ class Scene:
         depth, seed, n_threads = _depth(max_depth), _seed(seed), check_n_threads(n_threads)
         value = np.empty((suns.size, views.size))
         se = np.empty_like(value)
-        args = self._args()
         with _progress.bar(suns.size * views.size, "brf", _progress.resolve(progress)) as bar:
             for i, zs in enumerate(suns):
                 for j, zv in enumerate(views):
-                    value[i, j], se[i, j], _ = _core.radiometry_brf(
-                        *args, (az_s, float(zs)), (az_v, float(zv)), spp, depth, seed, n_threads)
+                    value[i, j], se[i, j], _ = self._raw_brf(
+                        (az_s, float(zs)), (az_v, float(zv)), spp, depth, seed, n_threads)
                     bar.update(1)
         return BrfSweep(suns, views, az_s, az_v, value, se, spp)
 
@@ -861,7 +1165,7 @@ class Scene:
         GDAL data model, https://gdal.org/user/raster_data_model.html (affine geotransform).
         """
         t = (self.profile or {}).get("transform")
-        if t is None:
+        if t is None or self.dem is None:
             return None
         from affine import Affine
 
