@@ -302,3 +302,99 @@ def test_cli_writes_the_mesh_and_the_table(tmp_path, capsys):
     assert cli.main(["canopy", "--lai", "-1", "--leaf-radius", "0.05", "--extent", "2", "2",
                      "--height", "0.1", "1"]) == 1
     assert "--lai:" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------- the canopy as a radiometric scene
+
+@pytest.mark.parametrize("lad,zenith", [("spherical", 0.0), ("planophile", 30.0), ("erectophile", 60.0),
+                                        (0.0, 45.0), ("extremophile", 20.0)])
+def test_scene_gap_fraction_is_the_exact_expectation(lad, zenith):
+    # the traced gap fraction of 1000 placements (256 rays each), averaged,
+    # against (1 - a G / (A cos theta))^N; SE from the spread over placements
+    vals = []
+    for seed in range(1000):
+        c = disc_canopy(lai=1.2, leaf_radius=0.12, extent=1.0, height=(0.2, 0.8), lad=lad, sides=6, seed=seed)
+        vals.append(c.scene().gap_fraction(zenith, azimuth=30.0, n=256, seed=seed).value)
+    mean, se = np.mean(vals), np.std(vals, ddof=1) / np.sqrt(len(vals))
+    exact = float(c.gap_probability(zenith))
+    assert abs(mean - exact) < 3 * se, (mean, se, exact)
+
+
+def test_scene_gap_fraction_of_one_canopy_matches_the_shadow_test():
+    # one realisation: the tracer and the independent shadow projection see the same geometry
+    c = disc_canopy(lai=1.5, leaf_radius=0.1, extent=(1.0, 1.5), height=(0.2, 1.0), lad="uniform", sides=5,
+                    seed=8)
+    e = c.scene().gap_fraction(50.0, azimuth=30.0, n=200_000, seed=1)
+    pts = np.random.default_rng(2).random((20_000, 2)) * [1.0, 1.5]
+    ref = _gap_by_shadows(c, 50.0, pts)
+    se_ref = np.sqrt(ref * (1 - ref) / len(pts))
+    assert abs(e.value - ref) < 3 * np.hypot(e.se, se_ref), (e.value, e.se, ref, se_ref)
+
+
+def test_scene_gap_fraction_tends_to_beer():
+    # many small leaves: exp(-G LAI / cos theta); spherical G = 1/2
+    vals = []
+    for seed in range(6):
+        c = disc_canopy(lai=2.0, leaf_radius=0.03, extent=1.5, height=(0.05, 1.0), sides=6, seed=seed)
+        vals.append(c.scene().gap_fraction(40.0, n=20_000, seed=seed).value)
+    beer = np.exp(-0.5 * c.lai / np.cos(np.radians(40.0)))
+    mean, se = np.mean(vals), np.std(vals, ddof=1) / np.sqrt(len(vals))
+    assert c.n_leaves > 1000
+    assert abs(mean - beer) < 3 * se + 1e-3, (mean, se, beer)
+
+
+def test_conservative_canopy_has_albedo_one():
+    c = disc_canopy(lai=2.0, leaf_radius=0.1, extent=1.5, height=(0.2, 1.0), lad="planophile", seed=4,
+                    leaf=BiLambertian(0.6, 0.4), soil=Lambertian(1.0))
+    s = c.scene()
+    a = s.albedo(sun=(30.0, 35.0), spp=20_000, max_depth=100_000, seed=1)
+    assert abs(a.value - 1.0) < 0.003, a
+    ab = s.absorption(sun=(30.0, 35.0), spp=5_000, max_depth=100_000)
+    assert all(e.value == 0.0 for e in ab["absorbed"])
+    assert ab["reflected"].value == pytest.approx(1.0, abs=0.003)
+
+
+def test_absorbed_plus_reflected_is_one_and_fapar_splits():
+    c = disc_canopy(lai=2.5, leaf_radius=0.1, extent=1.5, height=(0.2, 1.0), seed=5,
+                    leaf=BiLambertian(0.45, 0.35), soil=Lambertian(0.2))
+    s = c.scene()
+    ab = s.absorption(sun=(0.0, 30.0), spp=40_000, max_depth=1000, seed=3)
+    soil, leaf = ab["absorbed"]
+    total = soil.value + leaf.value + ab["reflected"].value + ab["trapped"].value
+    assert total == pytest.approx(1.0, abs=1e-12)
+    assert leaf.value > soil.value > 0
+    alb = s.albedo(sun=(0.0, 30.0), spp=40_000, max_depth=1000, seed=4)
+    assert abs(alb.value - ab["reflected"].value) < 3 * np.hypot(alb.se, ab["reflected"].se)
+    # black leaves and soil: the soil absorbs exactly the light through the gaps
+    b = disc_canopy(lai=2.5, leaf_radius=0.1, extent=1.5, height=(0.2, 1.0), seed=5,
+                    leaf=BiLambertian(0.0, 0.0), soil=Lambertian(0.0)).scene()
+    soil_b, leaf_b = b.absorption(sun=(0.0, 30.0), spp=40_000, seed=6)["absorbed"]
+    gap = b.gap_fraction(30.0, azimuth=0.0, n=40_000, seed=7)  # the same sun direction
+    assert abs(soil_b.value - gap.value) < 3 * np.hypot(soil_b.se, gap.se), (soil_b, gap)
+    assert soil_b.value + leaf_b.value == pytest.approx(1.0, abs=1e-12)
+
+
+def test_canopy_brf_is_reciprocal_and_thread_count_free():
+    s = disc_canopy(lai=2.0, leaf_radius=0.1, extent=1.5, height=(0.2, 1.0), lad="erectophile", seed=6).scene()
+    a = s.brf(sun=(0.0, 30.0), view=(120.0, 50.0), spp=40_000, seed=1)
+    b = s.brf(sun=(120.0, 50.0), view=(0.0, 30.0), spp=40_000, seed=2)
+    assert abs(a.value - b.value) < 3 * np.hypot(a.se, b.se), (a, b)
+    assert s.brf(sun=(0.0, 30.0), spp=3000, seed=3, n_threads=1) == s.brf(sun=(0.0, 30.0), spp=3000, seed=3,
+                                                                            n_threads=2)
+    assert s.gap_fraction(20.0, n=5000, n_threads=1) == s.gap_fraction(20.0, n=5000, n_threads=2)
+    assert s.absorption((0.0, 20.0), spp=3000, n_threads=1) == s.absorption((0.0, 20.0), spp=3000, n_threads=2)
+    assert s.albedo((0.0, 20.0), spp=3000, n_threads=1) == s.albedo((0.0, 20.0), spp=3000, n_threads=2)
+
+
+def test_scene_estimators_name_bad_parameters():
+    s = disc_canopy(lai=1.0, leaf_radius=0.1, extent=1.0, height=(0.2, 1.0), seed=1).scene()
+    with pytest.raises(ValueError, match="^zenith:"):
+        s.gap_fraction(95.0)
+    with pytest.raises(ValueError, match="^ground:"):
+        s.gap_fraction(10.0, ground=2)
+    with pytest.raises(ValueError, match="^n:"):
+        s.gap_fraction(10.0, n=0)
+    with pytest.raises(ValueError, match="^spp:"):
+        s.absorption((0.0, 10.0), spp=0)
+    with pytest.raises(ValueError, match="^max_depth:"):
+        s.absorption((0.0, 10.0), max_depth=0)

@@ -49,6 +49,9 @@ impl BiLambertian {
 }
 
 impl Bsdf for BiLambertian {
+    fn transmits(&self) -> bool {
+        self.t > 0.0
+    }
     fn eval(&self, wi: DVec3, wo: DVec3) -> f64 {
         let s = wi.z * wo.z;
         if s > 0.0 {

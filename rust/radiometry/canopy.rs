@@ -84,13 +84,7 @@ impl<G: Tracer> Scene<G> {
     /// Gap fraction towards `sun` (unit vector, pointing up): the fraction
     /// of `n` rays from the sun whose first hit is a facet of material
     /// `ground` (the soil), with its standard error.
-    pub fn gap_fraction(
-        &self,
-        sun: DVec3,
-        ground: u32,
-        n: u64,
-        seed: u64,
-    ) -> CoreResult<Estimate> {
+    pub fn gap_fraction(&self, sun: DVec3, ground: u32, n: u64, seed: u64) -> CoreResult<Estimate> {
         check_rays(n, "n")?;
         let nm = self.more_materials.len() + 1;
         if ground as usize >= nm {

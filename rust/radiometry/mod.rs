@@ -20,6 +20,7 @@
 //! block of paths then added in order, so results are bit-identical for any
 //! number of threads.
 pub mod bilambertian;
+pub mod canopy;
 pub mod hapke;
 pub mod heightfield;
 pub mod integrator;

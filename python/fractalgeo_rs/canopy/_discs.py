@@ -11,7 +11,7 @@ import numpy as np
 from fractalgeo_rs._validation import check_positive_float, check_positive_int, check_seed
 from fractalgeo_rs.canopy._lad import check_lad, normals_from_uniforms, projection_g
 from fractalgeo_rs.geometry import Mesh
-from fractalgeo_rs.radiometry import BiLambertian, Hapke, Lambertian, OrenNayar, Phong
+from fractalgeo_rs.radiometry import BiLambertian, Hapke, Lambertian, OrenNayar, Phong, Scene
 
 __all__ = ["DiscCanopy", "disc_canopy"]
 
@@ -104,6 +104,31 @@ class DiscCanopy:
         return (f"DiscCanopy({self.n_leaves} leaves of radius {self.leaf_radius}, lai={self.lai:.6g}, "
                 f"lad={self.lad!r}, extent={self.extent}, height={self.height}, overlap={self.overlap}, "
                 f"{len(self.mesh)} triangles)")
+
+    def scene(self) -> Scene:
+        """The canopy as a periodic radiometric scene: the mesh over the
+        tile ``(0, 0, extent)``, material 0 the soil and 1 the leaves
+        (two-sided facets), so the scene's ``brf``, ``albedo``, ``render``,
+        ``gap_fraction`` and ``absorption`` apply.
+
+        Returns
+        -------
+        fractalgeo_rs.radiometry.Scene
+
+        Examples
+        --------
+        >>> from fractalgeo_rs.canopy import disc_canopy
+        >>> s = disc_canopy(lai=1.0, leaf_radius=0.1, extent=2.0, height=(0.2, 1.0), seed=3).scene()
+        >>> s.materials[1], s.periodic
+        (BiLambertian(reflectance=0.4957, transmittance=0.4409), True)
+
+        References
+        ----------
+        B. Pinty et al., 2001 (see ``DiscCanopy``): cyclic boundary
+        conditions.
+        """
+        return Scene.from_mesh(self.mesh, materials=list(self.materials), material_ids=self.material_ids,
+                               periodic=True, extent=(0.0, 0.0, self.extent[0], self.extent[1]))
 
     def gap_probability(self, zenith):
         """The exact gap probability of this canopy's leaf statistics:
