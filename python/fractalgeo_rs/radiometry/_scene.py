@@ -1118,8 +1118,8 @@ class Scene:
         spp = check_positive_int(spp, "spp")
         absorbed, refl, trapped, n = self._scene_core().absorption(
             _direction(sun, "sun"), spp, _depth(max_depth), _seed(seed), check_n_threads(n_threads))
-        return {"absorbed": [Estimate(v, se, n) for v, se in absorbed], "reflected": Estimate(*refl, n),
-                "trapped": Estimate(*trapped, n)}
+        return {"absorbed": [Estimate(v, se, n) for v, se in absorbed], "reflected": Estimate(refl[0], refl[1], n),
+                "trapped": Estimate(trapped[0], trapped[1], n)}
 
     def render(self, sun, view="nadir", shape: Optional[Tuple[int, int]] = None, spp: int = 16,
                max_depth: int = 10, seed: int = 0, n_threads: Optional[int] = None,
