@@ -299,6 +299,11 @@ def test_cli_writes_the_mesh_and_the_table(tmp_path, capsys):
     rows = [r.split(",") for r in text.splitlines() if r and r[0].isdigit()]
     assert [float(r[0]) for r in rows] == [0.0, 60.0]
     assert float(rows[0][1]) == pytest.approx(4 / (3 * np.pi), abs=1e-6)
+    assert cli.main(["canopy", "--lai", "1", "--leaf-radius", "0.1", "--extent", "1", "1", "--height", "0.2", "1",
+                     "--seed", "1", "--zenith", "20", "--spp", "4000"]) == 0
+    head, row = [r for r in capsys.readouterr().out.splitlines() if not r.startswith("#")]
+    vals = dict(zip(head.split(","), map(float, row.split(","))))
+    assert 0 < vals["gap_traced"] < 1 and vals["brf_nadir"] > 0 and vals["brf_se"] > 0
     assert cli.main(["canopy", "--lai", "-1", "--leaf-radius", "0.05", "--extent", "2", "2",
                      "--height", "0.1", "1"]) == 1
     assert "--lai:" in capsys.readouterr().err

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from fractalgeo_rs._cli_common import HelpFormatter
+from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads
 
 LAD_HELP = ("leaf angle distribution: planophile, erectophile, plagiophile, extremophile, uniform, spherical, "
             "or one inclination in degrees")
@@ -33,6 +33,11 @@ def add_parsers(sub) -> None:
     p.add_argument("--sides", type=int, default=12, help="sides of each leaf polygon")
     p.add_argument("--zenith", default="0,15,30,45,60,75", help="comma-separated zeniths of the table, degrees")
     p.add_argument("--seed", type=int, default=None, help="seed of the placement (None: fresh entropy, printed)")
+    p.add_argument("--spp", type=int, default=0,
+                   help="rays per traced value: adds the traced gap fraction and the nadir BRF with the sun at "
+                   "each zenith (azimuth 0) and their standard errors (0: no tracing)")
+    p.add_argument("--max-depth", type=int, default=100, help="scattering events per BRF path")
+    add_n_threads(p)
     p.set_defaults(func=_run)
 
 
@@ -72,9 +77,18 @@ def _run(args: argparse.Namespace) -> int:
     if args.output:
         c.mesh.write(args.output)
         print(f"# mesh -> {args.output}")
-    print("zenith,G,gap_exact,gap_beer")
+    if args.spp < 0:
+        raise ValueError(f"--spp: expected 0 (no tracing) or a positive number of rays, got {args.spp}")
+    scene = c.scene() if args.spp else None
+    print("zenith,G,gap_exact,gap_beer" + (",gap_traced,gap_se,brf_nadir,brf_se" if scene else ""))
     for z in zen:
         g = projection_g(c.lad, z)
         beer = math.exp(-g * c.lai / math.cos(math.radians(z)))
-        print(f"{z:g},{g:.6f},{float(c.gap_probability(z)):.6f},{beer:.6f}")
+        row = f"{z:g},{g:.6f},{float(c.gap_probability(z)):.6f},{beer:.6f}"
+        if scene is not None:
+            gap = scene.gap_fraction(z, n=args.spp, seed=c.seed % 2**63, n_threads=args.n_threads)
+            brf = scene.brf(sun=(0.0, z), view="nadir", spp=args.spp, max_depth=args.max_depth,
+                            seed=c.seed % 2**63, n_threads=args.n_threads)
+            row += f",{gap.value:.6f},{gap.se:.2g},{brf.value:.6f},{brf.se:.2g}"
+        print(row)
     return 0
