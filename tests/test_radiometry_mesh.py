@@ -178,3 +178,18 @@ def test_bad_input_names_the_parameter():
         Scene.from_mesh(m, materials=[])
     # the inputs are not modified
     assert np.isfinite(m.vertices).all()
+
+
+def test_per_facet_path_with_one_material_is_the_plain_scene():
+    # the same paths: one material everywhere gives bit-identical estimates
+    z = periodic_surface(12, amp=3.0, seed=4)
+    a = Scene.from_dem(z, material=OrenNayar(0.5, 0.2))
+    b = Scene.from_dem(z, material=[OrenNayar(0.5, 0.2), Lambertian(0.9)], material_ids=np.zeros((12, 12, 2), int))
+    assert a.brf(sun=(30.0, 40.0), view=(100.0, 20.0), spp=5000) == b.brf(sun=(30.0, 40.0), view=(100.0, 20.0),
+                                                                           spp=5000)
+    assert a.albedo(sun=(30.0, 40.0), spp=2000) == b.albedo(sun=(30.0, 40.0), spp=2000)
+    np.testing.assert_array_equal(a.render(sun=(30.0, 40.0), spp=2), b.render(sun=(30.0, 40.0), spp=2))
+    # a mesh scene keeps its extent in map coordinates
+    m, ext = tile_mesh(z)
+    s = Scene.from_mesh(m, extent=ext)
+    assert s.extent == ext and s.render(sun=(0.0, 20.0), shape=(3, 5), spp=1).shape == (3, 5)

@@ -12,6 +12,7 @@ __all__ = [
     "LSystemCore",
     "ModuleString",
     "ProgressCounter",
+    "RadiometryScene",
     "__version__",
     "additions_refine_2d",
     "blanket_areas_image",

@@ -209,6 +209,9 @@ fn scene_with<G: crate::radiometry::Tracer>(
 /// `(absorbed per material, reflected, trapped, n)`, each a `(value, se)`.
 type AbsorptionOut = (Vec<(f64, f64)>, (f64, f64), (f64, f64), u64);
 
+/// `(areas, normals)` of [`RadiometryScene::facets`].
+type FacetArrays<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>);
+
 /// A scene kept between calls (a mesh's BVH is built once): a DEM or a
 /// triangle mesh with per-facet materials.
 #[pyclass(frozen, module = "fractalgeo_rs._core")]
@@ -388,10 +391,7 @@ impl RadiometryScene {
 
     /// `(areas, normals)`: area (square metres) and unit normal of every
     /// facet of the tile, in material-id order.
-    fn facets<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>)> {
+    fn facets<'py>(&self, py: Python<'py>) -> PyResult<FacetArrays<'py>> {
         use crate::radiometry::Tracer;
         let f = with_scene!(&self.kind, s => s.hf.facets());
         let areas: Vec<f64> = f.iter().map(|x| x.0).collect();

@@ -359,3 +359,180 @@ fn bad_meshes_and_materials_name_the_parameter() {
         .to_string();
     assert!(e.starts_with("materials:"), "{e}");
 }
+
+/// A two-sided leaf for the tests: reflectance `r` on the side the light
+/// comes from, transmittance `t` to the other, both Lambertian.
+#[derive(Debug)]
+struct TestLeaf {
+    r: f64,
+    t: f64,
+}
+
+impl Bsdf for TestLeaf {
+    fn eval(&self, wi: DVec3, wo: DVec3) -> f64 {
+        if wi.z * wo.z > 0.0 {
+            self.r / std::f64::consts::PI
+        } else {
+            self.t / std::f64::consts::PI
+        }
+    }
+    fn sample(&self, wo: DVec3, u: [f64; 2]) -> Option<material::BsdfSample> {
+        let p = self.r / (self.r + self.t);
+        let (reflect, u0) = if u[0] < p {
+            (true, u[0] / p)
+        } else {
+            (false, (u[0] - p) / (1.0 - p))
+        };
+        let mut wi = material::cosine_hemisphere([u0, u[1]]);
+        if !reflect {
+            wi.z = -wi.z;
+        }
+        let _ = wo;
+        let pdf = if reflect { p } else { 1.0 - p } * wi.z.abs() / std::f64::consts::PI;
+        Some(material::BsdfSample {
+            wi,
+            weight: self.r + self.t,
+            pdf,
+        })
+    }
+    fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
+        let p = self.r / (self.r + self.t);
+        let q = if wi.z * wo.z > 0.0 { p } else { 1.0 - p };
+        q * wi.z.abs() / std::f64::consts::PI
+    }
+    fn albedo(&self, _wo: DVec3) -> f64 {
+        self.r + self.t
+    }
+    fn transmits(&self) -> bool {
+        true
+    }
+}
+
+#[test]
+fn a_transmitting_leaf_layer_over_the_ground_matches_adding() {
+    // a horizontal leaf layer (r, t) 1 m above Lambertian ground (rho):
+    // BRF = albedo = r + t^2 rho / (1 - r rho) for every sun and view
+    // (diffuse adding of two layers); exercises transmitted sampling and
+    // next-event estimation through a leaf lit from behind
+    let leaf = tile_mesh(&[1.0; 16], 4, 4);
+    let ground = tile_mesh(&[0.0; 16], 4, 4);
+    let mut mesh = leaf.clone();
+    let k = mesh.vertices.len() as u32;
+    mesh.vertices.extend(&ground.vertices);
+    mesh.faces
+        .extend(ground.faces.iter().map(|f| f.map(|i| i + k)));
+    let ids: Vec<u32> = (0..mesh.faces.len())
+        .map(|i| (i >= leaf.faces.len()) as u32)
+        .collect();
+    let (r, t, rho) = (0.3, 0.5, 0.6);
+    let want = r + t * t * rho / (1.0 - r * rho);
+    let tr = MeshTracer::new(&mesh, true, tile_extent(4, 4)).unwrap();
+    let s = Scene::with_materials(tr, vec![Box::new(TestLeaf { r, t }), lam(rho)], ids).unwrap();
+    for (sun, view) in [((0.0, 0.0), (0.0, 0.0)), ((60.0, 50.0), (250.0, 35.0))] {
+        let e = s
+            .brf(dir(sun.0, sun.1), dir(view.0, view.1), 40000, 200, 1)
+            .unwrap();
+        assert!((e.value - want).abs() < 3.0 * e.se, "{e:?} vs {want}");
+        let a = s.albedo(dir(sun.0, sun.1), 40000, 200, 1).unwrap();
+        assert!((a.value - want).abs() < 3.0 * a.se, "{a:?} vs {want}");
+    }
+}
+
+mod instancing {
+    use super::*;
+    use crate::radiometry::InstancedTracer;
+    use glam::{DAffine3, DMat3};
+
+    #[test]
+    fn four_translated_copies_match_the_whole_mesh() {
+        // a periodic 4 x 4 tile placed 2 x 2 times is the 8 x 8 tile of the
+        // same surface repeated
+        let z4 = rough(4, 1.5, 21);
+        let piece = tile_mesh(&z4, 4, 4);
+        let mut z8 = vec![0.0; 64];
+        for r in 0..8 {
+            for c in 0..8 {
+                z8[r * 8 + c] = z4[(r % 4) * 4 + c % 4];
+            }
+        }
+        let whole = Scene::new(
+            MeshTracer::new(&tile_mesh(&z8, 8, 8), true, tile_extent(8, 8)).unwrap(),
+            lam(0.7),
+        );
+        let inst: Vec<(usize, DAffine3)> = [(0.0, 0.0), (4.0, 0.0), (0.0, -4.0), (4.0, -4.0)]
+            .iter()
+            .map(|&(x, y)| (0, DAffine3::from_translation(DVec3::new(x, y, 0.0))))
+            .collect();
+        let tr = InstancedTracer::new(&[piece], &inst, true, [0.0, -8.0, 8.0, 8.0]).unwrap();
+        assert_eq!(tr.facet_count(), 4 * 32);
+        let (s1, s2) = whole
+            .hf
+            .facets()
+            .iter()
+            .fold((0.0, 0.0), |a, f| (a.0 + f.0, a.1 + f.0 * f.1.z));
+        let (i1, i2) = tr
+            .facets()
+            .iter()
+            .fold((0.0, 0.0), |a, f| (a.0 + f.0, a.1 + f.0 * f.1.z));
+        assert!((s1 - i1).abs() < 1e-9 * s1 && (s2 - i2).abs() < 1e-9 * s2);
+        let inst_scene = Scene::new(tr, lam(0.7));
+        for (sun, view) in [((0.0, 30.0), (0.0, 0.0)), ((135.0, 60.0), (20.0, 40.0))] {
+            let a = whole
+                .brf(dir(sun.0, sun.1), dir(view.0, view.1), 20000, 5, 2)
+                .unwrap();
+            let b = inst_scene
+                .brf(dir(sun.0, sun.1), dir(view.0, view.1), 20000, 5, 2)
+                .unwrap();
+            assert!((a.value - b.value).abs() < 3.0 * a.se, "{a:?} {b:?}");
+            let aa = whole.albedo(dir(sun.0, sun.1), 20000, 5, 2).unwrap();
+            let ba = inst_scene.albedo(dir(sun.0, sun.1), 20000, 5, 2).unwrap();
+            assert!((aa.value - ba.value).abs() < 3.0 * aa.se, "{aa:?} {ba:?}");
+        }
+    }
+
+    #[test]
+    fn rotated_scaled_plane_instances_give_rho_and_per_instance_materials() {
+        // a unit square (two triangles) scaled by 2, rotated 90 degrees and
+        // placed four times to cover the 4 x 4 tile: a flat plane
+        let sq = Mesh {
+            vertices: vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [1.0, 1.0, 0.0],
+            ],
+            faces: vec![[0, 1, 2], [1, 3, 2]],
+            ..Mesh::default()
+        };
+        let rot = DMat3::from_rotation_z(std::f64::consts::FRAC_PI_2) * 2.0;
+        let inst: Vec<(usize, DAffine3)> = [(2.0, -4.0), (4.0, -4.0), (2.0, -2.0), (4.0, -2.0)]
+            .iter()
+            .map(|&(x, y)| {
+                (
+                    0,
+                    DAffine3::from_mat3_translation(rot, DVec3::new(x, y, 0.5)),
+                )
+            })
+            .collect();
+        let tr = InstancedTracer::new(&[sq], &inst, true, [0.0, -4.0, 4.0, 4.0]).unwrap();
+        for (a, n) in tr.facets() {
+            assert!((a - 2.0).abs() < 1e-12 && (n.z - 1.0).abs() < 1e-12);
+        }
+        let ids = vec![0, 0, 1, 1, 1, 1, 0, 0]; // instances 0 and 3 dark
+        let s = Scene::with_materials(tr, vec![lam(0.2), lam(0.6)], ids).unwrap();
+        let e = s
+            .brf(dir(40.0, 50.0), dir(220.0, 30.0), 20000, 4, 0)
+            .unwrap();
+        assert!((e.value - 0.4).abs() < 3.0 * e.se, "{e:?}");
+        let img = s
+            .render(dir(0.0, 60.0), DVec3::Z, (2, 2), 16, 4, 0)
+            .unwrap();
+        // image row 0 is north (y in [-2, 0]): instances 2 (x 0..2) and 3
+        let want = [0.6, 0.2, 0.2, 0.6].map(|r| r * 0.5 / std::f64::consts::PI);
+        for (p, w) in img.iter().zip(want) {
+            assert!((*p as f64 - w).abs() < 1e-6, "{img:?}");
+        }
+        let bad = InstancedTracer::new(&[], &[(0, DAffine3::IDENTITY)], true, [0.0, 0.0, 1.0, 1.0]);
+        assert!(bad.unwrap_err().to_string().starts_with("instances:"));
+    }
+}

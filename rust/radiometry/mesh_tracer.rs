@@ -52,6 +52,8 @@ pub struct MeshTracer {
     prims: Vec<Prim>,
     /// Area and unit normal (right-handed winding) of every triangle.
     tri_facets: Vec<(f64, DVec3)>,
+    /// Centroid of every triangle (mesh frame).
+    tri_centroids: Vec<DVec3>,
     /// Whether the tile repeats periodically.
     pub periodic: bool,
     /// Tile box in the mesh frame: `(x0, y0, width, height)`.
@@ -131,7 +133,7 @@ impl MeshTracer {
             let n = (b - a).cross(c - a);
             let len = n.length();
             let scale = (b - a).length() * (c - a).length();
-            if !(len > 1e-12 * scale) || len == 0.0 {
+            if len <= 1e-12 * scale {
                 return Err(CoreError::invalid(
                     "mesh",
                     format!("triangle {k} {f:?} is degenerate (zero area): {p:?}"),
@@ -280,10 +282,21 @@ impl MeshTracer {
             .iter()
             .map(|&i| prims[i as usize])
             .collect();
+        let tri_centroids = mesh
+            .faces
+            .iter()
+            .map(|f| {
+                f.iter()
+                    .map(|&i| v64(mesh.vertices[i as usize]))
+                    .sum::<DVec3>()
+                    / 3.0
+            })
+            .collect();
         Ok(MeshTracer {
             bvh,
             prims,
             tri_facets,
+            tri_centroids,
             periodic,
             tile,
             origin: mesh.origin,
@@ -358,7 +371,7 @@ impl MeshTracer {
     /// primitive (triangle, shift), so the result does not depend on the
     /// BVH's layout.
     #[inline]
-    fn search(
+    pub(crate) fn search(
         &self,
         o: DVec3,
         d: DVec3,
@@ -412,74 +425,126 @@ impl MeshTracer {
         best
     }
 
+    /// The triangle of BVH primitive `k`.
+    #[inline(always)]
+    pub(crate) fn prim_tri(&self, k: usize) -> u32 {
+        self.prims[k].tri
+    }
+
+    /// Area, unit normal and centroid of triangle `tri` (mesh frame).
+    pub(crate) fn triangle(&self, tri: usize) -> (f64, DVec3, DVec3) {
+        let (a, n) = self.tri_facets[tri];
+        (a, n, self.tri_centroids[tri])
+    }
+
+    /// Lower and upper corners of the triangles' bounding box (mesh frame).
+    pub(crate) fn bounds(&self) -> (DVec3, DVec3) {
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for p in &self.prims {
+            for v in p.v {
+                lo = lo.min(v64(v));
+                hi = hi.max(v64(v));
+            }
+        }
+        (lo, hi)
+    }
+
     #[inline]
-    fn prim_key(&self, k: usize) -> (u32, u32) {
+    pub(crate) fn prim_key(&self, k: usize) -> (u32, u32) {
         (self.prims[k].tri, self.prims[k].shift)
     }
 
     /// The nearest hit (`any`: whether something is hit) over all tiles.
-    fn cast(&self, o: DVec3, d: DVec3, skip: Option<u32>, any: bool) -> Option<(f64, usize)> {
+    pub(crate) fn cast(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        skip: Option<u32>,
+        any: bool,
+    ) -> Option<(f64, usize)> {
         if !self.periodic {
             return self.search(o, d, (0.0, f64::INFINITY), skip, 0.0, any);
         }
-        let (x0, y0, w, h) = self.tile;
-        let (x1, y1) = (x0 + w, y0 + h);
-        let mut oc = o;
-        oc.x -= ((o.x - x0) / w).floor() * w;
-        oc.y -= ((o.y - y0) / h).floor() * h;
-        let eps = self.seg_eps;
-        let mut t0 = 0.0f64;
-        for _ in 0..MAX_WRAPS {
-            let tx = if d.x > 0.0 {
-                (x1 - oc.x) / d.x
-            } else if d.x < 0.0 {
-                (x0 - oc.x) / d.x
-            } else {
-                f64::INFINITY
-            };
-            let ty = if d.y > 0.0 {
-                (y1 - oc.y) / d.y
-            } else if d.y < 0.0 {
-                (y0 - oc.y) / d.y
-            } else {
-                f64::INFINITY
-            };
-            let t1 = tx.min(ty).max(t0);
-            let z0 = oc.z + t0 * d.z;
-            let z1 = if t1.is_finite() {
-                oc.z + t1 * d.z
-            } else if d.z > 0.0 {
-                f64::INFINITY
-            } else if d.z < 0.0 {
-                f64::NEG_INFINITY
-            } else {
-                oc.z
-            };
-            if z0.min(z1) <= self.zmax + eps && z0.max(z1) >= self.zmin - eps {
-                // search the segment from its own start (small f32 offsets)
-                let os = oc + t0 * d;
-                let thi = if t1.is_finite() {
-                    t1 - t0 + eps
-                } else {
-                    f64::INFINITY
-                };
-                if let Some((t, k)) = self.search(os, d, (-eps, thi), skip, t0, any) {
-                    return Some((t + t0, k));
-                }
-            }
-            if !t1.is_finite() || (d.z >= 0.0 && z1 > self.zmax) || (d.z < 0.0 && z1 < self.zmin) {
-                return None;
-            }
-            if tx <= ty {
-                oc.x -= d.x.signum() * w;
-            }
-            if ty <= tx {
-                oc.y -= d.y.signum() * h;
-            }
-            t0 = t1;
-        }
-        None
+        periodic_segments(
+            self.tile,
+            (self.zmin, self.zmax),
+            self.seg_eps,
+            o,
+            d,
+            |os, thi, t0| self.search(os, d, (-self.seg_eps, thi), skip, t0, any),
+        )
     }
+}
+
+/// The periodic ray walk shared by the mesh tracers: `o + t d` is clipped
+/// to the tile box `(x0, y0, width, height)`; `search(os, thi, t0)` looks
+/// for a hit on the segment from `os` (the point at `t0`, moved into the
+/// tile) up to `thi` past it and returns `(t - t0, payload)`; with no hit
+/// the ray re-enters from the opposite side, until it leaves the slab
+/// `zr = (lowest, highest)`. Returns the nearest `(t, payload)`.
+pub(crate) fn periodic_segments<X>(
+    (x0, y0, w, h): (f64, f64, f64, f64),
+    (zmin, zmax): (f64, f64),
+    eps: f64,
+    o: DVec3,
+    d: DVec3,
+    mut search: impl FnMut(DVec3, f64, f64) -> Option<(f64, X)>,
+) -> Option<(f64, X)> {
+    let (x1, y1) = (x0 + w, y0 + h);
+    let mut oc = o;
+    oc.x -= ((o.x - x0) / w).floor() * w;
+    oc.y -= ((o.y - y0) / h).floor() * h;
+    let mut t0 = 0.0f64;
+    for _ in 0..MAX_WRAPS {
+        let tx = if d.x > 0.0 {
+            (x1 - oc.x) / d.x
+        } else if d.x < 0.0 {
+            (x0 - oc.x) / d.x
+        } else {
+            f64::INFINITY
+        };
+        let ty = if d.y > 0.0 {
+            (y1 - oc.y) / d.y
+        } else if d.y < 0.0 {
+            (y0 - oc.y) / d.y
+        } else {
+            f64::INFINITY
+        };
+        let t1 = tx.min(ty).max(t0);
+        let z0 = oc.z + t0 * d.z;
+        let z1 = if t1.is_finite() {
+            oc.z + t1 * d.z
+        } else if d.z > 0.0 {
+            f64::INFINITY
+        } else if d.z < 0.0 {
+            f64::NEG_INFINITY
+        } else {
+            oc.z
+        };
+        if z0.min(z1) <= zmax + eps && z0.max(z1) >= zmin - eps {
+            // search the segment from its own start (small f32 offsets)
+            let os = oc + t0 * d;
+            let thi = if t1.is_finite() {
+                t1 - t0 + eps
+            } else {
+                f64::INFINITY
+            };
+            if let Some((t, k)) = search(os, thi, t0) {
+                return Some((t + t0, k));
+            }
+        }
+        if !t1.is_finite() || (d.z >= 0.0 && z1 > zmax) || (d.z < 0.0 && z1 < zmin) {
+            return None;
+        }
+        if tx <= ty {
+            oc.x -= d.x.signum() * w;
+        }
+        if ty <= tx {
+            oc.y -= d.y.signum() * h;
+        }
+        t0 = t1;
+    }
+    None
 }
 
 impl Tracer for MeshTracer {

@@ -23,6 +23,7 @@ pub mod bilambertian;
 pub mod canopy;
 pub mod hapke;
 pub mod heightfield;
+pub mod instanced;
 pub mod integrator;
 pub mod lambertian;
 pub mod material;
@@ -38,6 +39,7 @@ mod mesh_tests;
 mod tests;
 
 pub use heightfield::{Heightfield, Split};
+pub use instanced::InstancedTracer;
 pub use integrator::{Estimate, Scene};
 pub use mesh_tracer::MeshTracer;
 pub use tracer::{TraceHit, Tracer};

@@ -616,10 +616,11 @@ class Scene:
         if self.mesh is not None:
             return (f"Scene(mesh of {len(self.mesh)} triangles, extent={self.extent}, periodic={self.periodic}, "
                     f"materials={list(self.materials)!r})")
+        dem = self._dem()
         if len(self.materials) > 1:
-            return (f"Scene({self.dem.shape[0]} x {self.dem.shape[1]} heights, cell_size={self.cell_size}, "
+            return (f"Scene({dem.shape[0]} x {dem.shape[1]} heights, cell_size={self.cell_size}, "
                     f"periodic={self.periodic}, materials={list(self.materials)!r}, split={self.split!r})")
-        return (f"Scene({self.dem.shape[0]} x {self.dem.shape[1]} heights, cell_size={self.cell_size}, "
+        return (f"Scene({dem.shape[0]} x {dem.shape[1]} heights, cell_size={self.cell_size}, "
                 f"periodic={self.periodic}, material={self.material!r}, split={self.split!r})")
 
     @classmethod
@@ -889,15 +890,23 @@ class Scene:
             return self._core.brf(sun, view, spp, depth, seed, n_threads)
         return _core.radiometry_brf(*self._args(), sun, view, spp, depth, seed, n_threads)
 
+    def _dem(self) -> np.ndarray:
+        if self.dem is None:
+            raise TypeError("a mesh scene has no DEM")
+        return self.dem
+
     def _default_shape(self) -> Tuple[int, int]:
         if self.mesh is not None:
             return (128, 128)
-        cells = self.dem.shape if self.periodic else (self.dem.shape[0] - 1, self.dem.shape[1] - 1)
+        dem = self._dem()
+        cells = dem.shape if self.periodic else (dem.shape[0] - 1, dem.shape[1] - 1)
         return (int(cells[0]), int(cells[1]))
 
     def _args(self) -> Tuple[np.ndarray, Tuple[float, float], bool, str, str, List[float]]:
         name, params = self.material._spec()
-        return (self.dem, self.cell_size, self.periodic, self.split, name, params)
+        if self.cell_size is None:
+            raise TypeError("a mesh scene has no cell size")
+        return (self._dem(), self.cell_size, self.periodic, self.split, name, params)
 
     def brf(self, sun, view="nadir", spp: int = 65536, max_depth: int = 10, seed: int = 0,
             n_threads: Optional[int] = None) -> Estimate:
@@ -1184,14 +1193,18 @@ class Scene:
         check_memory(rows * cols * 4, "shape", max_memory=max_memory, what=f"a {rows} x {cols} float32 image")
         from fractalgeo_rs import _progress
 
-        args = (_direction(sun, "sun"), _direction(view, "view"), (rows, cols),
-                check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed), check_n_threads(n_threads))
+        sun_d, view_d = _direction(sun, "sun"), _direction(view, "view")
+        spp_i, depth, seed_i = check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed)
+        threads = check_n_threads(n_threads)
         core = self._core
         with _progress.Steps(rows, "render", _progress.resolve(progress)) as steps:
             if core is not None:
-                return steps.counted(lambda counter: core.render(*args, progress=counter), rows)
-            dem_args = self._args()
-            return steps.counted(lambda counter: _core.radiometry_render(*dem_args, *args, progress=counter), rows)
+                return steps.counted(lambda counter: core.render(sun_d, view_d, (rows, cols), spp_i, depth, seed_i,
+                                                                 threads, progress=counter), rows)
+            dem, cell, periodic, split, name, params = self._args()
+            return steps.counted(lambda counter: _core.radiometry_render(
+                dem, cell, periodic, split, name, params, sun_d, view_d, (rows, cols), spp_i, depth, seed_i,
+                threads, progress=counter), rows)
 
     def brf_sweep(self, sun_zenith=PAPER_SUN_ZENITHS, view_zenith=(0.0,), sun_azimuth: float = 0.0,
                   view_azimuth: float = 0.0, spp: int = 65536, max_depth: int = 10, seed: int = 0,
