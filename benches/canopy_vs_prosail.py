@@ -68,9 +68,11 @@ def main() -> None:
     ap.add_argument("--spp", type=int, default=25_000)
     ap.add_argument("--depth", type=int, default=100)
     ap.add_argument("--placements", type=int, default=8)
+    ap.add_argument("--hspot", type=float, default=None,
+                    help="4SAIL hot-spot parameter (default: leaf diameter / canopy depth)")
     args = ap.parse_args()
     bottom, top = 0.1, 2.0
-    hspot = 2.0 * args.radius / (top - bottom)
+    hspot = 2.0 * args.radius / (top - bottom) if args.hspot is None else args.hspot
     print(f"LAI {args.lai}, spherical, disc radius {args.radius} m, heights {bottom}-{top} m, "
           f"tile {args.extent} m, sun zenith {args.sun}, spp {args.spp} x {args.placements} placement(s), "
           f"max_depth {args.depth}; 4SAIL hot spot {hspot:.4f}")
