@@ -6,17 +6,19 @@ radius ``--radius`` m, spherical leaf angles, LAI 3, centres uniform in
 heights 0.1-2.0 m, periodic 5 m tile) over a Lambertian soil, traced by
 ``Scene.brf`` with ``--spp`` paths per angle: all orders
 (``max_depth=--depth``) and single scattering (``max_depth=1``), each with
-its standard error: over ``--placements`` independent placements (default
-8) the spread of the per-placement estimates, which holds both the path
-noise and the placement-to-placement variation of a 5 m tile. 4SAIL's side: ``prosail.FourSAIL.foursail`` run directly with the
-same leaf reflectance/transmittance and soil reflectance, the spherical
-leaf angle distribution on 4SAIL's 18 inclination bins (``cos`` of the bin
+its standard error: over ``--placements`` independent placements
+(default 8) the spread of the per-placement estimates, which holds both
+the path noise and the placement-to-placement variation of a 5 m tile.
+
+4SAIL's side: ``prosail.FourSAIL.foursail`` run directly with the same
+leaf reflectance/transmittance and soil reflectance, the spherical leaf
+angle distribution on 4SAIL's 18 inclination bins (``cos`` of the bin
 edges differenced; the package's ``campbell(57.3)``, the usual way to ask
 for "spherical", has an eccentricity of 1.048 and gives ``G`` = 0.510 to
-0.516 instead of 0.500, so it is shown as an extra column), and the hot-spot
-parameter = leaf diameter / canopy depth. 4SAIL's single
-scattering is ``rsos + tsstoo * rsoil`` (leaves once + soil once seen
-through the sun and view gaps), its total ``rsot``.
+0.516 instead of 0.500, so it is shown as an extra column), and the
+hot-spot parameter = leaf diameter / canopy depth (``--hspot`` to change
+it). 4SAIL's single scattering is ``rsos + tsstoo * rsoil`` (leaves once +
+soil once seen through the sun and view gaps), its total ``rsot``.
 
 Two bands: RAMI's red (leaf 0.0546/0.0149, soil 0.127) and near-infrared
 (leaf 0.4957/0.4409, soil 0.159) (Pinty et al. 2001). Sun at ``--sun``
