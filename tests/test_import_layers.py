@@ -30,7 +30,7 @@ FOUNDATION = {"_core", "_warn", "_compat"}
 SERVICES = {"_validation", "_progress", "_backend", "_scales", "_zscale", "fit", "io", "plotting", "data",
             "_cli_common"}
 GEOMETRY = {"geometry"}
-DOMAINS = {"dimension", "synth", "transform", "dem", "lsystem", "tin", "radar", "radiometry"}
+DOMAINS = {"dimension", "synth", "transform", "dem", "lsystem", "tin", "radar", "radiometry", "canopy"}
 TOP = {"__init__", "cli", "demo"}
 
 # The domains a domain may import (downward edges only).
@@ -43,6 +43,7 @@ DOMAIN_DEPS = {
     "tin": {"dem"},
     "radar": {"synth"},  # fBm surfaces for physical optics
     "radiometry": set(),
+    "canopy": {"radiometry", "lsystem"},  # leaf optics; L-system plants
 }
 
 # Edges that break the layers today and are being removed by the work of

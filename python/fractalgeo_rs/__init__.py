@@ -26,7 +26,7 @@ import types
 from typing import TYPE_CHECKING, Any, Dict, List, Optional
 
 if TYPE_CHECKING:  # the names for type checkers and IDEs (not executed)
-    from fractalgeo_rs import data, geometry, io, radar, radiometry, tin
+    from fractalgeo_rs import canopy, data, geometry, io, radar, radiometry, tin
     from fractalgeo_rs._core import __version__
     from fractalgeo_rs.dem import fractal_resample, hillshade, lakes
     from fractalgeo_rs.dimension import (
@@ -65,6 +65,7 @@ if TYPE_CHECKING:  # the names for type checkers and IDEs (not executed)
 _EXPORTS: Dict[str, Optional[str]] = {
     "__version__": "fractalgeo_rs._core",
     # subpackages
+    "canopy": None,
     "data": None,
     "geometry": None,
     "io": None,

@@ -748,6 +748,12 @@ class RadiometryScene:
     def albedo(
         self, sun: Tuple[float, float], spp: int, max_depth: int, seed: int, n_threads: Optional[int] = None
     ) -> Tuple[float, float, int]: ...
+    def gap_fraction(
+        self, sun: Tuple[float, float], ground: int, n: int, seed: int, n_threads: Optional[int] = None
+    ) -> Tuple[float, float, int]: ...
+    def absorption(
+        self, sun: Tuple[float, float], spp: int, max_depth: int, seed: int, n_threads: Optional[int] = None
+    ) -> Tuple[List[Tuple[float, float]], Tuple[float, float], Tuple[float, float], int]: ...
     def render(
         self,
         sun: Tuple[float, float],

@@ -22,6 +22,7 @@ import warnings
 from typing import Optional, Sequence
 
 _DOMAIN_CLIS = (
+    "fractalgeo_rs.canopy._cli",
     "fractalgeo_rs.dem._cli",
     "fractalgeo_rs.dimension._cli",
     "fractalgeo_rs.demo",
@@ -50,6 +51,8 @@ _COMMANDS = {
                "radiance image of a DEM lit by the sun (virtual radiometric experiment)"),
     "brf": ("fractalgeo_rs.radiometry._cli",
             "BRF of a DEM over sun zenith angles (virtual radiometric experiment), as CSV"),
+    "canopy": ("fractalgeo_rs.canopy._cli",
+               "RAMI-like canopy of disc leaves over a soil, as a mesh, with its gap-fraction table"),
 }
 
 

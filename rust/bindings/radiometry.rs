@@ -556,6 +556,9 @@ fn scene_with<G: crate::radiometry::Tracer>(
     }
 }
 
+/// `(absorbed per material, reflected, trapped, n)`, each a `(value, se)`.
+type AbsorptionOut = (Vec<(f64, f64)>, (f64, f64), (f64, f64), u64);
+
 /// `(areas, normals)` of [`RadiometryScene::facets`].
 type FacetArrays<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>);
 
@@ -726,6 +729,51 @@ impl RadiometryScene {
             with_scene!(&self.kind, s => s.albedo(sun, spp, max_depth, seed))
         })?;
         Ok((e.value, e.se, e.n))
+    }
+
+    /// `(value, se, n)` of the gap fraction towards `sun`: the fraction of
+    /// `n` rays from the sun whose first hit has material `ground`.
+    #[pyo3(signature = (sun, ground, n, seed, n_threads=None))]
+    fn gap_fraction(
+        &self,
+        py: Python<'_>,
+        sun: (f64, f64),
+        ground: u32,
+        n: u64,
+        seed: u64,
+        n_threads: Option<usize>,
+    ) -> PyResult<(f64, f64, u64)> {
+        let e = run(py, n_threads, || {
+            let sun = direction(sun, "sun")?;
+            with_scene!(&self.kind, s => s.gap_fraction(sun, ground, n, seed))
+        })?;
+        Ok((e.value, e.se, e.n))
+    }
+
+    /// `(absorbed, reflected, trapped, n)`: `(value, se)` of the fraction of
+    /// the sun's light absorbed per material, reflected, and still
+    /// travelling after `max_depth` events.
+    #[pyo3(signature = (sun, spp, max_depth, seed, n_threads=None))]
+    fn absorption(
+        &self,
+        py: Python<'_>,
+        sun: (f64, f64),
+        spp: u64,
+        max_depth: u32,
+        seed: u64,
+        n_threads: Option<usize>,
+    ) -> PyResult<AbsorptionOut> {
+        let a = run(py, n_threads, || {
+            let sun = direction(sun, "sun")?;
+            with_scene!(&self.kind, s => s.absorption(sun, spp, max_depth, seed))
+        })?;
+        let pair = |e: crate::radiometry::Estimate| (e.value, e.se);
+        Ok((
+            a.absorbed.iter().map(|&e| pair(e)).collect(),
+            pair(a.reflected),
+            pair(a.trapped),
+            a.reflected.n,
+        ))
     }
 
     /// A float32 radiance image (orthographic sensor over the footprint).

@@ -102,6 +102,7 @@ pub fn basis(n: DVec3) -> (DVec3, DVec3) {
 /// | `phong` | `kd`, `ks` in [0, 1] with `kd + ks <= 1`, exponent >= 0 |
 /// | `hapke` | `w`, `b`, `c`, `theta_bar` (degrees), `B0`, `h` |
 /// | `specular` | `eta` > 0, `k` >= 0 (complex relative refractive index) |
+/// | `bilambertian` | `reflectance`, `transmittance` in [0, 1] with sum <= 1 (two-sided leaf) |
 pub fn from_name(name: &str, params: &[f64]) -> CoreResult<Box<dyn Bsdf>> {
     let want = |n: usize, what: &str| -> CoreResult<()> {
         if params.len() == n {
@@ -151,10 +152,16 @@ pub fn from_name(name: &str, params: &[f64]) -> CoreResult<Box<dyn Bsdf>> {
                 params[0], params[1],
             )?))
         }
+        "bilambertian" => {
+            want(2, "reflectance, transmittance")?;
+            Ok(Box::new(super::bilambertian::BiLambertian::new(
+                params[0], params[1],
+            )?))
+        }
         _ => Err(CoreError::invalid(
             "material",
             format!(
-                "expected one of 'lambertian', 'oren-nayar', 'oren-nayar-full', 'phong', 'hapke', 'specular', got {name:?}"
+                "expected one of 'lambertian', 'oren-nayar', 'oren-nayar-full', 'phong', 'hapke', 'specular', 'bilambertian', got {name:?}"
             ),
         )),
     }

@@ -19,6 +19,8 @@
 //! every path is keyed by `(seed, path index)`, and sums are formed per fixed
 //! block of paths then added in order, so results are bit-identical for any
 //! number of threads.
+pub mod bilambertian;
+pub mod canopy;
 pub mod hapke;
 pub mod heightfield;
 pub mod instanced;

@@ -16,6 +16,7 @@ Examples
 >>> round(scene.brf(sun=(135.0, 30.0), spp=1000).value, 6)  # a flat plane: rho
 0.3
 """
+from fractalgeo_rs.radiometry._leaf import BiLambertian
 from fractalgeo_rs.radiometry._scene import (
     PAPER_SUN_ZENITHS,
     BrfSweep,
@@ -29,5 +30,5 @@ from fractalgeo_rs.radiometry._scene import (
 )
 from fractalgeo_rs.radiometry._plot import plot_brf_polar, plot_brf_principal_plane, plot_incidence_series
 
-__all__ = ["BrfSweep", "Estimate", "Hapke", "Lambertian", "OrenNayar", "PAPER_SUN_ZENITHS", "Phong", "Scene", "Specular",
-           "plot_brf_polar", "plot_brf_principal_plane", "plot_incidence_series"]
+__all__ = ["BiLambertian", "BrfSweep", "Estimate", "Hapke", "Lambertian", "OrenNayar", "PAPER_SUN_ZENITHS", "Phong", "Scene",
+           "Specular", "plot_brf_polar", "plot_brf_principal_plane", "plot_incidence_series"]

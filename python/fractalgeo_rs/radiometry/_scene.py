@@ -22,6 +22,7 @@ from fractalgeo_rs._validation import (
     check_positive_int,
 )
 from fractalgeo_rs._warn import user_stacklevel
+from fractalgeo_rs.radiometry._leaf import BiLambertian
 
 __all__ = ["BrfSweep", "Estimate", "Hapke", "Lambertian", "OrenNayar", "Phong", "Scene", "Specular"]
 
@@ -330,8 +331,8 @@ class Specular:
         return "specular", [self.eta, self.k]
 
 
-Material = Union[Lambertian, OrenNayar, Phong, Hapke, Specular]
-_MATERIAL_TYPES = (Lambertian, OrenNayar, Phong, Hapke, Specular)
+Material = Union[Lambertian, OrenNayar, Phong, Hapke, Specular, BiLambertian]
+_MATERIAL_TYPES = (Lambertian, OrenNayar, Phong, Hapke, Specular, BiLambertian)
 
 #: Per-facet material choice: an integer array (one index into the material
 #: list per facet) or a function ``f(slope, height)`` of the facets' slopes
@@ -1273,6 +1274,125 @@ class Scene:
         else:
             v, se, n = _core.radiometry_albedo(*self._args(), *args)
         return Estimate(v, se, n)
+
+    def _scene_core(self):
+        """The kept ``_core.RadiometryScene`` (built for a one-material DEM scene)."""
+        if self._core is not None:
+            return self._core
+        return _core.RadiometryScene.from_dem(self.dem, self.cell_size, self.periodic, self.split,
+                                              [self.material._spec()], None)
+
+    def gap_fraction(self, zenith, azimuth: float = 0.0, n: int = 65536, ground: int = 0, seed: int = 0,
+                     n_threads: Optional[int] = None) -> "Estimate":
+        """Gap fraction: the fraction of the sun's rays at ``zenith`` that
+        reach the ground (their first hit is a facet of material ``ground``)
+        through the canopy.
+
+        ``n`` parallel rays start above the highest facet, on lines through
+        uniform points of the tile, and go down along the direction
+        ``(azimuth, zenith)``; in a periodic scene they cross the tile's
+        sides. For one realisation of a random canopy this is its own gap
+        fraction; its expectation over placements of ``N`` independent
+        leaves of area ``a`` in a tile of area ``A`` is ``(1 - a G / (A cos
+        theta))^N`` (``canopy.DiscCanopy.gap_probability``).
+
+        Parameters
+        ----------
+        zenith : float
+            Zenith of the direction, degrees in [0, 90).
+        azimuth : float
+            Azimuth of the direction, degrees clockwise from north.
+        n : int
+            Number of rays.
+        ground : int
+            Index of the ground's material (0: the first; the soil of
+            ``canopy.disc_canopy`` scenes).
+        seed : int
+            Seed; the result is the same for any ``n_threads``.
+        n_threads : int, optional
+            Threads (default all cores).
+
+        Returns
+        -------
+        Estimate
+            ``value`` (fraction in [0, 1]), ``se`` (binomial standard
+            error), ``n``.
+
+        Examples
+        --------
+        >>> from fractalgeo_rs.canopy import disc_canopy
+        >>> s = disc_canopy(lai=1.0, leaf_radius=0.1, extent=2.0, height=(0.2, 1.0), seed=3).scene()
+        >>> e = s.gap_fraction(30.0, n=20000)
+        >>> bool(abs(e.value - 0.56) < 0.05), e.n
+        (True, 20000)
+
+        References
+        ----------
+        J. Ross, *The Radiation Regime and Architecture of Plant Stands*,
+        Junk, The Hague, 1981.
+        """
+        sun = _direction((azimuth, zenith), "zenith")
+        n = check_positive_int(n, "n")
+        if isinstance(ground, bool) or not isinstance(ground, numbers.Integral) or \
+                not 0 <= int(ground) < len(self.materials):
+            raise ValueError(f"ground: expected a material index in [0, {len(self.materials)}), got {ground!r}")
+        v, se, k = self._scene_core().gap_fraction(sun, int(ground), n, _seed(seed), check_n_threads(n_threads))
+        return Estimate(v, se, k)
+
+    def absorption(self, sun, spp: int = 65536, max_depth: int = 1000, seed: int = 0,
+                   n_threads: Optional[int] = None) -> dict:
+        """Where the sun's light goes: the fraction absorbed by each
+        material (fAPAR of leaves and soil in a canopy), reflected (the
+        albedo) and still travelling after ``max_depth`` scattering events.
+
+        Rays from the sun start above the scene; at each hit the path's
+        weight times ``1 - albedo`` of the facet's model is absorbed there,
+        and the path continues with the sampling weight, so for Lambertian
+        and bi-Lambertian facets absorbed + reflected + trapped is 1 on
+        every path.
+
+        Parameters
+        ----------
+        sun : (float, float)
+            Direction towards the sun, ``(azimuth, zenith)`` in degrees.
+        spp : int
+            Number of paths.
+        max_depth : int
+            Scattering events per path.
+        seed : int
+            Seed; the result is the same for any ``n_threads``.
+        n_threads : int, optional
+            Threads (default all cores).
+
+        Returns
+        -------
+        dict
+            ``"absorbed"``: a list of one ``Estimate`` per material (in
+            ``materials`` order), ``"reflected"`` and ``"trapped"``:
+            ``Estimate``.
+
+        Examples
+        --------
+        >>> from fractalgeo_rs.canopy import disc_canopy
+        >>> from fractalgeo_rs.radiometry import BiLambertian, Lambertian
+        >>> c = disc_canopy(lai=2.0, leaf_radius=0.1, extent=2.0, height=(0.2, 1.0), seed=1,
+        ...                 leaf=BiLambertian(0.0, 0.0), soil=Lambertian(0.0))
+        >>> a = c.scene().absorption(sun=(0.0, 0.0), spp=20000)
+        >>> soil, leaves = a["absorbed"]  # black leaves: the soil absorbs the gap fraction
+        >>> round(soil.value + leaves.value, 12), bool(abs(soil.value - 0.37) < 0.04)
+        (1.0, True)
+
+        References
+        ----------
+        B. Pinty et al., "Radiation transfer model intercomparison (RAMI)
+        exercise", *J. Geophys. Res.* 106(D11) (2001) 11937-11956,
+        doi:10.1029/2000JD900493 (absorption, transmission and albedo).
+        """
+        spp = check_positive_int(spp, "spp")
+        absorbed, refl, trapped, n = self._scene_core().absorption(
+            _direction(sun, "sun"), spp, _depth(max_depth), _seed(seed), check_n_threads(n_threads))
+        return {"absorbed": [Estimate(v, se, n) for v, se in absorbed], "reflected": Estimate(refl[0], refl[1], n),
+                "trapped": Estimate(trapped[0], trapped[1], n)}
 
     def render(self, sun, view="nadir", shape: Optional[Tuple[int, int]] = None, spp: int = 16,
                max_depth: int = 10, seed: int = 0, n_threads: Optional[int] = None,
