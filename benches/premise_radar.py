@@ -75,12 +75,12 @@ def main(size, seeds):
 
 
 def real_renders(dem, cell):
-    """SAR renders of a real DEM at its own (row, column) spacing in metres."""
-    out = {"DEM itself": dem, "hillshade 315/45": fg.hillshade(dem, cell_size=(cell[1], cell[0]))}
+    """SAR renders of a real DEM at its own (row, column) spacing ``cell`` in metres."""
+    out = {"DEM itself": dem, "hillshade 315/45": fg.hillshade(dem, cell_size=cell)}
     for look in (90, 0):
         for inc in (35, 60):
             for looks in (None, 1, 4):
-                s = fg.radar.simulate(dem, (cell[1], cell[0]), look_azimuth=look, incidence=inc, looks=looks,
+                s = fg.radar.simulate(dem, cell, look_azimuth=look, incidence=inc, looks=looks,
                                       seed=7, **SURF)
                 tag = "no speckle" if looks is None else f"{looks}-look"
                 frac = (s.layover.mean(), s.shadow.mean())

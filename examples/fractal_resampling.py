@@ -39,7 +39,7 @@ def hurst_lags(z):
 def compare(factor=4, seed=1):
     z, meta = srtm_alps()
     z = z.astype(np.float64)
-    dx, dy = meta["cell_size"]
+    dy, dx = meta["cell_size"]
     coarse = z[::factor, ::factor]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)

@@ -49,8 +49,7 @@ ax.set(xlabel="incidence (degrees)", ylabel="sigma0 (dB)", ylim=(-60, 20), title
 ax.legend(fontsize=8)
 
 dem, info = fg.data.srtm_alps()
-ew, ns = info["cell_size"]
-scene = fg.radar.simulate(dem, (ns, ew), look_azimuth=90, incidence=35, wavelength=0.056, looks=4, seed=1)
+scene = fg.radar.simulate(dem, info["cell_size"], look_azimuth=90, incidence=35, wavelength=0.056, looks=4, seed=1)
 db = fg.radar.to_db(np.maximum(scene.image, 1e-6))
 ax1.imshow(db, cmap="gray", vmin=-25, vmax=5)
 overlay = np.zeros(dem.shape + (4,))

@@ -28,7 +28,7 @@ def test_geographic_cell_size_on_the_ellipsoid(loader):
     z, info = loader()
     a, _, _, _, e, f = info["transform"]
     lat = f + e * z.shape[0] / 2
-    dx, dy = info["cell_size"]
+    dy, dx = info["cell_size"]
     ex, ey = _closed_form(a, e, lat)
     assert isinstance(dx, float) and isinstance(dy, float)
     np.testing.assert_allclose([dx, dy], [ex, ey], rtol=2e-6)
@@ -44,4 +44,4 @@ def test_cli_reads_the_same_cell_size(tmp_path):
     fg.write_raster(tmp_path / "alps.tif", dem, crs=info["crs"], transform=Affine(*info["transform"]))
     _, prof = fg.read_raster(tmp_path / "alps.tif")
     dy, dx = ground_cell_size(prof, dem.shape[0])
-    np.testing.assert_allclose(info["cell_size"], (dx, dy), rtol=1e-12)
+    np.testing.assert_allclose(info["cell_size"], (dy, dx), rtol=1e-12)

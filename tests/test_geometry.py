@@ -116,7 +116,7 @@ def test_bundled_geographic_dem_is_refused_and_meshes_on_a_metric_grid():
         tin_from_dem(dem, max_error=5.0, grid=g)
     with pytest.raises(ValueError, match="^grid:.*geographic"):
         Mesh.from_grid(dem, grid=g)
-    dx, dy = (float(v) for v in info["cell_size"])  # metres east-west, north-south
+    dy, dx = (float(v) for v in info["cell_size"])  # metres north-south, east-west
     local = GeoGrid((0.0, dem.shape[0] * dy), (dx, dy))
     t = tin_from_dem(dem, max_error=5.0, grid=local)
     col, row = t.grid[:, 0], t.grid[:, 1]

@@ -27,7 +27,7 @@ import pytest
 PKG = Path(__file__).resolve().parents[1] / "python" / "fractalgeo_rs"
 
 FOUNDATION = {"_core", "_warn", "_compat"}
-SERVICES = {"_validation", "_progress", "_backend", "_scales", "_zscale", "fit", "io", "plotting", "data",
+SERVICES = {"_validation", "_progress", "_backend", "_geodesy", "_scales", "_zscale", "fit", "io", "plotting", "data",
             "_cli_common"}
 GEOMETRY = {"geometry"}
 DOMAINS = {"dimension", "synth", "transform", "dem", "lsystem", "tin", "radar", "radiometry", "canopy"}

@@ -154,7 +154,7 @@ def test_bundled_real_dem():
     """SRTM Maritime Alps (66 x 92 m cells): a finite image everywhere, and
     layover shrinking as the incidence grows (slopes steeper than theta)."""
     dem, info = fg.data.srtm_alps()
-    ew, ns = info["cell_size"]
+    ns, ew = info["cell_size"]
     lay = []
     for inc in (25, 35, 45):
         s = fg.radar.simulate(dem, (ns, ew), look_azimuth=90, incidence=inc, looks=4, seed=1, **SURF)

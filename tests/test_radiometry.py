@@ -84,7 +84,7 @@ def test_nadir_single_scattering_is_the_facet_mean_of_nz():
     assert rho * num / den < 0.97 * rho
     # rectangular cells (a geographic DEM's metres east-west and north-south)
     num, den = facet_sums(z, cell=1.5, cell_y=3.0)
-    s = Scene.from_dem(z, cell_size=(1.5, 3.0), material=Lambertian(rho))
+    s = Scene.from_dem(z, cell_size=(3.0, 1.5), material=Lambertian(rho))  # (dy, dx)
     e = s.brf(sun=(0, 0), view=(0, 0), spp=200_000, max_depth=1, seed=1)
     assert close(e, rho * num / den), (e, rho * num / den)
 

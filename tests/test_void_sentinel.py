@@ -53,6 +53,13 @@ def test_simulate_warns():
                        rms_height=0.01, correlation_length=0.1, permittivity=5 + 0.5j)
 
 
+def test_radiometry_scene_warns():
+    from fractalgeo_rs.radiometry import Scene
+
+    with pytest.warns(RuntimeWarning, match=r"dem: 2 cell\(s\) hold a void value.*fill them"):
+        Scene.from_dem(_dem(), cell_size=30.0, periodic=False)
+
+
 def test_deep_bathymetry_is_not_a_void():
     z = _dem(void=-10994.0)  # Challenger Deep, a real height
     with warnings.catch_warnings():

@@ -4,7 +4,11 @@ this file for provenance and licences).
 Each loader returns ``(array, info)`` where ``info`` is a dict with
 ``description``, ``attribution``, ``crs``, ``transform`` (affine
 coefficients ``(a, b, c, d, e, f)`` in ``rasterio.Affine`` order) and, where it applies, ``cell_size`` in metres and
-``nodata``.
+``nodata``. ``cell_size`` is ``(dy, dx)``, row spacing (north-south) then column
+spacing (east-west), numpy's axis order as every ``cell_size`` pair of the
+package takes it: pass it on as is (``hillshade``, ``fractal_resample``,
+``radar.simulate``, ``radiometry.Scene.from_dem``). rasterio's ``res`` is
+``(x, y)``: reverse it.
 """
 from __future__ import annotations
 
@@ -24,14 +28,15 @@ def _load(name: str):
 
 
 def _ground_cell(a: float, e: float, lat: float) -> Tuple[float, float]:
-    """``(x, y)`` metres of a cell of ``a`` x ``e`` degrees at latitude ``lat``
+    """``(dy, dx)`` metres (row spacing north-south, column spacing
+    east-west) of a cell of ``a`` x ``e`` degrees at latitude ``lat``
     on the WGS84 ellipsoid, as the CLI and ``hillshade`` convert geographic
     grids (a degree of latitude is 111.1 km at 44 N, not the equator's
     110.57 km)."""
-    from fractalgeo_rs.dem import metres_per_degree
+    from fractalgeo_rs._geodesy import metres_per_degree
 
     m_lat, m_lon = metres_per_degree(lat)
-    return (float(abs(a) * m_lon), float(abs(e) * m_lat))
+    return (float(abs(e) * m_lat), float(abs(a) * m_lon))
 
 
 def _srtm(key: str, description: str) -> Tuple[np.ndarray, Dict[str, Any]]:
@@ -46,7 +51,7 @@ def _srtm(key: str, description: str) -> Tuple[np.ndarray, Dict[str, Any]]:
         "attribution": _SRTM,
         "crs": "EPSG:4326",
         "transform": transform,
-        "cell_size": cell,  # (x, y) metres, from latitude
+        "cell_size": cell,  # (dy, dx) metres, from latitude
         "nodata": -32768,
         "units": "m",
     }
@@ -62,7 +67,7 @@ def srtm_alps() -> Tuple[np.ndarray, Dict[str, Any]]:
     info : dict
         ``description``, ``attribution``, ``crs`` (EPSG:4326), ``transform``
         (the crop's affine transform, rasterio order), ``cell_size`` (metres,
-        east-west and north-south), ``nodata`` and ``units``.
+        ``(dy, dx)``: north-south then east-west), ``nodata`` and ``units``.
 
     References
     ----------
@@ -92,7 +97,7 @@ def srtm_po_plain() -> Tuple[np.ndarray, Dict[str, Any]]:
     info : dict
         ``description``, ``attribution``, ``crs`` (EPSG:4326), ``transform``
         (the crop's affine transform, rasterio order), ``cell_size`` (metres,
-        east-west and north-south), ``nodata`` and ``units``.
+        ``(dy, dx)``: north-south then east-west), ``nodata`` and ``units``.
 
     References
     ----------
@@ -161,7 +166,7 @@ def _sentinel1(key: str, pol: str) -> Tuple[np.ndarray, Dict[str, Any]]:
         "attribution": "Contains modified Copernicus Sentinel data 2019 (Sen1Floods11 sample)",
         "crs": "EPSG:4326",
         "transform": _S1_TRANSFORM,
-        "cell_size": cell,  # (x, y) metres, from latitude (the grid is in degrees)
+        "cell_size": cell,  # (dy, dx) metres, from latitude (the grid is in degrees)
         "units": "dB",
     }
 
@@ -177,7 +182,7 @@ def sentinel1_vv_db() -> Tuple[np.ndarray, Dict[str, Any]]:
     info : dict
         ``description``, ``attribution`` ("Contains modified Copernicus
         Sentinel data 2019"), ``crs`` (EPSG:4326), ``transform``, ``cell_size``
-        (metres) and ``units``.
+        (metres, ``(dy, dx)``) and ``units``.
 
     References
     ----------
@@ -205,7 +210,7 @@ def sentinel1_vh_db() -> Tuple[np.ndarray, Dict[str, Any]]:
     info : dict
         ``description``, ``attribution`` ("Contains modified Copernicus
         Sentinel data 2019"), ``crs`` (EPSG:4326), ``transform``, ``cell_size``
-        (metres) and ``units``.
+        (metres, ``(dy, dx)``) and ``units``.
 
     References
     ----------

@@ -413,21 +413,6 @@ def detail_levels(levels, cell, min_scale):
     return [c / 2 ** (lvl + 1) >= ms for lvl in range(levels)]
 
 
-_GEO_NAMES = ("lat", "lon", "latitude", "longitude")
-
-
-def is_geographic_xarray(da):
-    """Whether a DataArray's coords look like degrees (names or units)."""
-    for dim in da.dims[-2:]:
-        if str(dim).lower() in _GEO_NAMES:
-            return True
-        if dim in da.coords:
-            units = str(da[dim].attrs.get("units", "")).lower()
-            if "degree" in units:
-                return True
-    return False
-
-
 def _check_memory(shape, f):
     """The package's memory policy (``check_memory``: MemoryLimitError naming
     ``factor``): the output and the last level's input, in float64."""

@@ -9,6 +9,7 @@ import numbers
 
 from fractalgeo_rs._backend import array_kind
 from fractalgeo_rs._compat import renamed_parameters
+from fractalgeo_rs._geodesy import is_geographic_xarray
 from fractalgeo_rs._validation import (
     check_choice,
     check_n_threads,
@@ -22,7 +23,6 @@ from fractalgeo_rs.dem._resample import (
     check_model,
     detail_levels,
     fine_coords,
-    is_geographic_xarray,
     levels_of,
     run_numpy,
 )

@@ -92,7 +92,7 @@ class SARScene:
 def _cell_pair(cell_size, dem):
     if cell_size is None:
         if array_kind(dem) == "xarray":
-            from fractalgeo_rs.dem._resample import is_geographic_xarray
+            from fractalgeo_rs._geodesy import is_geographic_xarray
 
             if is_geographic_xarray(dem):
                 raise ValueError("cell_size: the DataArray's coordinates are in degrees; pass cell_size in "

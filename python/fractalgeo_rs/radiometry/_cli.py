@@ -110,9 +110,9 @@ def _scene(args: argparse.Namespace):
         nodata = prof.get("nodata")
         if nodata is not None and np.any(z == nodata):
             raise ValueError(f"dem: {int(np.sum(z == nodata))} nodata cell(s); fill them first "
-                             "(e.g. fractalgeo_rs.dem.fill_nodata)")
+                             "(e.g. rasterio.fill.fillnodata)")
         ground = ground_cell_size(prof, z.shape[0])
-        cell = None if ground is None else (ground[1], ground[0])
+        cell = ground
     if args.cell_size is not None:
         cell = args.cell_size
     if cell is None:

@@ -20,6 +20,7 @@ from fractalgeo_rs._validation import (
     check_n_threads,
     check_positive_float,
     check_positive_int,
+    warn_void_sentinel,
 )
 from fractalgeo_rs._warn import user_stacklevel
 from fractalgeo_rs.radiometry._leaf import BiLambertian
@@ -400,7 +401,7 @@ def _dem_facets(z: np.ndarray, cell_size: Tuple[float, float], periodic: bool,
     else:
         tris = ((nw, ne, se), (nw, se, sw))
         grads = ((ne - nw, se - ne), (se - sw, sw - nw))
-    dx, dy = cell_size
+    dy, dx = cell_size
     slope = np.stack([np.degrees(np.arctan(np.hypot(b / dx, c / dy))) for b, c in grads], axis=-1)
     height = np.stack([(a + b + c) / 3.0 for a, b, c in tris], axis=-1)
     return slope, height
@@ -592,10 +593,10 @@ def _cell_size(value) -> Tuple[float, float]:
         v = check_positive_float(value, "cell_size")
         return (v, v)
     try:
-        dx, dy = value
+        dy, dx = value
     except (TypeError, ValueError):
-        raise TypeError(f"cell_size: expected a number or (dx, dy), got {value!r}") from None
-    return (check_positive_float(dx, "cell_size"), check_positive_float(dy, "cell_size"))
+        raise TypeError(f"cell_size: expected a number or (row spacing, column spacing), got {value!r}") from None
+    return (check_positive_float(dy, "cell_size"), check_positive_float(dx, "cell_size"))
 
 
 def _edge_mismatch(z: np.ndarray) -> Optional[str]:
@@ -634,8 +635,9 @@ class Scene:
         The heights (float64, read-only copy), metres; row 0 is north,
         columns go east.
     cell_size : tuple of float
-        ``(dx, dy)``: cell size east-west and north-south, in the unit of
-        the heights.
+        ``(dy, dx)``: row spacing (north-south) and column spacing
+        (east-west), in the unit of the heights; numpy's axis order, as
+        every ``cell_size`` pair of the package.
     periodic : bool
         Whether the DEM is one tile of an infinite periodic surface.
     material : Lambertian, OrenNayar, Phong, Hapke or Specular
@@ -730,9 +732,10 @@ class Scene:
         dem : array_like, shape (rows, cols)
             Heights in the same unit as ``cell_size``; NaN is an error.
         cell_size : float or (float, float)
-            Cell side, or ``(dx, dy)`` east-west and north-south (> 0), in
-            the unit of the heights (e.g. the ``info["cell_size"]`` of the
-            bundled geographic DEMs, in metres).
+            Cell side, or ``(dy, dx)``: row spacing (north-south) and column
+            spacing (east-west), > 0, in the unit of the heights (numpy's axis
+            order, as every ``cell_size`` pair of the package, e.g. the
+            ``info["cell_size"]`` of the bundled geographic DEMs, in metres).
         periodic : bool
             True: the DEM is one period of an infinite surface, ``rows x
             cols`` cells, the sample after the last column (row) being the
@@ -790,6 +793,7 @@ class Scene:
         if z.dtype.kind not in "iuf":
             raise TypeError(f"dem: expected real heights, got dtype {z.dtype}")
         z = np.array(z, dtype=np.float64, copy=True)
+        warn_void_sentinel(z, "dem", hint="fill them first (e.g. rasterio.fill.fillnodata)")
         bad = ~np.isfinite(z)
         if bad.any():
             r, c = np.argwhere(bad)[0]
@@ -836,7 +840,7 @@ class Scene:
                             (cells[0], cells[1], 2))
         if ids is not None:
             ids.setflags(write=False)
-        core = _core.RadiometryScene.from_dem(z, cell_size, periodic, split, [m._spec() for m in materials], ids)
+        core = _core.RadiometryScene.from_dem(z, (cell_size[1], cell_size[0]), periodic, split, [m._spec() for m in materials], ids)
         return cls(z, cell_size, periodic, material, split, profile=profile, materials=materials,
                    material_ids=ids, core=core)
 
@@ -1110,7 +1114,8 @@ class Scene:
         name, params = self.material._spec()
         if self.cell_size is None:
             raise TypeError("a mesh scene has no cell size")
-        return (self._dem(), self.cell_size, self.periodic, self.split, name, params)
+        dy, dx = self.cell_size
+        return (self._dem(), (dx, dy), self.periodic, self.split, name, params)
 
     def brf(self, sun, view="nadir", spp: int = 65536, max_depth: int = 10, seed: int = 0,
             n_threads: Optional[int] = None, sky: float = 0.0) -> Estimate:
@@ -1279,7 +1284,8 @@ class Scene:
         """The kept ``_core.RadiometryScene`` (built for a one-material DEM scene)."""
         if self._core is not None:
             return self._core
-        return _core.RadiometryScene.from_dem(self.dem, self.cell_size, self.periodic, self.split,
+        dy, dx = self.cell_size
+        return _core.RadiometryScene.from_dem(self.dem, (dx, dy), self.periodic, self.split,
                                               [self.material._spec()], None)
 
     def gap_fraction(self, zenith, azimuth: float = 0.0, n: int = 65536, ground: int = 0, seed: int = 0,
@@ -1570,7 +1576,7 @@ class Scene:
             centre = (x0 + 0.5 * w, y0 + 0.5 * h, zc)
         else:
             dem = self._dem()
-            dx, dy = self.cell_size if self.cell_size is not None else (1.0, 1.0)
+            dy, dx = self.cell_size if self.cell_size is not None else (1.0, 1.0)
             cells = dem.shape if self.periodic else (dem.shape[0] - 1, dem.shape[1] - 1)
             w, h = cells[1] * dx, cells[0] * dy
             centre = (0.5 * w, -0.5 * h, float(dem.mean()))
