@@ -49,8 +49,10 @@ def test_plant_mesh_invariants():
     n_seg = s.count("F")
     n_leaf = s.count("{")
     assert (m.kinds == 0).sum() == 2 * 5 * n_seg
-    # each leaf {-f+f+f-|-f+f+f} has 1 + 6 move vertices -> 5 triangles
-    assert (m.kinds == 1).sum() == 5 * n_leaf
+    # each leaf {-f+f+f-|-f+f+f} has 1 + 6 move vertices, the last back at
+    # the first (dropped: it only closed the fan with a zero-area triangle)
+    # -> 6 vertices, 4 triangles
+    assert (m.kinds == 1).sum() == 4 * n_leaf
     assert m.faces.max() < len(m.vertices)
     assert np.allclose(np.linalg.norm(m.normals, axis=1), 1.0, atol=1e-5)
     assert m.uvs[:, 0].min() >= 0 and m.uvs[:, 0].max() <= 1
@@ -149,3 +151,42 @@ def test_cli_writes_obj_png_and_svg(tmp_path, capsys):
     args = parser.parse_args(["lsystem", str(rules), "--out", str(tmp_path / "b.txt")])
     with pytest.raises(ValueError, match="--out"):
         args.func(args)
+
+
+def _areas(m):
+    v = m.vertices.astype(np.float64)
+    f = m.faces.astype(np.int64)
+    return 0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1)
+
+
+# (axiom, rules, n, angle): ABOP figures 1.24a, c, f (branching) and 1.25 (bush with leaves)
+PLANTS = [
+    ("F", {"F": "F[+F]F[-F]F"}, 4, 25.7),
+    ("F", {"F": "FF-[-F+F+F]+[+F-F-F]"}, 3, 22.5),
+    ("X", {"X": "F-[[X]+X]+F[+FX]-X", "F": "FF"}, 4, 22.5),
+    ("A", BUSH, 5, 22.5),
+    ("A", BUSH, 7, 22.5),
+    # leaves with repeated and collinear corners
+    ("F", {"F": "F[+F{.f..+f.+f.}][-F{.f.f.+f.+ff.}]"}, 3, 90.0),
+]
+
+
+@pytest.mark.parametrize("axiom,rules,n,angle", PLANTS)
+def test_plant_mesh_has_no_zero_area_triangle(axiom, rules, n, angle):
+    from fractalgeo_rs.geometry import Mesh as GeoMesh
+
+    s = LSystem(axiom, rules).derive(n)
+    m = plant_mesh(s, angle=angle)
+    area = _areas(m)
+    assert len(m) > 0 and area.min() > 0.0
+    assert m.faces.max() < len(m.vertices)
+    g = GeoMesh.from_triangles(m.vertices, m.faces)  # refuses zero-area triangles
+    assert len(g) == len(m)
+    # no leaf area was lost: the leaves' area equals that of the turtle's
+    # polygons (Newell's vector area, computed here in float64)
+    polys = turtle_3d(s, angle=angle).polygons
+    want = 0.0
+    for p in polys:
+        p = np.asarray(p, dtype=np.float64)
+        want += 0.5 * np.linalg.norm(np.cross(p, np.roll(p, -1, axis=0)).sum(axis=0))
+    assert np.isclose(area[m.kinds == 1].sum(), want, rtol=1e-5, atol=1e-9)

@@ -36,7 +36,7 @@ CRS_HELP = ("CRS of an input without one, e.g. EPSG:32633, recorded in the outpu
             "CRS, none for .npy/.png/.exr)")
 #: Help of ``--progress`` / ``--no-progress``.
 PROGRESS_HELP = ("progress bar on stderr (None: on when stderr is a terminal; needs tqdm, "
-                 "pip install \"fractalgeo_rs[progress]\", except with --chunks)")
+                 "pip install \"fractalgeo_rs[progress]\", except for the Dask bar of transform --chunks)")
 #: Help of ``--n-threads``.
 N_THREADS_HELP = "threads of the Rust kernels (None: one per core)"
 

@@ -191,6 +191,31 @@ impl Sink for MeshBuilder {
     }
 
     fn polygon(&mut self, pts: &[DVec3], color: u32) {
+        // Vertices at the previous one, and closing vertices back at the
+        // first (a leaf traced out and back, as in ABOP figure 1.25: the
+        // turtle returns to its start up to rounding), add nothing but
+        // zero-area (or sliver) fan triangles: closer than 1e-6 of the
+        // polygon's size, they are dropped.
+        let size = pts
+            .iter()
+            .map(|p| (*p - pts[0]).length())
+            .fold(0.0, f64::max);
+        let tol = 1e-6 * size;
+        let same = |a: &DVec3, b: &DVec3| (*a - *b).length() <= tol;
+        let mut kept: Vec<DVec3> = Vec::with_capacity(pts.len());
+        for p in pts {
+            if kept.last().is_none_or(|q| !same(q, p)) {
+                kept.push(*p);
+            }
+        }
+        while kept.len() > 1 && same(&kept[kept.len() - 1], &kept[0]) {
+            kept.pop();
+        }
+        let f32_of = |p: &DVec3| p.as_vec3().to_array();
+        if kept.len() < 3 {
+            return; // degenerate leaf: nothing to draw
+        }
+        let pts = &kept[..];
         // Newell's normal
         let mut nrm = DVec3::ZERO;
         for k in 0..pts.len() {
@@ -221,6 +246,19 @@ impl Sink for MeshBuilder {
                 c
             })
             .collect();
+        // fan triangles of zero area in the stored (f32) coordinates
+        // (collinear corners) are left out: meshes must have none
+        let stored = |k: usize| DVec3::from_array(f32_of(&pts[k]).map(|x| x as f64));
+        let fan: Vec<u32> = (1..pts.len() - 1)
+            .filter(|&k| {
+                let (a, b, c) = (stored(0), stored(k), stored(k + 1));
+                (b - a).cross(c - a).length_squared() > 0.0
+            })
+            .map(|k| k as u32)
+            .collect();
+        if fan.is_empty() {
+            return;
+        }
         let first = self.leaves.vertices.len() as u32;
         for (p, c) in pts.iter().zip(&uv) {
             self.leaves.vertices.push(p.as_vec3().to_array());
@@ -236,7 +274,7 @@ impl Sink for MeshBuilder {
         }
         let part = self.n_leaves;
         self.n_leaves += 1;
-        for k in 1..pts.len() as u32 - 1 {
+        for k in fan {
             self.leaves.faces.push([first, first + k, first + k + 1]);
             self.leaves.part_ids.push(part);
             self.leaves.kinds.push(KIND_LEAF);
@@ -372,5 +410,17 @@ mod tests {
             .uvs
             .iter()
             .all(|t| (0.0..=1.0).contains(&t[0]) && (0.0..=1.0).contains(&t[1])));
+    }
+
+    #[test]
+    fn leaves_traced_out_and_back_have_no_zero_area_triangle() {
+        // ABOP figure 1.25's leaf: out along one side, | turns around, back
+        // along the other; the last vertex is the first, and a repeated
+        // vertex (f of length 0 is not possible, but `..` is) adds nothing
+        let s = parse_module_string("{.-f.+f.+f.-|-f.+f.+f.}{.f..+f.+f.}", "axiom").unwrap();
+        let m = build_mesh(&s, &TurtleParams::spatial(22.5, 1.0), 6).unwrap();
+        m.validate().unwrap();
+        assert_eq!(m.faces.len(), 4 + 2);
+        assert_eq!(m.vertices.len(), 6 + 4);
     }
 }

@@ -204,7 +204,7 @@ def plot_brf_polar(scene: Scene, sun, view_zenith: Sequence[float] = tuple(range
 
 
 def plot_incidence_series(scene: Scene, sun_zenith: Sequence[float] = PAPER_SUN_ZENITHS,
-                          sun_azimuth: float = 90.0, view="nadir", shape=None, spp: int = 16,
+                          sun_azimuth: float = 0.0, view="nadir", shape=None, spp: int = 16,
                           max_depth: int = 10, seed: int = 0, n_threads: Optional[int] = None,
                           axes=None, white: Optional[float] = None, **kwargs):
     """Draw the images of the scene for a series of sun zeniths (the
@@ -220,7 +220,8 @@ def plot_incidence_series(scene: Scene, sun_zenith: Sequence[float] = PAPER_SUN_
     sun_zenith : sequence of float
         Sun zeniths, degrees in [0, 90); default 0, 15, ..., 75, 89.
     sun_azimuth : float
-        Sun azimuth, degrees clockwise from north (default east).
+        Sun azimuth, degrees clockwise from north (default 0, north: the
+        default of ``Scene.brf_sweep`` and ``fractalgeo brf``).
     view, shape, spp, max_depth, seed, n_threads
         As in ``Scene.render``.
     axes : sequence of matplotlib.axes.Axes, optional
