@@ -104,7 +104,7 @@ faces = np.vstack([plants.faces, ground.faces + len(plants.vertices)])
 ids = np.concatenate([plants.kinds, np.full(len(ground.faces), 2)]).astype(np.int64)  # 0 branch, 1 leaf, 2 soil
 v = vertices.astype(np.float64)
 area = np.linalg.norm(np.cross(v[faces[:, 1]] - v[faces[:, 0]], v[faces[:, 2]] - v[faces[:, 0]]), axis=1)
-faces, ids = faces[area > 1e-12], ids[area > 1e-12]  # plant_mesh leaves some zero-area triangles
+faces, ids = faces[area > 1e-12], ids[area > 1e-12]  # tubes tapered to zero width have zero-area triangles
 stand = Scene.from_mesh(Mesh.from_triangles(vertices, faces), periodic=False, material_ids=ids,
                         materials=[Lambertian(0.3), BiLambertian(0.45, 0.4), Lambertian(0.2)])
 print(f"{len(bases)} bushes, {len(faces)} triangles")

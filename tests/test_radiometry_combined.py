@@ -59,3 +59,24 @@ def test_two_materials_mix_linearly_under_sky():
     s = Scene.from_dem(z, material=[Lambertian(0.2), Lambertian(0.6)], material_ids=ids)
     e = s.brf(sun=(0.0, 30.0), view=(90.0, 20.0), sky=0.5, spp=16384, max_depth=1)
     assert abs(e.value - 0.4) < 4 * e.se + 1e-9, e
+
+
+def test_instanced_plane_under_sun_and_sky_is_lambertian():
+    # four unit squares, each scaled by 2, tile a 4 x 4 periodic plane: the
+    # instanced scene must give the flat Lambertian plane's closed forms
+    rho, sky = 0.3, 0.2
+    sq = Mesh.from_triangles([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], [[0, 1, 2], [1, 3, 2]])
+    xf = np.zeros((4, 3, 4))
+    xf[:, 0, 0] = xf[:, 1, 1] = 2.0
+    xf[:, 2, 2] = 1.0
+    xf[:, :2, 3] = [[0, 0], [2, 0], [0, 2], [2, 2]]
+    s = Scene.from_instances([sq], [0, 0, 0, 0], xf, extent=(0, 0, 4, 4), materials=Lambertian(rho))
+    sun = (20.0, 40.0)
+    cos_s = np.cos(np.radians(40.0))
+    assert abs(s.brf(sun=sun, view=(250.0, 35.0), sky=sky, spp=3000).value - rho) < 1e-9
+    assert abs(s.bhr(spp=3000).value - rho) < 1e-9
+    want = rho * (cos_s + sky) / np.pi
+    img = s.render(sun=sun, shape=(4, 4), spp=4, sky=sky, psf=np.ones((3, 3)), psf_step=0.5)
+    np.testing.assert_allclose(img, want, rtol=1e-6)
+    pers = s.render_perspective(sun=sun, view=(90.0, 50.0), shape=(3, 4), spp=2, sky=sky)
+    np.testing.assert_allclose(pers, want, rtol=1e-6)
