@@ -994,20 +994,26 @@ mod sobol_tests {
     use super::*;
 
     /// The first 2^10 points of a replicate put one point in each of the
-    /// 32 x 32 cells of dimensions (0, 1) and (2, 3) (a (0, 10, 2)-net),
-    /// and every coordinate lies in (0, 1).
+    /// 32 x 32 cells of dimensions (0, 1) (a (0, 10, 2)-net: the sensor
+    /// points) and in each of the 1024 intervals of every other dimension
+    /// used (each one a (0, 1)-sequence); every coordinate lies in (0, 1).
     #[test]
     fn replicate_prefixes_are_nets() {
         for (seed, scramble) in [(0u64, 0u32), (7, 0x9e37_79b9), (123, 42)] {
-            for dims in [(0, 1), (2, 3)] {
-                let mut cells = vec![0u32; 1024];
-                for i in 0..1024u32 {
-                    let mut p = SobolPath::new(i, scramble, StreamKey::new(seed, i as u64));
-                    let (a, b) = (p.uniform(dims.0), p.uniform(dims.1));
-                    assert!(a > 0.0 && a < 1.0 && b > 0.0 && b < 1.0);
-                    cells[(a * 32.0) as usize * 32 + (b * 32.0) as usize] += 1;
+            let mut cells = vec![0u32; 1024];
+            let mut slots = vec![vec![0u32; 1024]; 22];
+            for i in 0..1024u32 {
+                let mut p = SobolPath::new(i, scramble, StreamKey::new(seed, i as u64));
+                let u: Vec<f64> = (0..22).map(|d| p.uniform(d)).collect();
+                assert!(u.iter().all(|&x| x > 0.0 && x < 1.0));
+                cells[(u[0] * 32.0) as usize * 32 + (u[1] * 32.0) as usize] += 1;
+                for (d, x) in u.iter().enumerate() {
+                    slots[d][(x * 1024.0) as usize] += 1;
                 }
-                assert!(cells.iter().all(|&c| c == 1), "{seed} {dims:?}");
+            }
+            assert!(cells.iter().all(|&c| c == 1), "{seed}");
+            for (d, sl) in slots.iter().enumerate() {
+                assert!(sl.iter().all(|&c| c == 1), "{seed} {d}");
             }
         }
     }
