@@ -16,7 +16,7 @@ Lambertian soil (0.159). Two leaf cases:
   with ``mi.register_bsdf``: ``r / pi`` into the side the light comes from,
   ``t / pi`` through, the side sampled with probability ``r / (r + t)``
   and then a cosine-weighted direction). In ``scalar_rgb`` Mitsuba calls
-  this Python code at every interaction, so the case is about 5 times
+  this Python code at every interaction, so the case is 3-10 times
   slower than ``diffuse``; by default it runs at 5 of the 9 principal-plane
   views (``--all-views`` for all).
 
