@@ -212,14 +212,18 @@ def test_the_kernel_checks_too():
     from fractalgeo_rs import _core
 
     z = np.zeros((3, 3))
+
+    def scene(name="lambertian", params=(0.5,)):
+        return _core.RadiometryScene.from_dem(z, (1.0, 1.0), True, "ne-sw", [(name, list(params))], None)
+
     with pytest.raises(ValueError, match="^sun: zenith"):
-        _core.radiometry_brf(z, (1.0, 1.0), True, "ne-sw", "lambertian", [0.5], (0, 91), (0, 0), 10, 1, 0)
+        scene().brf((0, 91), (0, 0), 10, 1, 0)
     with pytest.raises(ValueError, match="^rho"):
-        _core.radiometry_albedo(z, (1.0, 1.0), True, "ne-sw", "lambertian", [2.0], (0, 0), 10, 1, 0)
+        scene(params=(2.0,))
     with pytest.raises(ValueError, match="^material"):
-        _core.radiometry_albedo(z, (1.0, 1.0), True, "ne-sw", "hapke", [0.5], (0, 0), 10, 1, 0)
+        scene("hapke")
     with pytest.raises(MemoryError, match="^shape"):
-        _core.radiometry_render(z, (1.0, 1.0), True, "ne-sw", "lambertian", [0.5], (0, 0), (0, 0), (10**5, 10**5), 1, 1, 0)
+        scene().render((0, 0), (0, 0), (10**5, 10**5), 1, 1, 0)
 
 
 def test_mismatched_periodic_edges_warn_and_mirroring_fixes_them():
@@ -516,3 +520,17 @@ def test_ray_batches_hit_a_flat_plane_exactly():
         _core.radiometry_intersect(z, (1.0, 1.0), True, "ne-sw", o, d[:3])
     with pytest.raises(ValueError, match="skip"):
         _core.radiometry_occluded(z, (1.0, 1.0), True, "ne-sw", o, d, np.zeros(3, dtype=np.int64))
+
+
+def test_a_dem_scene_keeps_its_kernel_scene_and_rebuilds_it_when_changed():
+    import pickle
+
+    z = np.zeros((4, 4))
+    s = Scene.from_dem(z, material=Lambertian(0.3))
+    assert s.brf(sun=(0.0, 30.0), spp=256).value == pytest.approx(0.3, abs=1e-12)
+    kept = s._scene_core()
+    assert s._scene_core() is kept  # built once, reused by every call
+    s.material = Lambertian(0.7)  # a changed attribute rebuilds it
+    assert s.albedo(sun=(0.0, 30.0), spp=256).value == pytest.approx(0.7, abs=1e-12)
+    s2 = pickle.loads(pickle.dumps(s))  # the kernel scene is not pickled, rebuilt on use
+    assert s2.bhr(spp=256).value == pytest.approx(0.7, abs=1e-12)

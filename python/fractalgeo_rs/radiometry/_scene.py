@@ -690,12 +690,20 @@ class Scene:
         #: ``(x0, y0, width, height)``: a mesh scene's tile or footprint, map coordinates.
         self.extent = extent
         self._core = core
+        # a one-material DEM scene builds its kernel scene on first use and
+        # keeps it (keyed by what it was built from, so changed attributes
+        # rebuild it); other scenes get theirs at construction
+        self._lazy_core = core is None
+        self._core_key: Optional[tuple] = None
         self.split = split
 
     def __getstate__(self) -> dict:
-        # the perspective images' weak references are per process: not pickled
+        # the perspective images' weak references are per process: not pickled;
+        # nor is a lazily built kernel scene (rebuilt on first use)
         state = dict(self.__dict__)
         state["_perspective"] = {}
+        if state.get("_lazy_core", False):
+            state["_core"], state["_core_key"] = None, None
         return state
 
     def __setstate__(self, state: dict) -> None:
@@ -1090,13 +1098,10 @@ class Scene:
 
     def _raw_brf(self, sun, view, sky: float, spp: int, depth: int, seed: int,
                  n_threads) -> Tuple[float, float, int]:
-        if self._core is not None:
-            if sky > 0.0:
-                return self._core.brf_sky(sun, view, sky, spp, depth, seed, n_threads)
-            return self._core.brf(sun, view, spp, depth, seed, n_threads)
+        core = self._scene_core()
         if sky > 0.0:
-            return _core.radiometry_brf_sky(*self._args(), sun, view, sky, spp, depth, seed, n_threads)
-        return _core.radiometry_brf(*self._args(), sun, view, spp, depth, seed, n_threads)
+            return core.brf_sky(sun, view, sky, spp, depth, seed, n_threads)
+        return core.brf(sun, view, spp, depth, seed, n_threads)
 
     def _dem(self) -> np.ndarray:
         if self.dem is None:
@@ -1109,13 +1114,6 @@ class Scene:
         dem = self._dem()
         cells = dem.shape if self.periodic else (dem.shape[0] - 1, dem.shape[1] - 1)
         return (int(cells[0]), int(cells[1]))
-
-    def _args(self) -> Tuple[np.ndarray, Tuple[float, float], bool, str, str, List[float]]:
-        name, params = self.material._spec()
-        if self.cell_size is None:
-            raise TypeError("a mesh scene has no cell size")
-        dy, dx = self.cell_size
-        return (self._dem(), (dx, dy), self.periodic, self.split, name, params)
 
     def brf(self, sun, view="nadir", spp: int = 65536, max_depth: int = 10, seed: int = 0,
             n_threads: Optional[int] = None, sky: float = 0.0) -> Estimate:
@@ -1223,10 +1221,7 @@ class Scene:
         (bi-hemispherical reflectance).
         """
         args = (_spp(spp), _depth(max_depth), _seed(seed), check_n_threads(n_threads))
-        if self._core is not None:
-            v, se, n = self._core.bhr(*args)
-        else:
-            v, se, n = _core.radiometry_bhr(*self._args(), *args)
+        v, se, n = self._scene_core().bhr(*args)
         return Estimate(v, se, n)
 
     def albedo(self, sun, spp: int = 65536, max_depth: int = 100, seed: int = 0,
@@ -1274,19 +1269,26 @@ class Scene:
         """
         args = (_direction(sun, "sun"), _spp(spp), _depth(max_depth), _seed(seed),
                 check_n_threads(n_threads))
-        if self._core is not None:
-            v, se, n = self._core.albedo(*args)
-        else:
-            v, se, n = _core.radiometry_albedo(*self._args(), *args)
+        v, se, n = self._scene_core().albedo(*args)
         return Estimate(v, se, n)
 
     def _scene_core(self):
-        """The kept ``_core.RadiometryScene`` (built for a one-material DEM scene)."""
-        if self._core is not None:
+        """The kernel scene (``_core.RadiometryScene``): a one-material DEM
+        scene builds it on first use and keeps it, rebuilt when ``dem``,
+        ``cell_size``, ``periodic``, ``split`` or ``material`` change."""
+        if not self._lazy_core:
             return self._core
-        dy, dx = self.cell_size
-        return _core.RadiometryScene.from_dem(self.dem, (dx, dy), self.periodic, self.split,
-                                              [self.material._spec()], None)
+        dem, cell_size = self._dem(), self.cell_size
+        if cell_size is None:
+            raise TypeError("a mesh scene has no cell size")
+        name, params = self.material._spec()
+        key = (id(dem), dem.shape, tuple(cell_size), bool(self.periodic), self.split, name, tuple(params))
+        if self._core is None or self._core_key != key:
+            dy, dx = cell_size
+            self._core = _core.RadiometryScene.from_dem(dem, (dx, dy), self.periodic, self.split,
+                                                        [(name, list(params))], None)
+            self._core_key = key
+        return self._core
 
     def gap_fraction(self, zenith, azimuth: float = 0.0, n: int = 65536, ground: int = 0, seed: int = 0,
                      n_threads: Optional[int] = None) -> "Estimate":
@@ -1489,19 +1491,13 @@ class Scene:
         sd = (_direction(sun, "sun"), _direction(view, "view"))
         rest = (check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed))
         nt = check_n_threads(n_threads)
-        core = self._core
+        core = self._scene_core()
         with _progress.Steps(rows, "render", _progress.resolve(progress)) as steps:
-            if core is not None:
-                if sky == 0.0 and kind == "box":
-                    return steps.counted(lambda counter: core.render(
-                        *sd, (rows, cols), *rest, nt, progress=counter), rows)
-                return steps.counted(lambda counter: core.render_psf(
-                    *sd, sky, (rows, cols), *rest, kind, pparams, table, nt, progress=counter), rows)
             if sky == 0.0 and kind == "box":
-                return steps.counted(lambda counter: _core.radiometry_render(
-                    *self._args(), *sd, (rows, cols), *rest, nt, progress=counter), rows)
-            return steps.counted(lambda counter: _core.radiometry_render_psf(
-                *self._args(), *sd, sky, (rows, cols), *rest, kind, pparams, table, nt, progress=counter), rows)
+                return steps.counted(lambda counter: core.render(
+                    *sd, (rows, cols), *rest, nt, progress=counter), rows)
+            return steps.counted(lambda counter: core.render_psf(
+                *sd, sky, (rows, cols), *rest, kind, pparams, table, nt, progress=counter), rows)
 
     def render_perspective(self, sun, view=(135.0, 60.0), distance: Optional[float] = None, eye=None,
                            target=None, fov: float = 40.0, shape: Tuple[int, int] = (240, 320), spp: int = 16,
@@ -1595,13 +1591,9 @@ class Scene:
 
         args = (_direction(sun, "sun"), _sky(sky), e, tgt, float(fov), (rows, cols),
                 check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed), check_n_threads(n_threads))
-        core = self._core
+        core = self._scene_core()
         with _progress.Steps(rows, "render", _progress.resolve(progress)) as steps:
-            if core is not None:
-                img = steps.counted(lambda counter: core.render_perspective(*args, progress=counter), rows)
-            else:
-                img = steps.counted(lambda counter: _core.radiometry_render_perspective(
-                    *self._args(), *args, progress=counter), rows)
+            img = steps.counted(lambda counter: core.render_perspective(*args, progress=counter), rows)
         key = id(img)
         self._perspective[key] = weakref.ref(img, lambda _r, k=key, d=self._perspective: d.pop(k, None))
         return img
