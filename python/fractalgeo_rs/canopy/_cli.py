@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads, add_progress
+from fractalgeo_rs._cli_common import HelpFormatter, add_band, add_cell_size, add_n_threads, add_progress
 
 LAD_HELP = ("leaf angle distribution: planophile, erectophile, plagiophile, extremophile, uniform, spherical, "
             "or one inclination in degrees")
@@ -51,9 +51,8 @@ def add_parsers(sub) -> None:
                    help="plant mode: the DEM raster (GeoTIFF or any format read_raster reads), heights in metres; "
                    "the cell size from its transform, in metres (a geographic grid is converted at its middle "
                    "latitude)")
-    p.add_argument("--band", type=int, default=None, help="plant mode: band of the DEM (None: its only band)")
-    p.add_argument("--cell-size", type=float, default=None,
-                   help="plant mode: cell size in metres, replacing the DEM's (required without georeferencing)")
+    add_band(p)  # plant mode: the DEM's band
+    add_cell_size(p, crs=False)  # plant mode: metres, replacing the DEM's (required without georeferencing)
     p.add_argument("--plant-scale", type=float, default=None,
                    help="plant mode: metres per turtle step (None: the preset's, 0.2 bush, 0.08 herb)")
     p.add_argument("--leaf", default="0.4957,0.4409", metavar="R,T",
