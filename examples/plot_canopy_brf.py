@@ -7,8 +7,8 @@ independently placed disc leaves of radius 5 cm with spherical leaf angles
 between 0.1 and 2 m, over a Lambertian soil, in a periodic 2 m tile, with
 RAMI's near-infrared leaf (reflectance 0.4957, transmittance 0.4409) and
 soil (0.159) (Pinty et al. 2001). Left: the nadir BRF (sun at 30 degrees)
-against the leaf area index, all orders and single scattering
-(``max_depth=1``). Middle: the BRF in the principal plane at LAI 3 for
+against the leaf area index, all orders, single and multiple scattering
+from the same paths (``Scene.brf_orders``). Middle: the BRF in the principal plane at LAI 3 for
 the sun at 30 and 50 degrees, with the hot spot where the view is along
 the sun. Right: the
 traced gap fraction against the exact ``(1 - a G / (A cos theta))^N`` of
@@ -50,8 +50,11 @@ fig, axes = plt.subplots(1, 3, figsize=(13, 4), constrained_layout=True)
 # BRF at nadir against LAI
 lais = [0.25, 0.5, 1.0, 2.0, 3.0, 5.0]
 scenes = {lai: make(lai).scene() for lai in lais}
-for depth, label in ((30, "all orders"), (1, "single scattering")):
-    est = [scenes[lai].brf(sun=sun, spp=10000, max_depth=depth, seed=3) for lai in lais]
+# one pass of paths gives both: the single-scattering part of each path is its
+# first sun estimate (equal to a separate max_depth=1 run with the same seed)
+orders = [scenes[lai].brf_orders(sun=sun, spp=10000, max_depth=30, seed=3) for lai in lais]
+for part, label in (("total", "all orders"), ("single", "single scattering"), ("multiple", "multiple scattering")):
+    est = [getattr(o, part) for o in orders]
     axes[0].errorbar(lais, [e.value for e in est], yerr=[2 * e.se for e in est], marker="o",
                      capsize=2, label=label)
     print(label, ", nadir BRF:", ", ".join(f"LAI {lai} {e.value:.3f}" for lai, e in zip(lais, est)))

@@ -659,6 +659,16 @@ class RadiometryScene:
         seed: int,
         n_threads: Optional[int] = None,
     ) -> Tuple[float, float, int]: ...
+    def brf_orders(
+        self,
+        sun: Tuple[float, float],
+        view: Tuple[float, float],
+        sky: float,
+        spp: int,
+        max_depth: int,
+        seed: int,
+        n_threads: Optional[int] = None,
+    ) -> Tuple[Tuple[float, float], Tuple[float, float], Tuple[float, float], int]: ...
     def bhr(
         self, spp: int, max_depth: int, seed: int, n_threads: Optional[int] = None
     ) -> Tuple[float, float, int]: ...

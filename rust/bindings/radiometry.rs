@@ -252,6 +252,9 @@ fn scene_with<G: crate::radiometry::Tracer>(
 /// `(absorbed per material, reflected, trapped, n)`, each a `(value, se)`.
 type AbsorptionOut = (Vec<(f64, f64)>, (f64, f64), (f64, f64), u64);
 
+/// `(single, multiple, total, n)` of [`RadiometryScene::brf_orders`], each a `(value, se)`.
+type OrdersOut = ((f64, f64), (f64, f64), (f64, f64), u64);
+
 /// `(areas, normals)` of [`RadiometryScene::facets`].
 type FacetArrays<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>);
 
@@ -514,6 +517,30 @@ impl RadiometryScene {
             with_scene!(&self.kind, s => s.brf_sky(sun, view, sky, spp, max_depth, seed))
         })?;
         Ok((e.value, e.se, e.n))
+    }
+
+    /// `((value, se), (value, se), (value, se), n)`: the reflectance factor
+    /// of [`RadiometryScene::brf_sky`] split into single and multiple
+    /// scattering, and the total, over the same paths.
+    #[pyo3(signature = (sun, view, sky, spp, max_depth, seed, n_threads=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn brf_orders(
+        &self,
+        py: Python<'_>,
+        sun: (f64, f64),
+        view: (f64, f64),
+        sky: f64,
+        spp: u64,
+        max_depth: u32,
+        seed: u64,
+        n_threads: Option<usize>,
+    ) -> PyResult<OrdersOut> {
+        let o = run(py, n_threads, || {
+            let (sun, view) = (direction(sun, "sun")?, direction(view, "view")?);
+            with_scene!(&self.kind, s => s.brf_orders(sun, view, sky, spp, max_depth, seed))
+        })?;
+        let pair = |e: crate::radiometry::Estimate| (e.value, e.se);
+        Ok((pair(o.single), pair(o.multiple), pair(o.total), o.total.n))
     }
 
     /// `(value, se, n)` of the bi-hemispherical reflectance (white-sky albedo).
