@@ -7,8 +7,8 @@ independently placed disc leaves of radius 5 cm with spherical leaf angles
 between 0.1 and 2 m, over a Lambertian soil, in a periodic 2 m tile, with
 RAMI's near-infrared leaf (reflectance 0.4957, transmittance 0.4409) and
 soil (0.159) (Pinty et al. 2001). Left: the nadir BRF (sun at 30 degrees)
-against the leaf area index, all orders and single scattering
-(``max_depth=1``). Middle: the BRF in the principal plane at LAI 3 for
+against the leaf area index, all orders, single and multiple scattering
+from the same paths (``Scene.brf_orders``). Middle: the BRF in the principal plane at LAI 3 for
 the sun at 30 and 50 degrees, with the hot spot where the view is along
 the sun. Right: the
 traced gap fraction against the exact ``(1 - a G / (A cos theta))^N`` of
@@ -23,7 +23,8 @@ derived 4 steps, each plant with its own seed) placed by
 (H = 0.8, 0.5 m cells), branches Lambertian 0.3, leaves
 ``BiLambertian(0.45, 0.4)``, soil 0.2, one mesh scene (not periodic: the
 dark rim is where plants overhang the DEM), rendered at nadir with the sun
-in the south-east at 20 and 60 degrees zenith.
+in the south-east at the paper's incidence series (sun zenith 0, 15, ...,
+75 and 89 degrees), every image on one grey scale.
 
 Data: generated, no licence needed.
 """
@@ -33,7 +34,7 @@ import numpy as np
 from fractalgeo_rs import canopy
 from fractalgeo_rs.geometry import Mesh
 from fractalgeo_rs.lsystem import LSystem, plants_on_terrain
-from fractalgeo_rs.radiometry import BiLambertian, Lambertian, Scene
+from fractalgeo_rs.radiometry import BiLambertian, Lambertian, Scene, plot_incidence_series
 from fractalgeo_rs.synth import fbm_surface
 
 leaf, soil = BiLambertian(0.4957, 0.4409), Lambertian(0.159)
@@ -50,8 +51,11 @@ fig, axes = plt.subplots(1, 3, figsize=(13, 4), constrained_layout=True)
 # BRF at nadir against LAI
 lais = [0.25, 0.5, 1.0, 2.0, 3.0, 5.0]
 scenes = {lai: make(lai).scene() for lai in lais}
-for depth, label in ((30, "all orders"), (1, "single scattering")):
-    est = [scenes[lai].brf(sun=sun, spp=10000, max_depth=depth, seed=3) for lai in lais]
+# one pass of paths gives both: the single-scattering part of each path is its
+# first sun estimate (equal to a separate max_depth=1 run with the same seed)
+orders = [scenes[lai].brf_orders(sun=sun, spp=10000, max_depth=30, seed=3) for lai in lais]
+for part, label in (("total", "all orders"), ("single", "single scattering"), ("multiple", "multiple scattering")):
+    est = [getattr(o, part) for o in orders]
     axes[0].errorbar(lais, [e.value for e in est], yerr=[2 * e.se for e in est], marker="o",
                      capsize=2, label=label)
     print(label, ", nadir BRF:", ", ".join(f"LAI {lai} {e.value:.3f}" for lai, e in zip(lais, est)))
@@ -108,10 +112,6 @@ faces, ids = faces[area > 1e-12], ids[area > 1e-12]  # tubes tapered to zero wid
 stand = Scene.from_mesh(Mesh.from_triangles(vertices, faces), periodic=False, material_ids=ids,
                         materials=[Lambertian(0.3), BiLambertian(0.45, 0.4), Lambertian(0.2)])
 print(f"{len(bases)} bushes, {len(faces)} triangles")
-fig, axes = plt.subplots(1, 2, figsize=(10, 5), constrained_layout=True)
-for ax, sz in zip(axes, (20.0, 60.0)):
-    img = stand.render(sun=(135.0, sz), shape=(200, 200), spp=4, max_depth=5, seed=6)
-    ax.imshow(img, cmap="gray", vmin=0.0, vmax=float(np.percentile(img, 99.5)))
-    ax.set_title(f"sun zenith {sz:.0f} deg, azimuth 135")
-    ax.set_axis_off()
+fig, axes = plt.subplots(1, 7, figsize=(14, 2.6), constrained_layout=True)
+plot_incidence_series(stand, sun_azimuth=135.0, shape=(120, 120), spp=4, max_depth=5, seed=6, axes=axes)
 plt.show()

@@ -280,12 +280,14 @@ def test_the_kernel_knows_bilambertian_by_name():
     # reflector is a Lambertian plane: exercises the registered kernel model
     from fractalgeo_rs import _core
 
-    v, se, _ = _core.radiometry_brf(np.zeros((4, 4)), (1.0, 1.0), True, "ne-sw", "bilambertian", [0.3, 0.0],
-                                    (0.0, 30.0), (0.0, 0.0), 1000, 5, 1, 1)
+    def leaf_plane(r, t):
+        return _core.RadiometryScene.from_dem(np.zeros((4, 4)), (1.0, 1.0), True, "ne-sw",
+                                              [("bilambertian", [r, t])], None)
+
+    v, se, _ = leaf_plane(0.3, 0.0).brf((0.0, 30.0), (0.0, 0.0), 1000, 5, 1, 1)
     assert v == pytest.approx(0.3, abs=1e-12)
     with pytest.raises(ValueError, match="transmittance"):
-        _core.radiometry_brf(np.zeros((4, 4)), (1.0, 1.0), True, "ne-sw", "bilambertian", [0.7, 0.5],
-                             (0.0, 30.0), (0.0, 0.0), 1000, 5, 1, 1)
+        leaf_plane(0.7, 0.5)
 
 
 def test_cli_writes_the_mesh_and_the_table(tmp_path, capsys):

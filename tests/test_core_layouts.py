@@ -71,6 +71,11 @@ def _file_bytes(write, a, suffix):
 
 
 # name: (the array argument, the call on it)
+def _dem_scene(a, periodic, split):
+    """A one-material DEM scene (what ``radiometry.Scene.from_dem`` builds)."""
+    return _core.RadiometryScene.from_dem(a, (1.0, 2.0), periodic, split, [("lambertian", [0.5])], None)
+
+
 CASES = {
     "box_count_binary": (MASK, lambda a: _core.box_count_binary(a, [1, 2, 4], 1, True)),
     "box_count_point_levels": (rng.random((2000, 2)), lambda a: _core.box_count_point_levels(a, 2, 2, 5.0, 8, 1)),
@@ -136,28 +141,26 @@ CASES = {
         a, a + 1, (a > 1).astype(np.uint32) + 1, np.abs(IMG[:, :20]), (IMG[:, :20] > 0).astype(np.uint8) * 2)),
     "radar_scene": (IMG, lambda a: _core.radar_scene(a, 2.0, 1.5, 35.0, [1.0, 0.5, 0.2], 45.0, 3, 5)),
     "radar_slant_extent": (IMG, lambda a: _core.radar_slant_extent(a, 2.0, 35.0)),
-    "radiometry_brf": (IMG[:9, :7], lambda a: _core.radiometry_brf(
-        a, (1.0, 2.0), False, "ne-sw", "lambertian", [0.5], (30.0, 40.0), (200.0, 20.0), 500, 3, 1)),
-    "radiometry_albedo": (IMG[:9, :7], lambda a: _core.radiometry_albedo(
-        a, (1.0, 2.0), False, "ne-sw", "lambertian", [0.5], (30.0, 40.0), 500, 3, 1)),
+    "RadiometryScene.from_dem(...).brf": (IMG[:9, :7], lambda a: _dem_scene(a, False, "ne-sw").brf(
+        (30.0, 40.0), (200.0, 20.0), 500, 3, 1)),
+    "RadiometryScene.from_dem(...).albedo": (IMG[:9, :7], lambda a: _dem_scene(a, False, "ne-sw").albedo(
+        (30.0, 40.0), 500, 3, 1)),
     "radiometry_intersect": (IMG[:9, :7], lambda a: _core.radiometry_intersect(
         a, (1.0, 2.0), False, "ne-sw", np.array([[2.0, -3.0, 99.0], [1.5, -9.0, 99.0]]),
         np.array([[0.1, 0.2, -1.0], [0.0, 0.0, -1.0]]))),
     "radiometry_occluded": (IMG[:9, :7], lambda a: _core.radiometry_occluded(
         a, (1.0, 2.0), True, "ne-sw", np.array([[2.0, -3.0, -99.0], [1.5, -9.0, 99.0]]),
         np.array([[0.1, 0.2, 1.0], [0.0, 0.3, 1.0]]))),
-    "radiometry_render": (IMG[:9, :7], lambda a: _core.radiometry_render(
-        a, (1.0, 2.0), False, "nw-se", "lambertian", [0.5], (30.0, 40.0), (0.0, 0.0), (5, 4), 4, 3, 1)),
-    "radiometry_brf_sky": (IMG[:9, :7], lambda a: _core.radiometry_brf_sky(
-        a, (1.0, 2.0), False, "ne-sw", "lambertian", [0.5], (30.0, 40.0), (200.0, 20.0), 0.4, 500, 3, 1)),
-    "radiometry_bhr": (IMG[:9, :7], lambda a: _core.radiometry_bhr(
-        a, (1.0, 2.0), False, "ne-sw", "lambertian", [0.5], 500, 3, 1)),
-    "radiometry_render_perspective": (IMG[:9, :7], lambda a: _core.radiometry_render_perspective(
-        a, (1.0, 2.0), True, "ne-sw", "lambertian", [0.5], (30.0, 40.0), 0.2, (3.0, 4.0, 60.0), (3.0, -8.0, 0.0),
-        40.0, (5, 4), 2, 3, 1)),
-    "radiometry_render_psf": (IMG[:9, :7], lambda a: _core.radiometry_render_psf(
-        a, (1.0, 2.0), False, "nw-se", "lambertian", [0.5], (30.0, 40.0), (0.0, 0.0), 0.3, (5, 4), 4, 3, 1,
-        "table", [0.5], np.abs(IMG[:3, :5]))),
+    "RadiometryScene.from_dem(...).render": (IMG[:9, :7], lambda a: _dem_scene(a, False, "nw-se").render(
+        (30.0, 40.0), (0.0, 0.0), (5, 4), 4, 3, 1)),
+    "RadiometryScene.from_dem(...).brf_sky": (IMG[:9, :7], lambda a: _dem_scene(a, False, "ne-sw").brf_sky(
+        (30.0, 40.0), (200.0, 20.0), 0.4, 500, 3, 1)),
+    "RadiometryScene.from_dem(...).bhr": (IMG[:9, :7], lambda a: _dem_scene(a, False, "ne-sw").bhr(500, 3, 1)),
+    "RadiometryScene.from_dem(...).render_perspective": (IMG[:9, :7], lambda a: _dem_scene(a, True, "ne-sw")
+                                                         .render_perspective((30.0, 40.0), 0.2, (3.0, 4.0, 60.0),
+                                                                             (3.0, -8.0, 0.0), 40.0, (5, 4), 2, 3, 1)),
+    "RadiometryScene.from_dem(...).render_psf": (IMG[:9, :7], lambda a: _dem_scene(a, False, "nw-se").render_psf(
+        (30.0, 40.0), (0.0, 0.0), 0.3, (5, 4), 4, 3, 1, "table", [0.5], np.abs(IMG[:3, :5]))),
     "RadiometryScene.from_dem": (IMG[:9, :7], lambda a: _core.RadiometryScene.from_dem(
         a, (1.0, 2.0), True, "ne-sw", [("lambertian", [0.2]), ("lambertian", [0.9])],
         (np.arange(126) % 2).astype(np.uint32)).render((30.0, 40.0), (0.0, 0.0), (5, 4), 4, 3, 1)),

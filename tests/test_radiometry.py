@@ -212,14 +212,18 @@ def test_the_kernel_checks_too():
     from fractalgeo_rs import _core
 
     z = np.zeros((3, 3))
+
+    def scene(name="lambertian", params=(0.5,)):
+        return _core.RadiometryScene.from_dem(z, (1.0, 1.0), True, "ne-sw", [(name, list(params))], None)
+
     with pytest.raises(ValueError, match="^sun: zenith"):
-        _core.radiometry_brf(z, (1.0, 1.0), True, "ne-sw", "lambertian", [0.5], (0, 91), (0, 0), 10, 1, 0)
+        scene().brf((0, 91), (0, 0), 10, 1, 0)
     with pytest.raises(ValueError, match="^rho"):
-        _core.radiometry_albedo(z, (1.0, 1.0), True, "ne-sw", "lambertian", [2.0], (0, 0), 10, 1, 0)
+        scene(params=(2.0,))
     with pytest.raises(ValueError, match="^material"):
-        _core.radiometry_albedo(z, (1.0, 1.0), True, "ne-sw", "hapke", [0.5], (0, 0), 10, 1, 0)
+        scene("hapke")
     with pytest.raises(MemoryError, match="^shape"):
-        _core.radiometry_render(z, (1.0, 1.0), True, "ne-sw", "lambertian", [0.5], (0, 0), (0, 0), (10**5, 10**5), 1, 1, 0)
+        scene().render((0, 0), (0, 0), (10**5, 10**5), 1, 1, 0)
 
 
 def test_mismatched_periodic_edges_warn_and_mirroring_fixes_them():
@@ -537,3 +541,17 @@ def test_brf_standard_errors_are_honest_at_grazing_sun(sun, view):
     assert np.sum(np.abs(zs) > 3) <= 3, zs
     one = s.brf(sun=sun, view=view, spp=4096, max_depth=3, seed=5, n_threads=1)
     assert one == s.brf(sun=sun, view=view, spp=4096, max_depth=3, seed=5, n_threads=2)
+
+
+def test_a_dem_scene_keeps_its_kernel_scene_and_rebuilds_it_when_changed():
+    import pickle
+
+    z = np.zeros((4, 4))
+    s = Scene.from_dem(z, material=Lambertian(0.3))
+    assert s.brf(sun=(0.0, 30.0), spp=256).value == pytest.approx(0.3, abs=1e-12)
+    kept = s._scene_core()
+    assert s._scene_core() is kept  # built once, reused by every call
+    s.material = Lambertian(0.7)  # a changed attribute rebuilds it
+    assert s.albedo(sun=(0.0, 30.0), spp=256).value == pytest.approx(0.7, abs=1e-12)
+    s2 = pickle.loads(pickle.dumps(s))  # the kernel scene is not pickled, rebuilt on use
+    assert s2.bhr(spp=256).value == pytest.approx(0.7, abs=1e-12)

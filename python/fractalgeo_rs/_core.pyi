@@ -77,15 +77,8 @@ __all__ = [
     "radar_scene",
     "radar_slant_extent",
     "speckle_f64",
-    "radiometry_albedo",
-    "radiometry_brf",
     "radiometry_intersect",
     "radiometry_occluded",
-    "radiometry_render",
-    "radiometry_bhr",
-    "radiometry_brf_sky",
-    "radiometry_render_psf",
-    "radiometry_render_perspective",
 ]
 
 # ---- geometry ----
@@ -577,20 +570,6 @@ def radar_slant_extent(
 ) -> Tuple[float, float]: ...
 # ---- radiometry ----
 
-def radiometry_brf(
-    dem: npt.NDArray[np.float64],
-    cell_size: Tuple[float, float],
-    periodic: bool,
-    split: str,
-    material: str,
-    params: Sequence[float],
-    sun: Tuple[float, float],
-    view: Tuple[float, float],
-    spp: int,
-    max_depth: int,
-    seed: int,
-    n_threads: Optional[int] = None,
-) -> Tuple[float, float, int]: ...
 def radiometry_intersect(
     dem: npt.NDArray[np.float64],
     cell_size: Tuple[float, float],
@@ -611,101 +590,6 @@ def radiometry_occluded(
     skip: Optional[npt.NDArray[np.int64]] = None,
     n_threads: Optional[int] = None,
 ) -> npt.NDArray[np.bool_]: ...
-def radiometry_albedo(
-    dem: npt.NDArray[np.float64],
-    cell_size: Tuple[float, float],
-    periodic: bool,
-    split: str,
-    material: str,
-    params: Sequence[float],
-    sun: Tuple[float, float],
-    spp: int,
-    max_depth: int,
-    seed: int,
-    n_threads: Optional[int] = None,
-) -> Tuple[float, float, int]: ...
-def radiometry_render(
-    dem: npt.NDArray[np.float64],
-    cell_size: Tuple[float, float],
-    periodic: bool,
-    split: str,
-    material: str,
-    params: Sequence[float],
-    sun: Tuple[float, float],
-    view: Tuple[float, float],
-    shape: Tuple[int, int],
-    spp: int,
-    max_depth: int,
-    seed: int,
-    n_threads: Optional[int] = None,
-    progress: Optional[ProgressCounter] = None,
-) -> npt.NDArray[np.float32]: ...
-def radiometry_brf_sky(
-    dem: npt.NDArray[np.float64],
-    cell_size: Tuple[float, float],
-    periodic: bool,
-    split: str,
-    material: str,
-    params: Sequence[float],
-    sun: Tuple[float, float],
-    view: Tuple[float, float],
-    sky: float,
-    spp: int,
-    max_depth: int,
-    seed: int,
-    n_threads: Optional[int] = None,
-) -> Tuple[float, float, int]: ...
-def radiometry_bhr(
-    dem: npt.NDArray[np.float64],
-    cell_size: Tuple[float, float],
-    periodic: bool,
-    split: str,
-    material: str,
-    params: Sequence[float],
-    spp: int,
-    max_depth: int,
-    seed: int,
-    n_threads: Optional[int] = None,
-) -> Tuple[float, float, int]: ...
-def radiometry_render_perspective(
-    dem: npt.NDArray[np.float64],
-    cell_size: Tuple[float, float],
-    periodic: bool,
-    split: str,
-    material: str,
-    params: Sequence[float],
-    sun: Tuple[float, float],
-    sky: float,
-    eye: Tuple[float, float, float],
-    target: Tuple[float, float, float],
-    fov: float,
-    shape: Tuple[int, int],
-    spp: int,
-    max_depth: int,
-    seed: int,
-    n_threads: Optional[int] = None,
-    progress: Optional[ProgressCounter] = None,
-) -> npt.NDArray[np.float32]: ...
-def radiometry_render_psf(
-    dem: npt.NDArray[np.float64],
-    cell_size: Tuple[float, float],
-    periodic: bool,
-    split: str,
-    material: str,
-    params: Sequence[float],
-    sun: Tuple[float, float],
-    view: Tuple[float, float],
-    sky: float,
-    shape: Tuple[int, int],
-    spp: int,
-    max_depth: int,
-    seed: int,
-    psf: str,
-    psf_params: Sequence[float],
-    psf_table: Optional[npt.NDArray[np.float64]] = None,
-    n_threads: Optional[int] = None,
-    progress: Optional[ProgressCounter] = None,
-) -> npt.NDArray[np.float32]: ...
 
 @final
 class RadiometryScene:
@@ -775,6 +659,16 @@ class RadiometryScene:
         seed: int,
         n_threads: Optional[int] = None,
     ) -> Tuple[float, float, int]: ...
+    def brf_orders(
+        self,
+        sun: Tuple[float, float],
+        view: Tuple[float, float],
+        sky: float,
+        spp: int,
+        max_depth: int,
+        seed: int,
+        n_threads: Optional[int] = None,
+    ) -> Tuple[Tuple[float, float], Tuple[float, float], Tuple[float, float], int]: ...
     def bhr(
         self, spp: int, max_depth: int, seed: int, n_threads: Optional[int] = None
     ) -> Tuple[float, float, int]: ...

@@ -1,7 +1,7 @@
-//! Bindings of `crate::radiometry`: BRF, albedo and images of a DEM scene.
-//!
-//! The scene is rebuilt from the DEM on every call (linear in the cells,
-//! negligible beside the rays), so nothing is kept between calls.
+//! Bindings of `crate::radiometry`: one scene object
+//! ([`RadiometryScene`], built once from a DEM, a mesh or instances and kept
+//! between calls) with its BRF, albedo, images and canopy methods, and the
+//! ray-batch queries of a DEM heightfield.
 use super::convert::{array1, array2, c_order, run};
 use super::geometry::MeshIn;
 use super::progress::{counter, ProgressCounter};
@@ -39,204 +39,6 @@ fn build(
     ))
 }
 
-/// `(value, se, n)` of the BRF of a DEM scene (directions `(azimuth, zenith)` in degrees).
-#[pyfunction]
-#[pyo3(signature = (dem, cell_size, periodic, split, material, params, sun, view, spp, max_depth, seed, n_threads=None))]
-#[allow(clippy::too_many_arguments)]
-fn radiometry_brf(
-    py: Python<'_>,
-    dem: PyReadonlyArray2<'_, f64>,
-    cell_size: (f64, f64),
-    periodic: bool,
-    split: &str,
-    material: &str,
-    params: Vec<f64>,
-    sun: (f64, f64),
-    view: (f64, f64),
-    spp: u64,
-    max_depth: u32,
-    seed: u64,
-    n_threads: Option<usize>,
-) -> PyResult<(f64, f64, u64)> {
-    let z = c_order(&dem);
-    let e = run(py, n_threads, || {
-        let s = build(
-            &z.data,
-            z.rows_cols(),
-            cell_size,
-            periodic,
-            split,
-            material,
-            &params,
-        )?;
-        s.brf(
-            direction(sun, "sun")?,
-            direction(view, "view")?,
-            spp,
-            max_depth,
-            seed,
-        )
-    })?;
-    Ok((e.value, e.se, e.n))
-}
-
-/// `(value, se, n)` of the directional-hemispherical albedo of a DEM scene.
-#[pyfunction]
-#[pyo3(signature = (dem, cell_size, periodic, split, material, params, sun, spp, max_depth, seed, n_threads=None))]
-#[allow(clippy::too_many_arguments)]
-fn radiometry_albedo(
-    py: Python<'_>,
-    dem: PyReadonlyArray2<'_, f64>,
-    cell_size: (f64, f64),
-    periodic: bool,
-    split: &str,
-    material: &str,
-    params: Vec<f64>,
-    sun: (f64, f64),
-    spp: u64,
-    max_depth: u32,
-    seed: u64,
-    n_threads: Option<usize>,
-) -> PyResult<(f64, f64, u64)> {
-    let z = c_order(&dem);
-    let e = run(py, n_threads, || {
-        let s = build(
-            &z.data,
-            z.rows_cols(),
-            cell_size,
-            periodic,
-            split,
-            material,
-            &params,
-        )?;
-        s.albedo(direction(sun, "sun")?, spp, max_depth, seed)
-    })?;
-    Ok((e.value, e.se, e.n))
-}
-
-/// A float32 radiance image of shape `shape` of a DEM scene (orthographic sensor).
-#[pyfunction]
-#[pyo3(signature = (dem, cell_size, periodic, split, material, params, sun, view, shape, spp, max_depth, seed, n_threads=None, progress=None))]
-#[allow(clippy::too_many_arguments)]
-fn radiometry_render<'py>(
-    py: Python<'py>,
-    dem: PyReadonlyArray2<'py, f64>,
-    cell_size: (f64, f64),
-    periodic: bool,
-    split: &str,
-    material: &str,
-    params: Vec<f64>,
-    sun: (f64, f64),
-    view: (f64, f64),
-    shape: (usize, usize),
-    spp: u64,
-    max_depth: u32,
-    seed: u64,
-    n_threads: Option<usize>,
-    progress: Option<&Bound<'py, ProgressCounter>>,
-) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    let z = c_order(&dem);
-    let pr = counter(progress);
-    let img = run(py, n_threads, || {
-        let s = build(
-            &z.data,
-            z.rows_cols(),
-            cell_size,
-            periodic,
-            split,
-            material,
-            &params,
-        )?;
-        s.render_progress(
-            direction(sun, "sun")?,
-            direction(view, "view")?,
-            shape,
-            spp,
-            max_depth,
-            seed,
-            pr.as_deref(),
-        )
-    })?;
-    array2(py, shape, img)
-}
-
-/// `(value, se, n)` of the reflectance factor under the sun and an
-/// isotropic sky of horizontal irradiance `sky` (the HDRF).
-#[pyfunction]
-#[pyo3(signature = (dem, cell_size, periodic, split, material, params, sun, view, sky, spp, max_depth, seed, n_threads=None))]
-#[allow(clippy::too_many_arguments)]
-fn radiometry_brf_sky(
-    py: Python<'_>,
-    dem: PyReadonlyArray2<'_, f64>,
-    cell_size: (f64, f64),
-    periodic: bool,
-    split: &str,
-    material: &str,
-    params: Vec<f64>,
-    sun: (f64, f64),
-    view: (f64, f64),
-    sky: f64,
-    spp: u64,
-    max_depth: u32,
-    seed: u64,
-    n_threads: Option<usize>,
-) -> PyResult<(f64, f64, u64)> {
-    let z = c_order(&dem);
-    let e = run(py, n_threads, || {
-        let s = build(
-            &z.data,
-            z.rows_cols(),
-            cell_size,
-            periodic,
-            split,
-            material,
-            &params,
-        )?;
-        s.brf_sky(
-            direction(sun, "sun")?,
-            direction(view, "view")?,
-            sky,
-            spp,
-            max_depth,
-            seed,
-        )
-    })?;
-    Ok((e.value, e.se, e.n))
-}
-
-/// `(value, se, n)` of the bi-hemispherical reflectance (white-sky albedo).
-#[pyfunction]
-#[pyo3(signature = (dem, cell_size, periodic, split, material, params, spp, max_depth, seed, n_threads=None))]
-#[allow(clippy::too_many_arguments)]
-fn radiometry_bhr(
-    py: Python<'_>,
-    dem: PyReadonlyArray2<'_, f64>,
-    cell_size: (f64, f64),
-    periodic: bool,
-    split: &str,
-    material: &str,
-    params: Vec<f64>,
-    spp: u64,
-    max_depth: u32,
-    seed: u64,
-    n_threads: Option<usize>,
-) -> PyResult<(f64, f64, u64)> {
-    let z = c_order(&dem);
-    let e = run(py, n_threads, || {
-        let s = build(
-            &z.data,
-            z.rows_cols(),
-            cell_size,
-            periodic,
-            split,
-            material,
-            &params,
-        )?;
-        s.bhr(spp, max_depth, seed)
-    })?;
-    Ok((e.value, e.se, e.n))
-}
-
 /// The point-spread function named `psf`: "box", "gaussian"
 /// (`psf_params` = [sigma, truncate]) or "table" (`table` weights,
 /// `psf_params` = [cell size in pixels]).
@@ -262,115 +64,6 @@ fn psf_of(
             ))
         }
     })
-}
-
-/// A float32 radiance image with sky light and a point-spread function:
-/// `psf` is "box", "gaussian" (`psf_params` = [sigma, truncate], pixels and
-/// sigmas) or "table" (`psf_table` weights, `psf_params` = [cell size in pixels]).
-#[pyfunction]
-#[pyo3(signature = (dem, cell_size, periodic, split, material, params, sun, view, sky, shape, spp, max_depth, seed, psf, psf_params, psf_table=None, n_threads=None, progress=None))]
-#[allow(clippy::too_many_arguments)]
-fn radiometry_render_psf<'py>(
-    py: Python<'py>,
-    dem: PyReadonlyArray2<'py, f64>,
-    cell_size: (f64, f64),
-    periodic: bool,
-    split: &str,
-    material: &str,
-    params: Vec<f64>,
-    sun: (f64, f64),
-    view: (f64, f64),
-    sky: f64,
-    shape: (usize, usize),
-    spp: u64,
-    max_depth: u32,
-    seed: u64,
-    psf: &str,
-    psf_params: Vec<f64>,
-    psf_table: Option<PyReadonlyArray2<'py, f64>>,
-    n_threads: Option<usize>,
-    progress: Option<&Bound<'py, ProgressCounter>>,
-) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    let z = c_order(&dem);
-    let table = psf_table.as_ref().map(c_order);
-    let pr = counter(progress);
-    let img = run(py, n_threads, || {
-        let kernel = psf_of(psf, &psf_params, table.as_ref())?;
-        let s = build(
-            &z.data,
-            z.rows_cols(),
-            cell_size,
-            periodic,
-            split,
-            material,
-            &params,
-        )?;
-        s.render_psf(
-            direction(sun, "sun")?,
-            direction(view, "view")?,
-            sky,
-            shape,
-            spp,
-            max_depth,
-            seed,
-            &kernel,
-            pr.as_deref(),
-        )
-    })?;
-    array2(py, shape, img)
-}
-
-/// A float32 radiance image seen by a pinhole camera at `eye` looking at
-/// `target` (scene coordinates: x east, y north, z up) with the vertical
-/// field of view `fov` degrees.
-#[pyfunction]
-#[pyo3(signature = (dem, cell_size, periodic, split, material, params, sun, sky, eye, target, fov, shape, spp, max_depth, seed, n_threads=None, progress=None))]
-#[allow(clippy::too_many_arguments)]
-fn radiometry_render_perspective<'py>(
-    py: Python<'py>,
-    dem: PyReadonlyArray2<'py, f64>,
-    cell_size: (f64, f64),
-    periodic: bool,
-    split: &str,
-    material: &str,
-    params: Vec<f64>,
-    sun: (f64, f64),
-    sky: f64,
-    eye: (f64, f64, f64),
-    target: (f64, f64, f64),
-    fov: f64,
-    shape: (usize, usize),
-    spp: u64,
-    max_depth: u32,
-    seed: u64,
-    n_threads: Option<usize>,
-    progress: Option<&Bound<'py, ProgressCounter>>,
-) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    let z = c_order(&dem);
-    let pr = counter(progress);
-    let img = run(py, n_threads, || {
-        let cam = Pinhole::new(eye.into(), target.into(), fov)?;
-        let s = build(
-            &z.data,
-            z.rows_cols(),
-            cell_size,
-            periodic,
-            split,
-            material,
-            &params,
-        )?;
-        s.render_perspective(
-            direction(sun, "sun")?,
-            sky,
-            &cam,
-            shape,
-            spp,
-            max_depth,
-            seed,
-            pr.as_deref(),
-        )
-    })?;
-    array2(py, shape, img)
 }
 
 /// Origins, directions and skipped facet indices of a batch of rays.
@@ -558,6 +251,9 @@ fn scene_with<G: crate::radiometry::Tracer>(
 
 /// `(absorbed per material, reflected, trapped, n)`, each a `(value, se)`.
 type AbsorptionOut = (Vec<(f64, f64)>, (f64, f64), (f64, f64), u64);
+
+/// `(single, multiple, total, n)` of [`RadiometryScene::brf_orders`], each a `(value, se)`.
+type OrdersOut = ((f64, f64), (f64, f64), (f64, f64), u64);
 
 /// `(areas, normals)` of [`RadiometryScene::facets`].
 type FacetArrays<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>);
@@ -823,6 +519,30 @@ impl RadiometryScene {
         Ok((e.value, e.se, e.n))
     }
 
+    /// `((value, se), (value, se), (value, se), n)`: the reflectance factor
+    /// of [`RadiometryScene::brf_sky`] split into single and multiple
+    /// scattering, and the total, over the same paths.
+    #[pyo3(signature = (sun, view, sky, spp, max_depth, seed, n_threads=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn brf_orders(
+        &self,
+        py: Python<'_>,
+        sun: (f64, f64),
+        view: (f64, f64),
+        sky: f64,
+        spp: u64,
+        max_depth: u32,
+        seed: u64,
+        n_threads: Option<usize>,
+    ) -> PyResult<OrdersOut> {
+        let o = run(py, n_threads, || {
+            let (sun, view) = (direction(sun, "sun")?, direction(view, "view")?);
+            with_scene!(&self.kind, s => s.brf_orders(sun, view, sky, spp, max_depth, seed))
+        })?;
+        let pair = |e: crate::radiometry::Estimate| (e.value, e.se);
+        Ok((pair(o.single), pair(o.multiple), pair(o.total), o.total.n))
+    }
+
     /// `(value, se, n)` of the bi-hemispherical reflectance (white-sky albedo).
     #[pyo3(signature = (spp, max_depth, seed, n_threads=None))]
     fn bhr(
@@ -841,8 +561,10 @@ impl RadiometryScene {
         Ok((e.value, e.se, e.n))
     }
 
-    /// A float32 radiance image with sky light and a point-spread function
-    /// (as `radiometry_render_psf`).
+    /// A float32 radiance image with sky light and a point-spread function:
+    /// `psf` is "box", "gaussian" (`psf_params` = [sigma, truncate], pixels
+    /// and sigmas) or "table" (`psf_table` weights, `psf_params` = [cell size
+    /// in pixels]).
     #[pyo3(signature = (sun, view, sky, shape, spp, max_depth, seed, psf, psf_params, psf_table=None, n_threads=None, progress=None))]
     #[allow(clippy::too_many_arguments)]
     fn render_psf<'py>(
@@ -926,14 +648,7 @@ impl RadiometryScene {
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<RadiometryScene>()?;
-    m.add_function(wrap_pyfunction!(radiometry_albedo, m)?)?;
-    m.add_function(wrap_pyfunction!(radiometry_brf, m)?)?;
     m.add_function(wrap_pyfunction!(radiometry_intersect, m)?)?;
     m.add_function(wrap_pyfunction!(radiometry_occluded, m)?)?;
-    m.add_function(wrap_pyfunction!(radiometry_render, m)?)?;
-    m.add_function(wrap_pyfunction!(radiometry_bhr, m)?)?;
-    m.add_function(wrap_pyfunction!(radiometry_brf_sky, m)?)?;
-    m.add_function(wrap_pyfunction!(radiometry_render_psf, m)?)?;
-    m.add_function(wrap_pyfunction!(radiometry_render_perspective, m)?)?;
     Ok(())
 }

@@ -53,6 +53,18 @@ pub struct Estimate {
     pub n: u64,
 }
 
+/// A reflectance factor split by scattering order ([`Scene::brf_orders`]),
+/// each part estimated from the same paths.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OrderSplit {
+    /// Light scattered once (the first-order next-event estimate).
+    pub single: Estimate,
+    /// Light scattered two to `max_depth` times (per path: total - single).
+    pub multiple: Estimate,
+    /// All orders up to `max_depth` ([`Scene::brf_sky`]).
+    pub total: Estimate,
+}
+
 /// A surface (a [`Heightfield`] by default, or any [`Tracer`] such as a
 /// [`super::MeshTracer`]) with its reflectance models.
 ///
@@ -338,8 +350,14 @@ impl<G: Tracer> Scene<G> {
     /// scattering events (`k <= max_depth`) adds `throughput * sky_l`. With
     /// `sky_l = 0` the walk stops after the `max_depth`-th sun estimate (no
     /// further draw), so sky-free results do not depend on the sky code.
+    ///
+    /// Returns `(l, l1)`: the radiance and its single-scattering part (the
+    /// sun's next-event estimate at the first hit and the sky light of paths
+    /// that leave after one event). Bounce `k` draws the uniforms `dim + 2 (k
+    /// - 1)`, `dim + 2 k - 1` whatever `max_depth` is, so `l1` is bit for bit
+    /// the `l` of the same path with `max_depth = 1`.
     #[allow(clippy::too_many_arguments)]
-    fn radiance<S: PathSampler>(
+    fn radiance_orders<S: PathSampler>(
         &self,
         mut o: DVec3,
         v: DVec3,
@@ -348,17 +366,22 @@ impl<G: Tracer> Scene<G> {
         max_depth: u32,
         key: &mut S,
         mut dim: u64,
-    ) -> f64 {
+    ) -> (f64, f64) {
         let hf = &self.hf;
         let mut d = -v;
         let mut skip: Option<G::Facet> = None;
         let mut throughput = 1.0;
         let mut l = 0.0;
+        let mut l1 = 0.0;
         let mut depth = 0u32;
         loop {
             let Some(hit) = hf.trace(o, d, skip) else {
                 if depth > 0 && d.z > 0.0 {
-                    l += throughput * sky_l; // escaped into the sky
+                    let c = throughput * sky_l; // escaped into the sky
+                    l += c;
+                    if depth == 1 {
+                        l1 += c;
+                    }
                 }
                 break;
             };
@@ -377,7 +400,11 @@ impl<G: Tracer> Scene<G> {
             let cos_s = n.dot(s);
             if (cos_s > 0.0 || (cos_s < 0.0 && m.transmits())) && !hf.occluded(p, s, Some(facet)) {
                 let wi = Self::local(n, t, b, s);
-                l += throughput * m.eval(wi, wo) * cos_s.abs();
+                let c = throughput * m.eval(wi, wo) * cos_s.abs();
+                l += c;
+                if depth == 1 {
+                    l1 += c;
+                }
             }
             if depth == max_depth && sky_l == 0.0 {
                 break;
@@ -393,7 +420,23 @@ impl<G: Tracer> Scene<G> {
             o = p;
             skip = Some(facet);
         }
-        l
+        (l, l1)
+    }
+
+    /// The radiance of [`Scene::radiance_orders`] (all orders).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn radiance<S: PathSampler>(
+        &self,
+        o: DVec3,
+        v: DVec3,
+        s: DVec3,
+        sky_l: f64,
+        max_depth: u32,
+        key: &mut S,
+        dim: u64,
+    ) -> f64 {
+        self.radiance_orders(o, v, s, sky_l, max_depth, key, dim).0
     }
 
     /// Bidirectional reflectance factor for the sun towards `sun` and the
@@ -415,7 +458,7 @@ impl<G: Tracer> Scene<G> {
     /// normal to the beam) plus an isotropic sky whose irradiance on a
     /// horizontal plane is `sky` (same unit): `pi L / (cos(sun zenith) +
     /// sky)`, the hemispherical-directional reflectance factor (HDRF); the
-    /// BRF for `sky = 0`.
+    /// BRF for `sky = 0`: the `total` of [`Scene::brf_orders`].
     ///
     /// Randomised quasi-Monte Carlo: the `spp` paths are split into
     /// [`replicates`]`(spp)` independently Owen-scrambled Sobol sequences
@@ -432,6 +475,28 @@ impl<G: Tracer> Scene<G> {
         max_depth: u32,
         seed: u64,
     ) -> CoreResult<Estimate> {
+        Ok(self.brf_orders(sun, view, sky, spp, max_depth, seed)?.total)
+    }
+
+    /// [`Scene::brf_sky`] split by scattering order over the same paths:
+    /// per path, the single-scattering value `r1` (the sun's next-event
+    /// estimate at the first hit, plus the sky light of paths leaving after
+    /// one event), the total `r` and the multiple-scattering value `r - r1`;
+    /// each estimate is formed from its own per-path values (sums and sums
+    /// of squares), so the standard error of `multiple` is that of the
+    /// per-path differences. `single` equals [`Scene::brf_sky`] with
+    /// `max_depth = 1` and the same seed bit for bit, `total` equals
+    /// [`Scene::brf_sky`] bit for bit, and `single + multiple = total` to
+    /// rounding.
+    pub fn brf_orders(
+        &self,
+        sun: DVec3,
+        view: DVec3,
+        sky: f64,
+        spp: u64,
+        max_depth: u32,
+        seed: u64,
+    ) -> CoreResult<OrderSplit> {
         check_spp(spp)?;
         check_depth(max_depth)?;
         check_sky(sky)?;
@@ -446,11 +511,13 @@ impl<G: Tracer> Scene<G> {
         let items: Vec<(u64, u64)> = (0..reps)
             .flat_map(|r| (0..size(r).div_ceil(BLOCK)).map(move |b| (r, b)))
             .collect();
-        let sums: Vec<(f64, f64, u64)> = items
+        type Sums = [(f64, f64, u64); 3];
+        let sums: Vec<Sums> = items
             .into_par_iter()
             .map(|(r, blk)| {
                 let scramble = (StreamKey::new(seed, TAG_SOBOL ^ r).bits(0) >> 32) as u32;
-                let (mut s1, mut s2) = (0.0, 0.0);
+                // (total, single, multiple): sum and sum of squares
+                let mut acc = [(0.0, 0.0); 3];
                 let end = ((blk + 1) * BLOCK).min(size(r));
                 for i in blk * BLOCK..end {
                     let mut u = SobolPath::new(
@@ -461,27 +528,38 @@ impl<G: Tracer> Scene<G> {
                     let x = x0 + u.uniform(0) * w;
                     let y = ytop - u.uniform(1) * h;
                     let o = self.sensor_ray(x, y, view);
-                    let l = norm * self.radiance(o, view, sun, sky_l, max_depth, &mut u, 2);
-                    s1 += l;
-                    s2 += l * l;
+                    let (l, l1) = self.radiance_orders(o, view, sun, sky_l, max_depth, &mut u, 2);
+                    let (t, t1) = (norm * l, norm * l1);
+                    for (a, x) in acc.iter_mut().zip([t, t1, t - t1]) {
+                        a.0 += x;
+                        a.1 += x * x;
+                    }
                 }
-                (s1, s2, end - blk * BLOCK)
+                let k = end - blk * BLOCK;
+                acc.map(|(s1, s2)| (s1, s2, k))
             })
             .collect();
-        // per-replicate sums, blocks added in order
-        let mut per_rep: Vec<(f64, f64, u64)> = Vec::with_capacity(reps as usize);
-        let mut k = 0;
-        for r in 0..reps {
-            let (mut a, mut b, mut n) = (0.0, 0.0, 0);
-            for _ in 0..size(r).div_ceil(BLOCK) {
-                a += sums[k].0;
-                b += sums[k].1;
-                n += sums[k].2;
-                k += 1;
+        // per-replicate sums of each part, blocks added in order
+        let part = |j: usize| {
+            let mut per_rep: Vec<(f64, f64, u64)> = Vec::with_capacity(reps as usize);
+            let mut k = 0;
+            for r in 0..reps {
+                let (mut a, mut b, mut n) = (0.0, 0.0, 0);
+                for _ in 0..size(r).div_ceil(BLOCK) {
+                    a += sums[k][j].0;
+                    b += sums[k][j].1;
+                    n += sums[k][j].2;
+                    k += 1;
+                }
+                per_rep.push((a, b, n));
             }
-            per_rep.push((a, b, n));
-        }
-        Ok(finish_replicates(&per_rep))
+            finish_replicates(&per_rep)
+        };
+        Ok(OrderSplit {
+            total: part(0),
+            single: part(1),
+            multiple: part(2),
+        })
     }
 
     /// The fraction of light arriving along `-sun` at the reference-plane

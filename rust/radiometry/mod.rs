@@ -41,7 +41,7 @@ mod tests;
 
 pub use heightfield::{Heightfield, Split};
 pub use instanced::InstancedTracer;
-pub use integrator::{Estimate, Scene};
+pub use integrator::{Estimate, OrderSplit, Scene};
 pub use mesh_tracer::MeshTracer;
 pub use tracer::{TraceHit, Tracer};
 

@@ -1017,3 +1017,95 @@ fn perspective_camera_over_a_flat_plane() {
     assert!(Pinhole::new(DVec3::ZERO, DVec3::ZERO, 40.0).is_err());
     assert!(Pinhole::new(DVec3::ZERO, DVec3::Z, 180.0).is_err());
 }
+
+#[test]
+fn orders_split_the_same_paths() {
+    let z = rough(16, 5.0, 3);
+    let s = scene(&z, 16, 16, true, "lambertian", &[0.7]);
+    let (sun, view) = (dir(10.0, 40.0), dir(200.0, 25.0));
+    for sky in [0.0, 0.3] {
+        let o = s.brf_orders(sun, view, sky, 5000, 12, 4).unwrap();
+        // single scattering is the max_depth = 1 run, total the full run, bit for bit
+        assert_eq!(o.single, s.brf_sky(sun, view, sky, 5000, 1, 4).unwrap());
+        assert_eq!(o.total, s.brf_sky(sun, view, sky, 5000, 12, 4).unwrap());
+        let sum = o.single.value + o.multiple.value;
+        assert!(
+            (sum - o.total.value).abs() <= 1e-14 * o.total.value,
+            "{o:?}"
+        );
+        assert!(o.multiple.value > 10.0 * o.multiple.se, "{o:?}");
+    }
+    // a flat plane scatters once: multiple exactly 0
+    let flat = scene(&[0.0; 16], 4, 4, true, "lambertian", &[0.6]);
+    let o = flat.brf_orders(sun, view, 0.0, 3000, 20, 1).unwrap();
+    assert_eq!((o.multiple.value, o.multiple.se), (0.0, 0.0));
+    assert!((o.single.value - 0.6).abs() < 1e-12, "{o:?}");
+}
+
+#[test]
+fn orders_scale_as_powers_of_rho() {
+    // Lambertian paths do not depend on rho (cosine sampling, weight rho):
+    // order k carries exactly rho^k, so single / rho is the same for every
+    // rho and multiple / rho^2 tends to the second-order term
+    let z = rough(16, 5.0, 3);
+    let (sun, view) = (dir(10.0, 40.0), dir(200.0, 25.0));
+    let go = |rho: f64| {
+        scene(&z, 16, 16, true, "lambertian", &[rho])
+            .brf_orders(sun, view, 0.0, 4000, 30, 6)
+            .unwrap()
+    };
+    let (a, b, c) = (go(1e-2), go(1e-3), go(1e-4));
+    for (x, rho) in [(&a, 1e-2), (&b, 1e-3), (&c, 1e-4)] {
+        let r1 = x.single.value / rho / (a.single.value / 1e-2);
+        assert!((r1 - 1.0).abs() < 1e-12, "{rho}: {r1}");
+    }
+    let (m2, m3, m4) = (
+        a.multiple.value / 1e-4,
+        b.multiple.value / 1e-6,
+        c.multiple.value / 1e-8,
+    );
+    assert!(m4 > 0.0 && m2 > m3 && m3 > m4, "{m2} {m3} {m4}");
+    // the third-order remainder: relative 1e-3 then 1e-4 of the second order
+    assert!(
+        (m3 - m4) / m4 < 1e-2 && (m2 - m4) / m4 < 1e-1,
+        "{m2} {m3} {m4}"
+    );
+}
+
+#[test]
+fn orders_of_a_conservative_v_groove() {
+    // white V-grooves (rho = 1): the single-scattering nadir BRF is cos(s)
+    // for every sun (closed form above), the rest is multiple scattering
+    let s_deg: f64 = 30.0;
+    let z = v_grooves(s_deg, 8);
+    let sc = scene(&z, 8, 8, true, "lambertian", &[1.0]);
+    for (az, zen) in [(90.0, 20.0), (0.0, 75.0)] {
+        let o = sc
+            .brf_orders(dir(az, zen), DVec3::Z, 0.0, 50_000, 200, 5)
+            .unwrap();
+        let expect = s_deg.to_radians().cos();
+        assert!(
+            (o.single.value - expect).abs() < 4.0 * o.single.se + 1e-9,
+            "{o:?}"
+        );
+        assert!(o.multiple.value > 0.05, "{o:?}");
+        let sum = o.single.value + o.multiple.value;
+        assert!(
+            (sum - o.total.value).abs() <= 1e-14 * o.total.value,
+            "{o:?}"
+        );
+    }
+}
+
+#[test]
+fn orders_do_not_depend_on_the_thread_count() {
+    let z = rough(8, 4.0, 5);
+    let s = scene(&z, 8, 8, true, "lambertian", &[0.4]);
+    let go = |n| {
+        run_in_pool(Some(n), || {
+            s.brf_orders(dir(0.0, 30.0), dir(90.0, 10.0), 0.2, 5000, 4, 9)
+        })
+        .unwrap()
+    };
+    assert_eq!(go(1), go(2));
+}

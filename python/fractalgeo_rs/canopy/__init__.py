@@ -1,6 +1,7 @@
 """Vegetation canopies for the radiometric experiment: leaf angle
 distributions, Ross's projection function ``G`` and RAMI-like homogeneous
-canopies of disc leaves in a periodic tile. See :doc:`/canopy`.
+canopies of disc leaves in a periodic tile, and stands of L-system plants
+on a DEM. See :doc:`/canopy`.
 
 Examples
 --------
@@ -13,5 +14,7 @@ Examples
 """
 from fractalgeo_rs.canopy._discs import DiscCanopy, disc_canopy
 from fractalgeo_rs.canopy._lad import LADS, leaf_angle_density, projection_g, sample_leaf_normals
+from fractalgeo_rs.canopy._stand import PLANT_PRESETS, PlantStand, plant_stand
 
-__all__ = ["DiscCanopy", "LADS", "disc_canopy", "leaf_angle_density", "projection_g", "sample_leaf_normals"]
+__all__ = ["DiscCanopy", "LADS", "PLANT_PRESETS", "PlantStand", "disc_canopy", "leaf_angle_density", "plant_stand",
+           "projection_g", "sample_leaf_normals"]

@@ -1,43 +1,75 @@
 """``fractalgeo canopy``: a RAMI-like disc canopy as a mesh, with its leaf
-statistics (G, gap probability, Beer) per zenith."""
+statistics (G, gap probability, Beer) per zenith; or, with ``--plant``, a
+stand of L-system plants on a DEM with its BRF table."""
 from __future__ import annotations
 
 import argparse
 
-from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads
+from fractalgeo_rs._cli_common import HelpFormatter, add_band, add_cell_size, add_n_threads, add_progress
 
 LAD_HELP = ("leaf angle distribution: planophile, erectophile, plagiophile, extremophile, uniform, spherical, "
             "or one inclination in degrees")
+
+#: The options of each mode (attribute, option), checked against the other mode.
+_DISC = (("lai", "--lai"), ("leaf_radius", "--leaf-radius"), ("extent", "--extent"), ("height", "--height"))
+_PLANT = (("density", "--density"), ("dem", "--dem"), ("bark", "--bark"), ("plant_scale", "--plant-scale"),
+          ("band", "--band"), ("cell_size", "--cell-size"))
 
 
 def add_parsers(sub) -> None:
     p = sub.add_parser(
         "canopy", formatter_class=HelpFormatter,
         help="RAMI-like canopy of disc leaves over a soil, as a mesh, with its gap-fraction table",
-        description="A homogeneous canopy of disc leaves in a periodic tile (fractalgeo_rs.canopy.disc_canopy): "
-        "leaves as area-matched polygons with normals from the leaf angle distribution, independent or "
-        "non-overlapping. Writes the mesh (.ply or .obj; the triangle kinds are the material ids, 0 soil and "
-        "1 leaf) and prints, per zenith, Ross's G, the exact gap probability (1 - a G / (A cos theta))^N of "
-        "independently placed leaves and Beer's exp(-G LAI / cos theta), as CSV.",
+        description="Disc mode (--lai, --leaf-radius, --extent, --height): a homogeneous canopy of disc leaves "
+        "in a periodic tile (fractalgeo_rs.canopy.disc_canopy): leaves as area-matched polygons with normals "
+        "from the leaf angle distribution, independent or non-overlapping. Writes the mesh (.ply or .obj; the "
+        "triangle kinds are the material ids, 0 soil and 1 leaf) and prints, per zenith, Ross's G, the exact "
+        "gap probability (1 - a G / (A cos theta))^N of independently placed leaves and Beer's "
+        "exp(-G LAI / cos theta), as CSV. Plant mode (--plant, --density, --dem): L-system plants of a preset "
+        "placed on the DEM (fractalgeo_rs.canopy.plant_stand: bark on the branches, bi-Lambertian leaves, "
+        "the DEM as soil, a finite scene over the DEM's cell centres); writes the mesh and prints the nadir "
+        "BRF with the sun at each zenith (azimuth 0), split into single and multiple scattering "
+        "(Scene.brf_orders), as CSV.",
     )
     p.add_argument("output", nargs="?", default=None, help="output mesh, .ply or .obj (None: no file)")
-    p.add_argument("--lai", type=float, required=True, help="leaf area index (one-sided leaf area per ground area)")
-    p.add_argument("--leaf-radius", type=float, required=True, help="disc radius, metres")
-    p.add_argument("--extent", type=float, nargs=2, required=True, metavar=("EAST", "NORTH"),
-                   help="tile size, metres")
-    p.add_argument("--height", type=float, nargs=2, required=True, metavar=("BOTTOM", "TOP"),
-                   help="range of the leaf-centre heights, metres")
+    p.add_argument("--lai", type=float, default=None,
+                   help="disc mode: leaf area index (one-sided leaf area per ground area)")
+    p.add_argument("--leaf-radius", type=float, default=None, help="disc mode: disc radius, metres")
+    p.add_argument("--extent", type=float, nargs=2, default=None, metavar=("EAST", "NORTH"),
+                   help="disc mode: tile size, metres")
+    p.add_argument("--height", type=float, nargs=2, default=None, metavar=("BOTTOM", "TOP"),
+                   help="disc mode: range of the leaf-centre heights, metres")
     p.add_argument("--lad", default="spherical", help=LAD_HELP)
     p.add_argument("--no-overlap", action="store_true",
                    help="non-overlapping leaves (random sequential addition) instead of independent ones")
     p.add_argument("--sides", type=int, default=12, help="sides of each leaf polygon")
+    p.add_argument("--plant", default=None,
+                   help="plant mode: the plant preset, bush (ABOP 1.25, about 1.6 m) or herb (stochastic, "
+                   "about 1 m)")
+    p.add_argument("--density", type=float, default=None, help="plant mode: plants per square metre")
+    p.add_argument("--dem", default=None,
+                   help="plant mode: the DEM raster (GeoTIFF or any format read_raster reads), heights in metres; "
+                   "the cell size from its transform, in metres (a geographic grid is converted at its middle "
+                   "latitude)")
+    add_band(p)  # plant mode: the DEM's band
+    add_cell_size(p, crs=False)  # plant mode: metres, replacing the DEM's (required without georeferencing)
+    p.add_argument("--plant-scale", type=float, default=None,
+                   help="plant mode: metres per turtle step (None: the preset's, 0.2 bush, 0.08 herb)")
+    p.add_argument("--leaf", default="0.4957,0.4409", metavar="R,T",
+                   help="leaf reflectance and transmittance (bi-Lambertian; RAMI's near-infrared leaf)")
+    p.add_argument("--soil", type=float, default=0.159, help="Lambertian soil reflectance (RAMI's near-infrared)")
+    p.add_argument("--bark", type=float, default=None,
+                   help="plant mode: Lambertian bark reflectance of the branches (None: 0.3)")
     p.add_argument("--zenith", default="0,15,30,45,60,75", help="comma-separated zeniths of the table, degrees")
-    p.add_argument("--seed", type=int, default=None, help="seed of the placement (None: fresh entropy, printed)")
-    p.add_argument("--spp", type=int, default=0,
-                   help="rays per traced value: adds the traced gap fraction and the nadir BRF with the sun at "
-                   "each zenith (azimuth 0) and their standard errors (0: no tracing)")
+    p.add_argument("--seed", type=int, default=None,
+                   help="seed of the placement (and of the tracing; None: fresh entropy, printed)")
+    p.add_argument("--spp", type=int, default=None,
+                   help="rays per traced value (None: 0 in disc mode, 65536 in plant mode); disc mode adds the "
+                   "traced gap fraction and the nadir BRF with the sun at each zenith (azimuth 0) and their "
+                   "standard errors (0: no tracing)")
     p.add_argument("--max-depth", type=int, default=100, help="scattering events per BRF path")
     add_n_threads(p)
+    add_progress(p)
     p.set_defaults(func=_run)
 
 
@@ -48,47 +80,163 @@ def _lad(text: str):
         return str(text).strip().lower()
 
 
+def _renamed(e: ValueError, pairs) -> ValueError:
+    """``e`` with a leading ``param:`` spelled as its option."""
+    msg = str(e)
+    for py, opt in pairs:
+        if msg.startswith(py + ":"):
+            return ValueError(opt + msg[len(py):])
+    return ValueError(msg)
+
+
+def _zeniths(text: str):
+    try:
+        zen = [float(v) for v in str(text).split(",") if v.strip()]
+    except ValueError:
+        raise ValueError(f"zenith: expected comma-separated angles in degrees, got {text!r}") from None
+    for z in zen:
+        if not 0.0 <= z < 90.0:
+            raise ValueError(f"zenith: expected degrees in [0, 90), got {z}")
+    return zen
+
+
+def _leaf(text: str):
+    from fractalgeo_rs.radiometry import BiLambertian
+
+    try:
+        r, t = (float(v) for v in str(text).split(","))
+    except ValueError:
+        raise ValueError(f"--leaf: expected R,T (reflectance, transmittance), got {text!r}") from None
+    try:
+        return BiLambertian(r, t)
+    except ValueError as e:
+        raise ValueError(f"--leaf: {e}") from None
+
+
+def _lambertian(value: float, option: str):
+    from fractalgeo_rs.radiometry import Lambertian
+
+    try:
+        return Lambertian(value)
+    except ValueError as e:
+        raise ValueError(f"{option}: {e}") from None
+
+
 def _run(args: argparse.Namespace) -> int:
+    if args.plant is not None:
+        return _run_plant(args)
+    given = [opt for attr, opt in _PLANT if getattr(args, attr, None) is not None]
+    if given:
+        raise ValueError(f"{given[0]}: only with --plant (plant mode)")
+    for attr, opt in _DISC:
+        if getattr(args, attr) is None:
+            raise ValueError(f"{opt}: required in disc mode (or give --plant, --density and --dem)")
+    return _run_discs(args)
+
+
+def _run_discs(args: argparse.Namespace) -> int:
     import math
 
     from fractalgeo_rs.canopy import disc_canopy, projection_g
 
-    try:
-        zen = [float(v) for v in str(args.zenith).split(",") if v.strip()]
-    except ValueError:
-        raise ValueError(f"zenith: expected comma-separated angles in degrees, got {args.zenith!r}") from None
-    for z in zen:
-        if not 0.0 <= z < 90.0:
-            raise ValueError(f"zenith: expected degrees in [0, 90), got {z}")
+    zen = _zeniths(args.zenith)
+    leaf, soil = _leaf(args.leaf), _lambertian(args.soil, "--soil")
+    spp = 0 if args.spp is None else args.spp
     try:
         c = disc_canopy(lai=args.lai, leaf_radius=args.leaf_radius, extent=tuple(args.extent),
                         height=tuple(args.height), lad=_lad(args.lad), overlap=not args.no_overlap,
-                        sides=args.sides, seed=args.seed)
+                        sides=args.sides, seed=args.seed, leaf=leaf, soil=soil)
     except ValueError as e:
-        msg = str(e)
-        for py, opt in (("leaf_radius:", "--leaf-radius:"), ("lai:", "--lai:"), ("lad:", "--lad:"),
-                        ("extent:", "--extent:"), ("height:", "--height:"), ("sides:", "--sides:"),
-                        ("seed:", "--seed:")):
-            if msg.startswith(py):
-                msg = opt + msg[len(py):]
-                break
-        raise ValueError(msg) from None
+        raise _renamed(e, (("leaf_radius", "--leaf-radius"), ("lai", "--lai"), ("lad", "--lad"),
+                           ("extent", "--extent"), ("height", "--height"), ("sides", "--sides"),
+                           ("seed", "--seed"))) from None
     print(f"# canopy: {c.n_leaves} leaves, lai {c.lai:.6g}, lad {c.lad}, seed {c.seed}, {len(c.mesh)} triangles")
     if args.output:
         c.mesh.write(args.output)
         print(f"# mesh -> {args.output}")
-    if args.spp < 0:
-        raise ValueError(f"--spp: expected 0 (no tracing) or a positive number of rays, got {args.spp}")
-    scene = c.scene() if args.spp else None
+    if spp < 0:
+        raise ValueError(f"--spp: expected 0 (no tracing) or a positive number of rays, got {spp}")
+    scene = c.scene() if spp else None
     print("zenith,G,gap_exact,gap_beer" + (",gap_traced,gap_se,brf_nadir,brf_se" if scene else ""))
     for z in zen:
         g = projection_g(c.lad, z)
         beer = math.exp(-g * c.lai / math.cos(math.radians(z)))
         row = f"{z:g},{g:.6f},{float(c.gap_probability(z)):.6f},{beer:.6f}"
         if scene is not None:
-            gap = scene.gap_fraction(z, n=args.spp, seed=c.seed % 2**63, n_threads=args.n_threads)
-            brf = scene.brf(sun=(0.0, z), view="nadir", spp=args.spp, max_depth=args.max_depth,
+            gap = scene.gap_fraction(z, n=spp, seed=c.seed % 2**63, n_threads=args.n_threads)
+            brf = scene.brf(sun=(0.0, z), view="nadir", spp=spp, max_depth=args.max_depth,
                             seed=c.seed % 2**63, n_threads=args.n_threads)
             row += f",{gap.value:.6f},{gap.se:.2g},{brf.value:.6f},{brf.se:.2g}"
         print(row)
+    return 0
+
+
+def _read_dem(args: argparse.Namespace):
+    """Heights and ``(dy, dx)`` in metres of ``--dem`` (``--cell-size`` replaces the file's)."""
+    import numpy as np
+
+    from fractalgeo_rs.dem._cli import ground_cell_size
+    from fractalgeo_rs.io import read_raster
+
+    z, prof = read_raster(args.dem, band=args.band)
+    z = np.asarray(z, dtype=np.float64)
+    cell = None
+    if prof:
+        nodata = prof.get("nodata")
+        if nodata is not None and np.any(z == nodata):
+            raise ValueError(f"--dem: {int(np.sum(z == nodata))} nodata cell(s); fill them first "
+                             "(e.g. rasterio.fill.fillnodata)")
+        cell = ground_cell_size(prof, z.shape[0])
+    if args.cell_size is not None:
+        cell = (args.cell_size, args.cell_size)
+    if cell is None:
+        raise ValueError("--cell-size: the DEM has no georeferencing; pass --cell-size (metres)")
+    return z, cell
+
+
+def _run_plant(args: argparse.Namespace) -> int:
+    import sys
+
+    from fractalgeo_rs._progress import bar, resolve
+    from fractalgeo_rs.canopy import plant_stand
+
+    given = [opt for attr, opt in _DISC if getattr(args, attr) is not None]
+    if given:
+        raise ValueError(f"{given[0]}: disc mode only, not with --plant")
+    for attr, opt in (("density", "--density"), ("dem", "--dem")):
+        if getattr(args, attr) is None:
+            raise ValueError(f"{opt}: required with --plant")
+    zen = _zeniths(args.zenith)
+    spp = 65536 if args.spp is None else args.spp
+    if spp <= 0:
+        raise ValueError(f"--spp: expected a positive number of paths per BRF value, got {spp}")
+    if not 1 <= args.max_depth <= 100_000:
+        raise ValueError(f"--max-depth: expected 1 to 100000 scattering events, got {args.max_depth}")
+    leaf, soil = _leaf(args.leaf), _lambertian(args.soil, "--soil")
+    bark = None if args.bark is None else _lambertian(args.bark, "--bark")
+    z, cell = _read_dem(args)
+    try:
+        st = plant_stand(args.plant, args.density, z, cell_size=cell, bark=bark, leaf=leaf, soil=soil,
+                         scale=args.plant_scale, seed=args.seed)
+    except ValueError as e:
+        raise _renamed(e, (("plant", "--plant"), ("density", "--density"), ("dem", "--dem"),
+                           ("cell_size", "--cell-size"), ("scale", "--plant-scale"), ("seed", "--seed"),
+                           ("max_plants", "--density"))) from None
+    print(f"# stand: {len(st.bases)} {st.plant} plants, leaf area {st.leaf_area:.6g} m^2, lai {st.lai:.6g}, "
+          f"ground {st.extent[2]:.6g} m x {st.extent[3]:.6g} m (cells {cell[0]:.6g} m x {cell[1]:.6g} m), "
+          f"seed {st.seed}, {len(st.mesh)} triangles")
+    if args.output:
+        st.mesh.write(args.output)
+        print(f"# mesh -> {args.output} (triangle kinds = material ids: 0 soil, 1 bark, 2 leaf)")
+    print("sun_zenith,brf,se,single,single_se,multiple,multiple_se")
+    sys.stdout.flush()
+    scene = st.scene()
+    with bar(len(zen), "canopy brf", resolve(args.progress, cli=True)) as b:
+        for z_ in zen:
+            o = scene.brf_orders(sun=(0.0, z_), view="nadir", spp=spp, max_depth=args.max_depth,
+                                 seed=st.seed % 2**63, n_threads=args.n_threads)
+            print(f"{z_:g},{o.total.value:.6f},{o.total.se:.2g},{o.single.value:.6f},{o.single.se:.2g},"
+                  f"{o.multiple.value:.6f},{o.multiple.se:.2g}")
+            sys.stdout.flush()
+            b.update(1)
     return 0

@@ -25,10 +25,11 @@ from fractalgeo_rs.radiometry._scene import (
     Lambertian,
     OrenNayar,
     Phong,
+    ScatteringOrders,
     Scene,
     Specular,
 )
 from fractalgeo_rs.radiometry._plot import plot_brf_polar, plot_brf_principal_plane, plot_incidence_series
 
-__all__ = ["BiLambertian", "BrfSweep", "Estimate", "Hapke", "Lambertian", "OrenNayar", "PAPER_SUN_ZENITHS", "Phong", "Scene",
-           "Specular", "plot_brf_polar", "plot_brf_principal_plane", "plot_incidence_series"]
+__all__ = ["BiLambertian", "BrfSweep", "Estimate", "Hapke", "Lambertian", "OrenNayar", "PAPER_SUN_ZENITHS", "Phong",
+           "ScatteringOrders", "Scene", "Specular", "plot_brf_polar", "plot_brf_principal_plane", "plot_incidence_series"]

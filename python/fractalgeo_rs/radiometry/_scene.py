@@ -471,6 +471,47 @@ class Estimate:
 
 
 @dataclass(frozen=True)
+class ScatteringOrders:
+    """A reflectance factor split by scattering order (``Scene.brf_orders``).
+
+    The three estimates come from the same paths: per path, ``single`` is
+    its first-order next-event estimate of the sun (plus, with a sky, the
+    sky light of paths that leave after one scattering event), ``total``
+    the whole path and ``multiple`` their difference, so ``single.value +
+    multiple.value == total.value`` to rounding and each standard error is
+    that of its own per-path values (not a sum of standard errors).
+
+    Attributes
+    ----------
+    single : Estimate
+        Light scattered once; equals ``Scene.brf(..., max_depth=1)`` with
+        the same seed exactly.
+    multiple : Estimate
+        Light scattered 2 to ``max_depth`` times.
+    total : Estimate
+        All orders; equals ``Scene.brf(...)`` with the same arguments
+        exactly.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fractalgeo_rs.radiometry import Lambertian, Scene
+    >>> o = Scene.from_dem(np.zeros((4, 4)), material=Lambertian(0.3)).brf_orders(sun=(0.0, 30.0), spp=100)
+    >>> round(o.single.value, 9), o.multiple.value, o.multiple.se   # a plane scatters once
+    (0.3, 0.0, 0.0)
+
+    References
+    ----------
+    J. Ross, *The Radiation Regime and Architecture of Plant Stands*, Junk,
+    The Hague, 1981 (single and multiple scattering in canopies).
+    """
+
+    single: Estimate
+    multiple: Estimate
+    total: Estimate
+
+
+@dataclass(frozen=True)
 class BrfSweep:
     """BRFs over a grid of sun and view zenith angles (``Scene.brf_sweep``).
 
@@ -695,12 +736,20 @@ class Scene:
         #: ``(x0, y0, width, height)``: a mesh scene's tile or footprint, map coordinates.
         self.extent = extent
         self._core = core
+        # a one-material DEM scene builds its kernel scene on first use and
+        # keeps it (keyed by what it was built from, so changed attributes
+        # rebuild it); other scenes get theirs at construction
+        self._lazy_core = core is None
+        self._core_key: Optional[tuple] = None
         self.split = split
 
     def __getstate__(self) -> dict:
-        # the perspective images' weak references are per process: not pickled
+        # the perspective images' weak references are per process: not pickled;
+        # nor is a lazily built kernel scene (rebuilt on first use)
         state = dict(self.__dict__)
         state["_perspective"] = {}
+        if state.get("_lazy_core", False):
+            state["_core"], state["_core_key"] = None, None
         return state
 
     def __setstate__(self, state: dict) -> None:
@@ -1095,13 +1144,10 @@ class Scene:
 
     def _raw_brf(self, sun, view, sky: float, spp: int, depth: int, seed: int,
                  n_threads) -> Tuple[float, float, int]:
-        if self._core is not None:
-            if sky > 0.0:
-                return self._core.brf_sky(sun, view, sky, spp, depth, seed, n_threads)
-            return self._core.brf(sun, view, spp, depth, seed, n_threads)
+        core = self._scene_core()
         if sky > 0.0:
-            return _core.radiometry_brf_sky(*self._args(), sun, view, sky, spp, depth, seed, n_threads)
-        return _core.radiometry_brf(*self._args(), sun, view, spp, depth, seed, n_threads)
+            return core.brf_sky(sun, view, sky, spp, depth, seed, n_threads)
+        return core.brf(sun, view, spp, depth, seed, n_threads)
 
     def _dem(self) -> np.ndarray:
         if self.dem is None:
@@ -1114,13 +1160,6 @@ class Scene:
         dem = self._dem()
         cells = dem.shape if self.periodic else (dem.shape[0] - 1, dem.shape[1] - 1)
         return (int(cells[0]), int(cells[1]))
-
-    def _args(self) -> Tuple[np.ndarray, Tuple[float, float], bool, str, str, List[float]]:
-        name, params = self.material._spec()
-        if self.cell_size is None:
-            raise TypeError("a mesh scene has no cell size")
-        dy, dx = self.cell_size
-        return (self._dem(), (dx, dy), self.periodic, self.split, name, params)
 
     def brf(self, sun, view="nadir", spp: int = 65536, max_depth: int = 10, seed: int = 0,
             n_threads: Optional[int] = None, sky: float = 0.0) -> Estimate:
@@ -1189,6 +1228,71 @@ class Scene:
                                  check_n_threads(n_threads))
         return Estimate(v, se, n)
 
+    def brf_orders(self, sun, view="nadir", spp: int = 65536, max_depth: int = 10, seed: int = 0,
+                   n_threads: Optional[int] = None, sky: float = 0.0) -> ScatteringOrders:
+        """The reflectance factor of ``brf`` split into single and multiple
+        scattering over the same paths.
+
+        Each path is traced once: its first-order next-event estimate of the
+        sun (the sun's direct light on the first facet the sensor sees) is
+        its single-scattering value, the rest of the path (orders 2 to
+        ``max_depth``) its multiple-scattering value. With ``sky > 0`` the
+        sky light of paths leaving after one scattering event counts as
+        single scattering too. Random numbers are keyed by path and by
+        bounce, so ``single`` is exactly ``brf(..., max_depth=1)`` with the
+        same seed and ``total`` exactly ``brf(...)``; ``single.value +
+        multiple.value`` equals ``total.value`` to rounding, and
+        ``multiple.se`` is the standard error of the per-path differences
+        (smaller than what two separate runs would give).
+
+        Parameters
+        ----------
+        sun : (float, float)
+            Direction towards the sun, ``(azimuth, zenith)`` in degrees;
+            zenith in [0, 90).
+        view : (float, float) or "nadir"
+            Direction towards the sensor, same convention.
+        spp : int
+            Number of paths (> 0).
+        max_depth : int
+            Scattering events per path (>= 1; with 1, ``multiple`` is 0).
+        seed : int
+            Seed of the counter-based random numbers; the result is the same
+            for any ``n_threads``.
+        n_threads : int, optional
+            Threads (default: all cores).
+        sky : float
+            Irradiance of a uniform sky on a horizontal plane relative to
+            the sun's normal irradiance (>= 0), as in ``brf``; the parts are
+            then HDRFs.
+
+        Returns
+        -------
+        ScatteringOrders
+            ``single``, ``multiple`` and ``total``, each an ``Estimate``.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from fractalgeo_rs.radiometry import Lambertian, Scene
+        >>> x = np.arange(16)
+        >>> dem = np.where(x % 2 == 0, 0.0, 1.0)[None, :].repeat(16, axis=0)   # V-grooves
+        >>> s = Scene.from_dem(dem, material=Lambertian(0.5))
+        >>> o = s.brf_orders(sun=(90.0, 30.0), spp=4096)
+        >>> bool(o.multiple.value > 0), abs(o.single.value + o.multiple.value - o.total.value) < 1e-12
+        (True, True)
+
+        References
+        ----------
+        E. Veach, *Robust Monte Carlo Methods for Light Transport
+        Simulation*, PhD thesis, Stanford University, 1997 (path tracing
+        with next-event estimation).
+        """
+        (sv, sse), (mv, mse), (tv, tse), n = self._scene_core().brf_orders(
+            _direction(sun, "sun"), _direction(view, "view"), _sky(sky), _spp(spp), _depth(max_depth),
+            _seed(seed), check_n_threads(n_threads))
+        return ScatteringOrders(Estimate(sv, sse, n), Estimate(mv, mse, n), Estimate(tv, tse, n))
+
     def bhr(self, spp: int = 65536, max_depth: int = 100, seed: int = 0,
             n_threads: Optional[int] = None) -> Estimate:
         """Bi-hemispherical reflectance (white-sky albedo).
@@ -1234,10 +1338,7 @@ class Scene:
         (bi-hemispherical reflectance).
         """
         args = (_spp(spp), _depth(max_depth), _seed(seed), check_n_threads(n_threads))
-        if self._core is not None:
-            v, se, n = self._core.bhr(*args)
-        else:
-            v, se, n = _core.radiometry_bhr(*self._args(), *args)
+        v, se, n = self._scene_core().bhr(*args)
         return Estimate(v, se, n)
 
     def albedo(self, sun, spp: int = 65536, max_depth: int = 100, seed: int = 0,
@@ -1285,19 +1386,26 @@ class Scene:
         """
         args = (_direction(sun, "sun"), _spp(spp), _depth(max_depth), _seed(seed),
                 check_n_threads(n_threads))
-        if self._core is not None:
-            v, se, n = self._core.albedo(*args)
-        else:
-            v, se, n = _core.radiometry_albedo(*self._args(), *args)
+        v, se, n = self._scene_core().albedo(*args)
         return Estimate(v, se, n)
 
     def _scene_core(self):
-        """The kept ``_core.RadiometryScene`` (built for a one-material DEM scene)."""
-        if self._core is not None:
+        """The kernel scene (``_core.RadiometryScene``): a one-material DEM
+        scene builds it on first use and keeps it, rebuilt when ``dem``,
+        ``cell_size``, ``periodic``, ``split`` or ``material`` change."""
+        if not self._lazy_core:
             return self._core
-        dy, dx = self.cell_size
-        return _core.RadiometryScene.from_dem(self.dem, (dx, dy), self.periodic, self.split,
-                                              [self.material._spec()], None)
+        dem, cell_size = self._dem(), self.cell_size
+        if cell_size is None:
+            raise TypeError("a mesh scene has no cell size")
+        name, params = self.material._spec()
+        key = (id(dem), dem.shape, tuple(cell_size), bool(self.periodic), self.split, name, tuple(params))
+        if self._core is None or self._core_key != key:
+            dy, dx = cell_size
+            self._core = _core.RadiometryScene.from_dem(dem, (dx, dy), self.periodic, self.split,
+                                                        [(name, list(params))], None)
+            self._core_key = key
+        return self._core
 
     def gap_fraction(self, zenith, azimuth: float = 0.0, n: int = 65536, ground: int = 0, seed: int = 0,
                      n_threads: Optional[int] = None) -> "Estimate":
@@ -1500,19 +1608,13 @@ class Scene:
         sd = (_direction(sun, "sun"), _direction(view, "view"))
         rest = (check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed))
         nt = check_n_threads(n_threads)
-        core = self._core
+        core = self._scene_core()
         with _progress.Steps(rows, "render", _progress.resolve(progress)) as steps:
-            if core is not None:
-                if sky == 0.0 and kind == "box":
-                    return steps.counted(lambda counter: core.render(
-                        *sd, (rows, cols), *rest, nt, progress=counter), rows)
-                return steps.counted(lambda counter: core.render_psf(
-                    *sd, sky, (rows, cols), *rest, kind, pparams, table, nt, progress=counter), rows)
             if sky == 0.0 and kind == "box":
-                return steps.counted(lambda counter: _core.radiometry_render(
-                    *self._args(), *sd, (rows, cols), *rest, nt, progress=counter), rows)
-            return steps.counted(lambda counter: _core.radiometry_render_psf(
-                *self._args(), *sd, sky, (rows, cols), *rest, kind, pparams, table, nt, progress=counter), rows)
+                return steps.counted(lambda counter: core.render(
+                    *sd, (rows, cols), *rest, nt, progress=counter), rows)
+            return steps.counted(lambda counter: core.render_psf(
+                *sd, sky, (rows, cols), *rest, kind, pparams, table, nt, progress=counter), rows)
 
     def render_perspective(self, sun, view=(135.0, 60.0), distance: Optional[float] = None, eye=None,
                            target=None, fov: float = 40.0, shape: Tuple[int, int] = (240, 320), spp: int = 16,
@@ -1606,13 +1708,9 @@ class Scene:
 
         args = (_direction(sun, "sun"), _sky(sky), e, tgt, float(fov), (rows, cols),
                 check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed), check_n_threads(n_threads))
-        core = self._core
+        core = self._scene_core()
         with _progress.Steps(rows, "render", _progress.resolve(progress)) as steps:
-            if core is not None:
-                img = steps.counted(lambda counter: core.render_perspective(*args, progress=counter), rows)
-            else:
-                img = steps.counted(lambda counter: _core.radiometry_render_perspective(
-                    *self._args(), *args, progress=counter), rows)
+            img = steps.counted(lambda counter: core.render_perspective(*args, progress=counter), rows)
         key = id(img)
         self._perspective[key] = weakref.ref(img, lambda _r, k=key, d=self._perspective: d.pop(k, None))
         return img
