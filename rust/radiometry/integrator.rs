@@ -14,7 +14,11 @@
 //! with per-facet materials.
 //!
 //! BRF = `pi * L / cos(sun zenith)` with `L` the radiance averaged over the
-//! horizontal reference area (unit irradiance normal to the beam). The
+//! horizontal reference area (unit irradiance normal to the beam). The BRF
+//! draws its sensor points and scattering directions from independently
+//! Owen-scrambled Sobol sequences (randomised quasi-Monte Carlo, its error
+//! the spread of the replicates); images and albedos use independent
+//! uniforms. The
 //! directional-hemispherical albedo follows rays from the sun: each carries
 //! the product of the sampling weights of its scattering events and counts
 //! when it escapes upwards (or, without periodicity, through a side).
@@ -42,7 +46,8 @@ pub const MAX_DEPTH: u32 = 100_000;
 pub struct Estimate {
     /// Sample mean.
     pub value: f64,
-    /// Standard error of the mean (sample standard deviation / sqrt(n)).
+    /// Standard error of the mean: sample standard deviation / sqrt(n), or
+    /// for the BRF the spread of its replicate means ([`Scene::brf_sky`]).
     pub se: f64,
     /// Number of paths.
     pub n: u64,
@@ -85,7 +90,7 @@ pub struct Scene<G: Tracer = Heightfield> {
 const TAG_BRF: u64 = 0x6272_6600_0000_0000;
 const TAG_ALBEDO: u64 = 0x616c_6200_0000_0000;
 const TAG_IMAGE: u64 = 0x696d_6700_0000_0000;
-const TAG_STRATA: u64 = 0x7374_7200_0000_0000;
+const TAG_SOBOL: u64 = 0x736f_6200_0000_0000;
 
 fn check_spp(spp: u64) -> CoreResult<()> {
     if spp == 0 {
@@ -107,18 +112,91 @@ fn check_depth(max_depth: u32) -> CoreResult<()> {
     Ok(())
 }
 
-/// Strata of the BRF estimator: each full block of [`BLOCK`] paths puts one
-/// point in each of `STRATA x STRATA` equal cells of the tile.
-const STRATA: u64 = 32;
-const _: () = assert!(STRATA * STRATA == BLOCK);
+/// The uniforms of one path, by dimension (a pure function of the path).
+trait PathSampler {
+    /// The uniform in (0, 1) of dimension `dim`.
+    fn uniform(&mut self, dim: u64) -> f64;
+}
 
-/// Mean and standard error of a stratified estimate from per-block
-/// `(sum, sum of squares, n)`: full blocks are independent stratified
-/// samples, so the standard error comes from the spread of the block means
-/// (the per-path formula would overstate it); with fewer than 8 blocks, the
-/// per-path formula (conservative) is used. The standard error is at least
+impl PathSampler for StreamKey {
+    #[inline(always)]
+    fn uniform(&mut self, dim: u64) -> f64 {
+        StreamKey::uniform(*self, dim)
+    }
+}
+
+/// Points per Owen-scrambled Sobol sequence ([`sobol_burley`] supports 2^16).
+const SOBOL_POINTS: u64 = 1 << 16;
+
+/// Dimensions taken from the Sobol sequence (the crate's 256); later ones
+/// are independent uniforms.
+const SOBOL_DIMS: u64 = sobol_burley::NUM_DIMENSIONS as u64;
+
+/// The fewest independently scrambled replicates of an RQMC estimate (its
+/// standard error is the spread of their means).
+const MIN_REPLICATES: u64 = 16;
+
+/// Replicates of a BRF estimate over `spp` paths: 16, or as many as keep
+/// each at most 2^16 points; never more than `spp`.
+pub fn replicates(spp: u64) -> u64 {
+    spp.div_ceil(SOBOL_POINTS).max(MIN_REPLICATES).min(spp)
+}
+
+/// Point `index` of an Owen-scrambled Sobol sequence (Burley 2020, the
+/// [`sobol_burley`] crate) with scramble seed `seed`: dimension `d < 256`
+/// is the sequence's 23-bit value plus an independent uniform below its
+/// last bit (so each coordinate is uniform on (0, 1) and the net structure
+/// is kept); later dimensions are independent uniforms from `jitter`.
+struct SobolPath {
+    index: u32,
+    seed: u32,
+    jitter: StreamKey,
+    set: u32,
+    cache: [f32; 4],
+}
+
+impl SobolPath {
+    #[inline]
+    fn new(index: u32, seed: u32, jitter: StreamKey) -> Self {
+        SobolPath {
+            index,
+            seed,
+            jitter,
+            set: u32::MAX,
+            cache: [0.0; 4],
+        }
+    }
+}
+
+/// The last bit of [`sobol_burley`]'s values, 2^-23.
+const SOBOL_ULP: f64 = 1.0 / (1u64 << 23) as f64;
+
+/// The largest f64 below 1.
+const BELOW_ONE: f64 = 1.0 - f64::EPSILON / 2.0;
+
+impl PathSampler for SobolPath {
+    #[inline]
+    fn uniform(&mut self, dim: u64) -> f64 {
+        let j = self.jitter.uniform(dim);
+        if dim >= SOBOL_DIMS {
+            return j;
+        }
+        let set = (dim / 4) as u32;
+        if set != self.set {
+            self.cache = sobol_burley::sample_4d(self.index, set, self.seed);
+            self.set = set;
+        }
+        (f64::from(self.cache[(dim % 4) as usize]) + j * SOBOL_ULP).min(BELOW_ONE)
+    }
+}
+
+/// Mean and standard error of a randomised quasi-Monte Carlo estimate from
+/// per-replicate `(sum, sum of squares, n)`: replicates are independent, so
+/// the standard error comes from the spread of their means (the per-path
+/// formula would overstate it); with fewer than 8 replicates (fewer than 8
+/// paths), the per-path formula is used. The standard error is at least
 /// 1e-12 of the value (the rounding of the sums).
-fn finish_stratified(blocks: &[(f64, f64, u64)]) -> Estimate {
+fn finish_replicates(blocks: &[(f64, f64, u64)]) -> Estimate {
     let e = finish(blocks);
     let k = blocks.len();
     if k < 8 {
@@ -239,11 +317,11 @@ impl<G: Tracer> Scene<G> {
     /// leaving along local `wo`: the new world direction and the sampling
     /// weight, from the uniforms `dim`, `dim + 1` of `key` (`dim` advances).
     #[inline]
-    fn scatter(
+    fn scatter<S: PathSampler>(
         m: &dyn Bsdf,
         (t, b, n): (DVec3, DVec3, DVec3),
         wo: DVec3,
-        key: StreamKey,
+        key: &mut S,
         dim: &mut u64,
     ) -> Option<(DVec3, f64)> {
         let u = [key.uniform(*dim), key.uniform(*dim + 1)];
@@ -279,14 +357,14 @@ impl<G: Tracer> Scene<G> {
     /// - 1)`, `dim + 2 k - 1` whatever `max_depth` is, so `l1` is bit for bit
     /// the `l` of the same path with `max_depth = 1`.
     #[allow(clippy::too_many_arguments)]
-    fn radiance_orders(
+    fn radiance_orders<S: PathSampler>(
         &self,
         mut o: DVec3,
         v: DVec3,
         s: DVec3,
         sky_l: f64,
         max_depth: u32,
-        key: StreamKey,
+        key: &mut S,
         mut dim: u64,
     ) -> (f64, f64) {
         let hf = &self.hf;
@@ -331,7 +409,7 @@ impl<G: Tracer> Scene<G> {
             if depth == max_depth && sky_l == 0.0 {
                 break;
             }
-            let Some((wi, weight)) = Self::scatter(m, (t, b, n), wo, key, &mut dim) else {
+            let Some((wi, weight)) = Self::scatter(m, (t, b, n), wo, &mut *key, &mut dim) else {
                 break;
             };
             throughput *= weight;
@@ -348,14 +426,14 @@ impl<G: Tracer> Scene<G> {
     /// The radiance of [`Scene::radiance_orders`] (all orders).
     #[allow(clippy::too_many_arguments)]
     #[inline]
-    fn radiance(
+    fn radiance<S: PathSampler>(
         &self,
         o: DVec3,
         v: DVec3,
         s: DVec3,
         sky_l: f64,
         max_depth: u32,
-        key: StreamKey,
+        key: &mut S,
         dim: u64,
     ) -> f64 {
         self.radiance_orders(o, v, s, sky_l, max_depth, key, dim).0
@@ -380,9 +458,14 @@ impl<G: Tracer> Scene<G> {
     /// normal to the beam) plus an isotropic sky whose irradiance on a
     /// horizontal plane is `sky` (same unit): `pi L / (cos(sun zenith) +
     /// sky)`, the hemispherical-directional reflectance factor (HDRF); the
-    /// BRF for `sky = 0`. Sensor points are stratified over the footprint
-    /// (one per cell of a 32 x 32 division in each full block of 1024 paths).
-    /// The `total` of [`Scene::brf_orders`].
+    /// BRF for `sky = 0`: the `total` of [`Scene::brf_orders`].
+    ///
+    /// Randomised quasi-Monte Carlo: the `spp` paths are split into
+    /// [`replicates`]`(spp)` independently Owen-scrambled Sobol sequences
+    /// (at most 2^16 points each); point `i` of a sequence gives the sensor
+    /// point (dimensions 0, 1) and the scattering draws (2, 3 for the first
+    /// bounce, and so on) of one path. The value is the mean of all paths
+    /// and its standard error the spread of the replicate means.
     pub fn brf_sky(
         &self,
         sun: DVec3,
@@ -421,27 +504,33 @@ impl<G: Tracer> Scene<G> {
         let ytop = y0 + h;
         let norm = PI / (sun.z + sky);
         let sky_l = sky / PI;
+        let reps = replicates(spp);
+        let (base, extra) = (spp / reps, spp % reps);
+        let size = |r: u64| base + u64::from(r < extra);
+        // work items (replicate, block of up to BLOCK points), replicate-major
+        let items: Vec<(u64, u64)> = (0..reps)
+            .flat_map(|r| (0..size(r).div_ceil(BLOCK)).map(move |b| (r, b)))
+            .collect();
         type Sums = [(f64, f64, u64); 3];
-        let blocks: Vec<Sums> = (0..spp.div_ceil(BLOCK))
+        let sums: Vec<Sums> = items
             .into_par_iter()
-            .map(|blk| {
+            .map(|(r, blk)| {
+                let scramble = (StreamKey::new(seed, TAG_SOBOL ^ r).bits(0) >> 32) as u32;
                 // (total, single, multiple): sum and sum of squares
                 let mut acc = [(0.0, 0.0); 3];
-                let end = ((blk + 1) * BLOCK).min(spp);
-                // path j of the block takes stratum (797 j + b) mod 1024, an odd
-                // multiplier and a random offset per block: every stratum once
-                // in a full block, and each point uniform over the tile
-                let off = (StreamKey::new(seed, TAG_STRATA ^ blk).uniform(0) * BLOCK as f64) as u64;
+                let end = ((blk + 1) * BLOCK).min(size(r));
                 for i in blk * BLOCK..end {
-                    let key = StreamKey::new(seed, TAG_BRF ^ i);
-                    let st = (797 * (i - blk * BLOCK) + off) % BLOCK;
-                    let (sx, sy) = ((st % STRATA) as f64, (st / STRATA) as f64);
-                    let x = x0 + (sx + key.uniform(0)) / STRATA as f64 * w;
-                    let y = ytop - (sy + key.uniform(1)) / STRATA as f64 * h;
+                    let mut u = SobolPath::new(
+                        i as u32,
+                        scramble,
+                        StreamKey::new(seed, TAG_BRF ^ (r << 16 | i)),
+                    );
+                    let x = x0 + u.uniform(0) * w;
+                    let y = ytop - u.uniform(1) * h;
                     let o = self.sensor_ray(x, y, view);
-                    let (l, l1) = self.radiance_orders(o, view, sun, sky_l, max_depth, key, 2);
-                    let (r, r1) = (norm * l, norm * l1);
-                    for (a, x) in acc.iter_mut().zip([r, r1, r - r1]) {
+                    let (l, l1) = self.radiance_orders(o, view, sun, sky_l, max_depth, &mut u, 2);
+                    let (t, t1) = (norm * l, norm * l1);
+                    for (a, x) in acc.iter_mut().zip([t, t1, t - t1]) {
                         a.0 += x;
                         a.1 += x * x;
                     }
@@ -450,9 +539,21 @@ impl<G: Tracer> Scene<G> {
                 acc.map(|(s1, s2)| (s1, s2, k))
             })
             .collect();
+        // per-replicate sums of each part, blocks added in order
         let part = |j: usize| {
-            let b: Vec<(f64, f64, u64)> = blocks.iter().map(|s| s[j]).collect();
-            finish_stratified(&b)
+            let mut per_rep: Vec<(f64, f64, u64)> = Vec::with_capacity(reps as usize);
+            let mut k = 0;
+            for r in 0..reps {
+                let (mut a, mut b, mut n) = (0.0, 0.0, 0);
+                for _ in 0..size(r).div_ceil(BLOCK) {
+                    a += sums[k][j].0;
+                    b += sums[k][j].1;
+                    n += sums[k][j].2;
+                    k += 1;
+                }
+                per_rep.push((a, b, n));
+            }
+            finish_replicates(&per_rep)
         };
         Ok(OrderSplit {
             total: part(0),
@@ -470,7 +571,7 @@ impl<G: Tracer> Scene<G> {
         sun: DVec3,
         (x, y): (f64, f64),
         max_depth: u32,
-        key: StreamKey,
+        mut key: StreamKey,
         mut dim: u64,
     ) -> f64 {
         let hf = &self.hf;
@@ -497,7 +598,7 @@ impl<G: Tracer> Scene<G> {
             // reciprocity: sample the reflected direction as an incident
             // one for the light's arrival direction
             let m = self.bsdf(facet);
-            let Some((wi, weight)) = Self::scatter(m, (t, b, n), wo, key, &mut dim) else {
+            let Some((wi, weight)) = Self::scatter(m, (t, b, n), wo, &mut key, &mut dim) else {
                 return 0.0;
             };
             throughput *= weight;
@@ -646,7 +747,7 @@ impl<G: Tracer> Scene<G> {
                     let x = x0 + (j as f64 + fx) * pw;
                     let y = ytop - (i as f64 + fy) * ph;
                     let o = self.sensor_ray(x, y, view);
-                    s += self.radiance(o, view, sun, sky_l, max_depth, key, 2);
+                    s += self.radiance(o, view, sun, sky_l, max_depth, &mut { key }, 2);
                 }
                 *px = (s / spp as f64) as f32;
             }
@@ -703,7 +804,7 @@ impl<G: Tracer> Scene<G> {
                     };
                     s += match o {
                         Some(o) if hf.trace(o, d, None).is_some() => {
-                            self.radiance(o, -d, sun, sky_l, max_depth, key, 2)
+                            self.radiance(o, -d, sun, sky_l, max_depth, &mut { key }, 2)
                         }
                         _ if d.z > 0.0 => sky_l,
                         _ => 0.0,
@@ -963,5 +1064,44 @@ impl Pinhole {
         let sx = (2.0 * col / cols as f64 - 1.0) * self.tan_half * aspect;
         let sy = (1.0 - 2.0 * row / rows as f64) * self.tan_half;
         (self.fwd + sx * self.right + sy * self.up).normalize()
+    }
+}
+
+#[cfg(test)]
+mod sobol_tests {
+    use super::*;
+
+    /// The first 2^10 points of a replicate put one point in each of the
+    /// 32 x 32 cells of dimensions (0, 1) (a (0, 10, 2)-net: the sensor
+    /// points) and in each of the 1024 intervals of every other dimension
+    /// used (each one a (0, 1)-sequence); every coordinate lies in (0, 1).
+    #[test]
+    fn replicate_prefixes_are_nets() {
+        for (seed, scramble) in [(0u64, 0u32), (7, 0x9e37_79b9), (123, 42)] {
+            let mut cells = vec![0u32; 1024];
+            let mut slots = vec![vec![0u32; 1024]; 22];
+            for i in 0..1024u32 {
+                let mut p = SobolPath::new(i, scramble, StreamKey::new(seed, i as u64));
+                let u: Vec<f64> = (0..22).map(|d| p.uniform(d)).collect();
+                assert!(u.iter().all(|&x| x > 0.0 && x < 1.0));
+                cells[(u[0] * 32.0) as usize * 32 + (u[1] * 32.0) as usize] += 1;
+                for (d, x) in u.iter().enumerate() {
+                    slots[d][(x * 1024.0) as usize] += 1;
+                }
+            }
+            assert!(cells.iter().all(|&c| c == 1), "{seed}");
+            for (d, sl) in slots.iter().enumerate() {
+                assert!(sl.iter().all(|&c| c == 1), "{seed} {d}");
+            }
+        }
+    }
+
+    #[test]
+    fn replicates_hold_at_most_2_pow_16_points() {
+        for spp in [1, 7, 16, 17, 1000, 1 << 20, (1 << 20) + 1, 5 << 20] {
+            let r = replicates(spp);
+            assert!(r <= spp && spp.div_ceil(r) <= SOBOL_POINTS, "{spp} {r}");
+            assert!(r == spp || r >= MIN_REPLICATES);
+        }
     }
 }

@@ -442,8 +442,12 @@ class Estimate:
     value : float
         The sample mean.
     se : float
-        Its standard error (sample standard deviation / sqrt(n)); 0 when
-        every path gives the same value (e.g. a flat Lambertian plane).
+        Its standard error: for ``albedo`` and ``bhr`` the sample standard
+        deviation / sqrt(n); for ``brf`` the spread of the means of its
+        independently scrambled quasi-Monte Carlo replicates / sqrt(number
+        of replicates). 0 (``albedo``) or 1e-12 of the value (``brf``, the
+        rounding of the sums) when every path gives the same value (e.g. a
+        flat Lambertian plane).
     n : int
         Number of paths.
 
@@ -616,10 +620,11 @@ def _depth(value) -> int:
 
 
 def _spp(value) -> int:
-    """Paths of one estimate; the kernel keeps one partial sum (24 bytes) per
-    block of 1024 paths, checked against the memory limit before the call."""
+    """Paths of one estimate; the kernel keeps one partial sum (at most 40
+    bytes) per block of up to 1024 paths (of each replicate of the BRF),
+    checked against the memory limit before the call."""
     n = check_positive_int(value, "spp")
-    check_memory(-(-n // 1024) * 24, "spp", what=f"spp={n} paths (24 bytes per block of 1024)")
+    check_memory((-(-n // 1024) + 16) * 40, "spp", what=f"spp={n} paths (40 bytes per block of 1024)")
     return n
 
 
@@ -1176,7 +1181,13 @@ class Scene:
         view : (float, float) or "nadir"
             Direction towards the sensor, same convention.
         spp : int
-            Number of paths (> 0); the standard error falls as 1/sqrt(spp).
+            Number of paths (> 0). They are randomised quasi-Monte Carlo
+            points: ``max(16, ceil(spp / 65536))`` independently
+            Owen-scrambled Sobol sequences (replicates) give the sensor
+            point and the scattering directions; ``se`` is the spread of
+            the replicate means. The standard error falls at least as fast
+            as 1/sqrt(spp), faster where the radiance is smooth over the
+            tile (at a grazing sun the shadows limit the gain).
         max_depth : int
             Scattering events per path: 1 = single scattering. Light of
             order k is about ``rho**k``; raise it for bright surfaces.
