@@ -383,8 +383,8 @@ def test_absorbed_plus_reflected_is_one_and_fapar_splits():
 
 def test_canopy_brf_is_reciprocal_and_thread_count_free():
     s = disc_canopy(lai=2.0, leaf_radius=0.1, extent=1.5, height=(0.2, 1.0), lad="erectophile", seed=6).scene()
-    a = s.brf(sun=(0.0, 30.0), view=(120.0, 50.0), spp=40_000, seed=1)
-    b = s.brf(sun=(120.0, 50.0), view=(0.0, 30.0), spp=40_000, seed=2)
+    a = s.brf(sun=(0.0, 30.0), view=(120.0, 50.0), spp=40_000, seed=1, reciprocity=False)
+    b = s.brf(sun=(120.0, 50.0), view=(0.0, 30.0), spp=40_000, seed=2, reciprocity=False)
     assert abs(a.value - b.value) < 3 * np.hypot(a.se, b.se), (a, b)
     assert s.brf(sun=(0.0, 30.0), spp=3000, seed=3, n_threads=1) == s.brf(sun=(0.0, 30.0), spp=3000, seed=3,
                                                                             n_threads=2)

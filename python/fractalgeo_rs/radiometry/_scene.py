@@ -1142,9 +1142,26 @@ class Scene:
         return cls(None, None, bool(periodic), mats[0], "ne-sw", materials=mats, material_ids=ids, extent=ext,
                    core=core)
 
+    def _swap(self, sun, view, sky: float, reciprocity: Optional[bool]) -> bool:
+        """Whether to trace the reciprocal configuration (sun and view
+        exchanged): with ``None``, when that is allowed (a periodic scene,
+        no sky; every reflectance model here is reciprocal) and the sun is
+        lower than the sensor, so the sun's next-event estimate sees fewer
+        shadows."""
+        if reciprocity is None:
+            return bool(self.periodic) and sky == 0.0 and float(sun[1]) > float(view[1])
+        if not isinstance(reciprocity, (bool, np.bool_)):
+            raise TypeError(f"reciprocity: expected None, True or False, got {reciprocity!r}")
+        if reciprocity and (not self.periodic or sky != 0.0):
+            raise ValueError("reciprocity: exchanging sun and view needs a periodic scene and sky=0 "
+                             f"(periodic={self.periodic}, sky={sky})")
+        return bool(reciprocity)
+
     def _raw_brf(self, sun, view, sky: float, spp: int, depth: int, seed: int,
-                 n_threads) -> Tuple[float, float, int]:
+                 n_threads, reciprocity: Optional[bool] = None) -> Tuple[float, float, int]:
         core = self._scene_core()
+        if self._swap(sun, view, sky, reciprocity):
+            sun, view = view, sun
         if sky > 0.0:
             return core.brf_sky(sun, view, sky, spp, depth, seed, n_threads)
         return core.brf(sun, view, spp, depth, seed, n_threads)
@@ -1162,7 +1179,8 @@ class Scene:
         return (int(cells[0]), int(cells[1]))
 
     def brf(self, sun, view="nadir", spp: int = 65536, max_depth: int = 10, seed: int = 0,
-            n_threads: Optional[int] = None, sky: float = 0.0) -> Estimate:
+            n_threads: Optional[int] = None, sky: float = 0.0,
+            reciprocity: Optional[bool] = None) -> Estimate:
         """Bidirectional reflectance factor of the whole tile.
 
         ``BRF = pi L / cos(sun zenith)``, with ``L`` the radiance towards
@@ -1204,6 +1222,19 @@ class Scene:
             zenith) + sky)``, ``L`` including the sky light scattered up to
             ``max_depth`` times; a flat Lambertian plane still gives
             ``rho``.
+        reciprocity : bool, optional
+            Trace the reciprocal configuration, sun and view exchanged
+            (Helmholtz reciprocity: the tile's BRF, each scattering order
+            included, is symmetric in sun and view for a periodic scene of
+            reciprocal reflectance models, which all models here are).
+            ``None`` (default): exchange them when the scene is periodic,
+            ``sky`` is 0 and the sun is lower than the sensor, so the
+            sun's next-event estimate sees fewer shadows (same value, much
+            smaller standard error at a grazing sun: at 89 degrees with a
+            nadir sensor on a rough fBm tile, about 800 times less
+            variance per path). ``False``: always trace from the sensor
+            (what a test of reciprocity needs). ``True``: always exchange
+            (a ValueError on a finite patch or with sky light).
 
         Returns
         -------
@@ -1225,11 +1256,12 @@ class Scene:
         """
         v, se, n = self._raw_brf(_direction(sun, "sun"), _direction(view, "view"), _sky(sky),
                                  _spp(spp), _depth(max_depth), _seed(seed),
-                                 check_n_threads(n_threads))
+                                 check_n_threads(n_threads), reciprocity)
         return Estimate(v, se, n)
 
     def brf_orders(self, sun, view="nadir", spp: int = 65536, max_depth: int = 10, seed: int = 0,
-                   n_threads: Optional[int] = None, sky: float = 0.0) -> ScatteringOrders:
+                   n_threads: Optional[int] = None, sky: float = 0.0,
+                   reciprocity: Optional[bool] = None) -> ScatteringOrders:
         """The reflectance factor of ``brf`` split into single and multiple
         scattering over the same paths.
 
@@ -1265,6 +1297,9 @@ class Scene:
             Irradiance of a uniform sky on a horizontal plane relative to
             the sun's normal irradiance (>= 0), as in ``brf``; the parts are
             then HDRFs.
+        reciprocity : bool, optional
+            As in ``brf`` (each scattering order is reciprocal on its own,
+            so the split holds in the exchanged configuration too).
 
         Returns
         -------
@@ -1288,9 +1323,11 @@ class Scene:
         Simulation*, PhD thesis, Stanford University, 1997 (path tracing
         with next-event estimation).
         """
+        sun, view, sky = _direction(sun, "sun"), _direction(view, "view"), _sky(sky)
+        if self._swap(sun, view, sky, reciprocity):
+            sun, view = view, sun
         (sv, sse), (mv, mse), (tv, tse), n = self._scene_core().brf_orders(
-            _direction(sun, "sun"), _direction(view, "view"), _sky(sky), _spp(spp), _depth(max_depth),
-            _seed(seed), check_n_threads(n_threads))
+            sun, view, sky, _spp(spp), _depth(max_depth), _seed(seed), check_n_threads(n_threads))
         return ScatteringOrders(Estimate(sv, sse, n), Estimate(mv, mse, n), Estimate(tv, tse, n))
 
     def bhr(self, spp: int = 65536, max_depth: int = 100, seed: int = 0,
@@ -1717,7 +1754,8 @@ class Scene:
 
     def brf_sweep(self, sun_zenith=PAPER_SUN_ZENITHS, view_zenith=(0.0,), sun_azimuth: float = 0.0,
                   view_azimuth: float = 0.0, spp: int = 65536, max_depth: int = 10, seed: int = 0,
-                  n_threads: Optional[int] = None, progress: Optional[bool] = None, sky: float = 0.0) -> BrfSweep:
+                  n_threads: Optional[int] = None, progress: Optional[bool] = None, sky: float = 0.0,
+                  reciprocity: Optional[bool] = None) -> BrfSweep:
         """BRF over every pair of sun and view zenith angles.
 
         One ``brf`` per pair (each with the same ``seed``: common random
@@ -1742,6 +1780,8 @@ class Scene:
         sky : float
             Horizontal irradiance of a uniform sky, as in ``brf`` (the
             values are then HDRFs).
+        reciprocity : bool, optional
+            As in ``brf``, for every pair.
 
         Returns
         -------
@@ -1775,7 +1815,7 @@ class Scene:
             for i, zs in enumerate(suns):
                 for j, zv in enumerate(views):
                     value[i, j], se[i, j], _ = self._raw_brf(
-                        (az_s, float(zs)), (az_v, float(zv)), sky, spp, depth, seed, n_threads)
+                        (az_s, float(zs)), (az_v, float(zv)), sky, spp, depth, seed, n_threads, reciprocity)
                     bar.update(1)
         return BrfSweep(suns, views, az_s, az_v, value, se, spp)
 
