@@ -19,9 +19,10 @@ at lags 1-2 (:func:`fractalgeo_rs.variogram`), as does the DEM itself:
   degrees, looking east, Kirchhoff facets) without speckle and with 4 looks.
 
 If the premise held, every line would follow the dotted 1:1 line. Only the
-DEM does. The images read higher and over a compressed range (an image is a
-function of the surface's gradient, rougher than the surface), the order of
-the surfaces survives without speckle, and 4-look speckle flattens it. The
+DEM does. The images compress the range of dimensions (without speckle their
+lines rise with slopes of about 0.3 to 0.45 instead of 1: an image is a
+function of the surface's gradient, not of its heights), the order of the
+surfaces survives without speckle, and 4-look speckle flattens it. The
 rendered image reads higher than hillshade: Horn's 3 x 3 gradients smooth
 what the renderer's facets do not. docs/radar.md ("The premise, measured")
 has the full tables over four estimators, two seeds and more renderers.
