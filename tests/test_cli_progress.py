@@ -50,3 +50,32 @@ def test_transform_chunks_progress_uses_dask_bar(tmp_path, scene, capsys):
     assert code == 0 and "Completed" in err
     code, mem, _ = _transform(tmp_path, scene, capsys, name="m.npy")
     np.testing.assert_allclose(lazy, mem, equal_nan=True)
+
+
+def _sar(tmp_path, scene, capsys, *extra, name="s.npy"):
+    out = tmp_path / name
+    code = main(["sar", str(scene), str(out), "--cell-size", "10", "--incidence", "35", "--looks", "4",
+                 "--seed", "3", *extra])
+    cap = capsys.readouterr()
+    return code, np.load(out), cap.err
+
+
+def test_sar_progress_flags(tmp_path, scene, capsys):
+    pytest.importorskip("tqdm")
+    code, quiet, err = _sar(tmp_path, scene, capsys, name="a.npy")  # stderr is not a terminal here
+    assert code == 0 and "radar.simulate" not in err
+    code, shown, err = _sar(tmp_path, scene, capsys, "--progress", name="b.npy")
+    assert code == 0 and "radar.simulate" in err
+    code, off, err = _sar(tmp_path, scene, capsys, "--no-progress", name="c.npy")
+    assert code == 0 and "radar.simulate" not in err
+    np.testing.assert_array_equal(quiet, shown)
+    np.testing.assert_array_equal(quiet, off)
+
+
+def test_sar_progress_on_at_a_terminal(tmp_path, scene, capsys, monkeypatch):
+    pytest.importorskip("tqdm")
+    from fractalgeo_rs import _progress
+
+    monkeypatch.setattr(_progress.sys.stderr, "isatty", lambda: True, raising=False)
+    code, _, err = _sar(tmp_path, scene, capsys, "--look-azimuth", "0")
+    assert code == 0 and "radar.simulate" in err

@@ -558,6 +558,7 @@ def radar_scene(
     n_threads: Optional[int] = None,
     row0: int = 0,
     slant: Optional[Tuple[float, int]] = None,
+    progress: Optional[ProgressCounter] = None,
 ) -> Tuple[
     npt.NDArray[np.float64],
     npt.NDArray[np.float64],

@@ -1,5 +1,6 @@
 //! Bindings of `crate::radar`: speckle and the side-looking geometry.
 use super::convert::{array2, c_order, run};
+use super::progress::{counter, ProgressCounter};
 use crate::radar::geometry;
 use crate::radar::speckle::{self, Placement};
 use numpy::{PyArray2, PyReadonlyArray2};
@@ -164,7 +165,7 @@ fn radar_geocode<'py>(
 /// of its first line, `slant = (lo, n_bins)` the whole scene's slant axis
 /// (from `radar_slant_extent`).
 #[pyfunction]
-#[pyo3(signature = (dem, dx, dy, incidence, table, table_step, looks, seed, n_threads=None, row0=0, slant=None))]
+#[pyo3(signature = (dem, dx, dy, incidence, table, table_step, looks, seed, n_threads=None, row0=0, slant=None, progress=None))]
 #[allow(clippy::type_complexity, clippy::too_many_arguments)]
 fn radar_scene<'py>(
     py: Python<'py>,
@@ -179,6 +180,7 @@ fn radar_scene<'py>(
     n_threads: Option<usize>,
     row0: u64,
     slant: Option<(f64, usize)>,
+    progress: Option<&Bound<'py, ProgressCounter>>,
 ) -> PyResult<(
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<f64>>,
@@ -189,9 +191,22 @@ fn radar_scene<'py>(
     let a = c_order(&dem);
     let (rows, cols) = a.rows_cols();
     let looks = (looks > 0).then_some(looks);
+    let pr = counter(progress);
     let s = run(py, n_threads, || {
         geometry::scene_block(
-            &a.data, rows, cols, dx, dy, incidence, &table, table_step, looks, seed, row0, slant,
+            &a.data,
+            rows,
+            cols,
+            dx,
+            dy,
+            incidence,
+            &table,
+            table_step,
+            looks,
+            seed,
+            row0,
+            slant,
+            pr.as_deref(),
         )
     })?;
     Ok((

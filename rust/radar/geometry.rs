@@ -25,6 +25,7 @@
 //!   A bin is in layover when the footprints of more than one pixel of the
 //!   line cover its centre.
 use crate::error::{CoreError, CoreResult};
+use crate::progress::{self, Progress};
 use rayon::prelude::*;
 
 /// Bit of [`Geometry::flags`]: the pixel is in radar shadow (cast, or its
@@ -623,7 +624,7 @@ pub fn scene(
     seed: u64,
 ) -> CoreResult<Scene> {
     scene_block(
-        z, rows, cols, dx, dy, incidence, table, table_step, looks, seed, 0, None,
+        z, rows, cols, dx, dy, incidence, table, table_step, looks, seed, 0, None, None,
     )
 }
 
@@ -635,6 +636,9 @@ pub fn scene(
 /// whole scene's `(lo, n_bins)` and `row0`, and one line more on each side
 /// where the scene has them (for the derivative across lines), equals the
 /// same lines of the whole scene.
+///
+/// `progress`, when given, gets `rows` added to its total and one tick per
+/// range line done; it never changes the result.
 #[allow(clippy::too_many_arguments)]
 pub fn scene_block(
     z: &[f64],
@@ -649,6 +653,7 @@ pub fn scene_block(
     seed: u64,
     row0: u64,
     slant: Option<(f64, usize)>,
+    progress: Option<&Progress>,
 ) -> CoreResult<Scene> {
     check(z, rows, cols, dx, dy, incidence)?;
     if table.is_empty() || !(table_step.is_finite() && table_step > 0.0) {
@@ -674,6 +679,7 @@ pub fn scene_block(
         None => slant_axis(z, cols, &prm)?,
     };
     let key = crate::rng::StreamKey::new(seed, crate::radar::speckle::STREAM);
+    progress::add_total(progress, rows as u64);
     let n = rows * cols;
     let mut theta = vec![0.0; n];
     let mut image = vec![0.0; n];
@@ -738,6 +744,7 @@ pub fn scene_block(
                     }
                     shd[j] = fl[j] & SHADOW;
                 }
+                progress::tick(progress, 1);
             },
         );
     Ok(Scene {
@@ -962,6 +969,7 @@ mod tests {
                 11,
                 h0 as u64,
                 axis,
+                None,
             )
             .unwrap();
             let off = (a - h0) * cols;
@@ -986,5 +994,41 @@ mod tests {
             assert_eq!(&s.layover[off..off + m], &whole.layover[a * cols..b * cols]);
             assert_eq!(&s.shadow[off..off + m], &whole.shadow[a * cols..b * cols]);
         }
+    }
+
+    #[test]
+    fn progress_ticks_each_range_line_and_changes_nothing() {
+        let (rows, cols) = (13, 17);
+        let z: Vec<f64> = (0..rows * cols)
+            .map(|i| {
+                let (r, c) = ((i / cols) as f64, (i % cols) as f64);
+                15.0 * (0.5 * c).sin() * (0.2 * r).cos()
+            })
+            .collect();
+        let table: Vec<f64> = (0..900).map(|i| (-(i as f64) / 300.0).exp()).collect();
+        let plain = scene(&z, rows, cols, 1.5, 2.0, 30.0, &table, 0.1, Some(3), 5).unwrap();
+        let p = Progress::new();
+        let counted = scene_block(
+            &z,
+            rows,
+            cols,
+            1.5,
+            2.0,
+            30.0,
+            &table,
+            0.1,
+            Some(3),
+            5,
+            0,
+            None,
+            Some(&p),
+        )
+        .unwrap();
+        assert_eq!((p.done(), p.total()), (rows as u64, rows as u64));
+        let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&plain.image), bits(&counted.image));
+        assert_eq!(bits(&plain.sigma0), bits(&counted.sigma0));
+        assert_eq!(plain.layover, counted.layover);
+        assert_eq!(plain.shadow, counted.shadow);
     }
 }

@@ -6,7 +6,7 @@ import os
 
 import numpy as np
 
-from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads, add_raster_io
+from fractalgeo_rs._cli_common import HelpFormatter, add_n_threads, add_progress, add_raster_io
 
 
 def add_parsers(sub) -> None:
@@ -17,7 +17,8 @@ def add_parsers(sub) -> None:
         "facets, radar shadow, slant-range projection with layover, facet sigma0 from a backscatter model, "
         "L-look speckle, terrain-geocoded onto the DEM's grid. The output (float32, linear sigma0 or dB with "
         "--db, nodata NaN) keeps the DEM's CRS and transform. Cell size from the file's georeferencing "
-        "(metres; on a geographic grid converted at the centre latitude) or --cell-size.",
+        "(metres; on a geographic grid converted at the centre latitude) or --cell-size. A progress bar over the "
+        "range lines is drawn when stderr is a terminal (--progress / --no-progress).",
     )
     add_raster_io(p, input="dem", output_help="output .tif (or .npy)", cell_size=True)
     p.add_argument("--incidence", type=float, required=True, help="incidence angle, degrees in (0, 90)")
@@ -30,10 +31,12 @@ def add_parsers(sub) -> None:
     p.add_argument("--seed", type=int, default=None, help="speckle seed in [0, 2**64); None draws one")
     p.add_argument("--db", action="store_true", help="write 10 log10(intensity) instead of linear")
     add_n_threads(p)
+    add_progress(p)
     p.set_defaults(func=_run_sar)
 
 
 def _run_sar(args: argparse.Namespace) -> int:
+    from fractalgeo_rs import _progress
     from fractalgeo_rs.dem._cli import ground_cell_size
     from fractalgeo_rs.io import read_raster, write_raster
     from fractalgeo_rs.radar import simulate, to_db
@@ -56,7 +59,7 @@ def _run_sar(args: argparse.Namespace) -> int:
         raise ValueError("cell_size: the DEM has no georeferencing; pass --cell-size (metres)")
     scene = simulate(z, cell, look_azimuth=args.look_azimuth, incidence=args.incidence,
                      wavelength=args.wavelength, model=args.model, looks=args.looks or None, seed=args.seed,
-                     n_threads=args.n_threads)
+                     n_threads=args.n_threads, progress=_progress.resolve(args.progress, cli=True))
     img = scene.image
     if args.db:
         with np.errstate(divide="ignore"):

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from fractalgeo_rs import _core
+from fractalgeo_rs import _core, _progress
 from fractalgeo_rs._backend import array_kind
 from fractalgeo_rs._validation import check_n_threads, check_real_array, warn_void_sentinel
 from fractalgeo_rs._warn import user_stacklevel
@@ -225,7 +225,7 @@ def _from_rotated(shape, dy, dx, frame):
 def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model="kirchhoff",
              permittivity=5 + 0.5j, rms_height=None, correlation_length=None, correlation="exponential",
              hurst=None, topothesy=None, polarization="vv", looks=1, seed=None, multilook=None, ground_range=True,
-             n_threads=None):
+             n_threads=None, progress=None):
     r"""Synthetic SAR intensity image of a DEM, with layover, shadow and speckle.
 
     Side-looking geometry with a distant radar (plane wave, the same
@@ -300,6 +300,16 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
         azimuth in the range frame, columns slant-range bins from near range).
     n_threads : int or None
         Threads of the Rust kernels.
+    progress : bool or None
+        A progress bar on stderr (needs tqdm; ``None`` and ``False``: none),
+        in DEM cells of the range frame: the fused kernel (``ground_range``
+        without ``multilook``) ticks once per range line as it finishes it;
+        a look azimuth off the grid adds the resampling as one step before,
+        and ``multilook`` or ``ground_range=False`` advance the bar per stage
+        (geometry, projection, speckle, geocoding). With a Dask DEM, Dask's
+        bar over the pass that finds the slant-range extent (the result stays
+        lazy: wrap its ``compute`` in ``dask.diagnostics.ProgressBar``). The
+        result does not depend on it.
 
     Returns
     -------
@@ -356,6 +366,7 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
         looks = check_looks(looks)
     seed = resolve_seed(seed)
     n_threads = check_n_threads(n_threads)
+    show = _progress.resolve(progress)
     # facet backscatter on a table of local incidence (validates the surface)
     step = 0.1
     table_deg = np.arange(900) * step
@@ -379,27 +390,51 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
             raise ValueError(_DASK_SLANT.format("multilook"))
         if not ground_range:
             raise ValueError(_DASK_SLANT.format("ground_range"))
-        return _simulate_dask(z, dem, kind, dy, dx, look, inc, table, step, looks, seed, n_threads)
+        with _progress.dask_bar(show):
+            return _simulate_dask(z, dem, kind, dy, dx, look, inc, table, step, looks, seed, n_threads)
     z64 = np.asarray(z, dtype=np.float64)
     frame = None
+    fused = ground_range and ml is None
+    if look is not None:
+        zr_shape = z64.shape if look in (90, 270) else z64.shape[::-1]
+    else:
+        frame = _rotated_grid(z.shape, dy, dx, azimuth)
+        zr_shape = (frame[5], frame[6])
+    cells = int(zr_shape[0]) * int(zr_shape[1])
+    # the bar: the resampling (rotated looks) as one step, then the range frame's cells (per line from the
+    # fused kernel; per stage otherwise: geometry, projection, speckle, geocoding)
+    total = (z64.size if frame is not None else 0) + cells * (1 if fused else 4 if ground_range else 3)
+    with _progress.Steps(total, "radar.simulate", show) as steps:
+        return _simulate_numpy(z64, dem, kind, dy, dx, look, frame, inc, table, step, looks, seed, ml,
+                               ground_range, n_threads, steps)
+
+
+def _simulate_numpy(z64, dem, kind, dy, dx, look, frame, inc, table, step, looks, seed, ml, ground_range,
+                    n_threads, steps):
+    """:func:`simulate` of an in-memory DEM, advancing ``steps`` (a :class:`_progress.Steps`)."""
     if look is not None:
         zr = np.ascontiguousarray(_TO_RANGE[look](z64))
         d_range, d_az = (dx, dy) if look in (90, 270) else (dy, dx)
     else:
-        frame = _rotated_grid(z.shape, dy, dx, azimuth)
         zr = _to_rotated(z64, dy, dx, frame)
         d_range = d_az = frame[4]
+        steps.step(z64.size)
     if ground_range and ml is None:
         # fused per range line (the same values as the steps below, without whole-scene intermediates)
-        theta_l, g_img, g_s0, g_lay, g_shd = _core.radar_scene(zr, d_range, d_az, inc, table.tolist(), step,
-                                                               0 if looks is None else looks, seed, n_threads)
+        lk = 0 if looks is None else looks
+        theta_l, g_img, g_s0, g_lay, g_shd = steps.counted(
+            lambda pr: _core.radar_scene(zr, d_range, d_az, inc, table.tolist(), step, lk, seed, n_threads,
+                                         progress=pr), zr.size)
         spacing = d_range * math.sin(math.radians(inc))
         return _to_ground(g_img, g_s0, g_lay.view(bool), g_shd.view(bool), theta_l, z64, dem, kind, look,
                           frame, dy, dx, spacing)
     theta_l, power, pos, flags, n_bins = _core.radar_geometry(zr, d_range, d_az, inc, table.tolist(), step,
                                                               n_threads)
+    steps.step(zr.size)
     slant, count, nlit = _core.radar_project(power, pos, flags, n_bins, n_threads)
+    steps.step(zr.size)
     speckled = slant if looks is None else _core.speckle_f64(slant, looks, seed, (0, 0), 0, n_threads)
+    steps.step(zr.size)
     spacing = d_range * math.sin(math.radians(inc))
     if ml is not None:
         az, rg = ml
@@ -415,6 +450,7 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
     if not ground_range:
         return SARScene(speckled, slant, count > 1, (count > 0) & (nlit == 0), theta_l, spacing, "slant")
     g_img, g_s0, g_lay = _core.radar_geocode(speckled, slant, count, pos, flags, n_threads)
+    steps.step(zr.size)
     return _to_ground(g_img, g_s0, g_lay.view(bool), (flags & 1).view(bool), theta_l, z64, dem, kind, look,
                       frame, dy, dx, spacing)
 
