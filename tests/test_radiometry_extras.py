@@ -7,24 +7,9 @@ import numpy as np
 import pytest
 
 from fractalgeo_rs.radiometry import Lambertian, Scene
+from surfaces import rough_tile, v_grooves
 
 
-def _rough(n=16, amp=1.0, seed=3):
-    """A smooth periodic rough tile: a few random Fourier modes."""
-    rng = np.random.default_rng(seed)
-    y, x = np.mgrid[0:n, 0:n] * (2 * np.pi / n)
-    z = np.zeros((n, n))
-    for kx in range(-2, 3):
-        for ky in range(-2, 3):
-            if kx or ky:
-                z += amp * rng.normal() / math.hypot(kx, ky) * np.cos(kx * x + ky * y + rng.uniform(0, 2 * np.pi))
-    return z
-
-
-def _grooves(n=8, slope_deg=30.0):
-    """Periodic V-grooves along the north-south axis, constant slope."""
-    x = np.arange(n)
-    return np.where(x % 2 == 1, np.tan(np.radians(slope_deg)), 0.0)[None, :].repeat(n, 0)
 
 
 # ---- bi-hemispherical reflectance ----
@@ -37,7 +22,7 @@ def test_bhr_of_a_flat_lambertian_plane_is_rho():
 def test_bhr_is_the_cosine_weighted_integral_of_the_albedo():
     # BHR = (1/pi) int albedo(s) cos(s) ds = int_0^1 du (1/2pi) int dphi albedo(u = sin^2 zenith, phi);
     # Gauss-Legendre in u, the trapezoid (exact for trigonometric polynomials) in azimuth
-    scene = Scene.from_dem(_rough(amp=0.8), material=Lambertian(0.7))
+    scene = Scene.from_dem(rough_tile(amp=0.8), material=Lambertian(0.7))
     u, wu = np.polynomial.legendre.leggauss(6)
     u, wu = 0.5 * (u + 1), 0.5 * wu
     phis = np.arange(8) * 45.0
@@ -54,7 +39,7 @@ def test_bhr_is_the_cosine_weighted_integral_of_the_albedo():
 
 
 def test_bhr_threads_and_bad_input():
-    scene = Scene.from_dem(_rough(8), material=Lambertian(0.5))
+    scene = Scene.from_dem(rough_tile(8), material=Lambertian(0.5))
     assert scene.bhr(spp=5000, n_threads=1) == scene.bhr(spp=5000, n_threads=2)
     with pytest.raises(ValueError, match="spp"):
         scene.bhr(spp=0)
@@ -83,7 +68,7 @@ def test_v_groove_sky_view_factor(sun):
     # nadir radiance from the sky is rho E_sky cos(s) / pi. The same seed gives
     # the same sun paths with and without sky, so the difference is the sky term.
     rho, sky, s = 0.8, 2.0, math.radians(30.0)
-    scene = Scene.from_dem(_grooves(), material=Lambertian(rho))
+    scene = Scene.from_dem(v_grooves(), material=Lambertian(rho))
     cz = math.cos(math.radians(sun[1]))
     with_sky = scene.brf(sun=sun, spp=60000, max_depth=1, sky=sky, seed=3)
     sun_only = scene.brf(sun=sun, spp=60000, max_depth=1, seed=3)
@@ -96,7 +81,7 @@ def test_v_groove_sky_view_factor(sun):
 
 
 def test_brf_sweep_with_sky_is_brf_with_sky():
-    scene = Scene.from_dem(_rough(8), material=Lambertian(0.5))
+    scene = Scene.from_dem(rough_tile(8), material=Lambertian(0.5))
     sw = scene.brf_sweep(sun_zenith=[10, 50], view_zenith=[0, 30], sun_azimuth=45.0, spp=2000, sky=0.5)
     for i, zs in enumerate((10, 50)):
         for j, zv in enumerate((0, 30)):
@@ -181,7 +166,7 @@ def test_array_psf_is_the_weighted_mean_of_neighbouring_boxes():
 
 
 def test_psf_box_and_threads():
-    scene = Scene.from_dem(_rough(8), material=Lambertian(0.5))
+    scene = Scene.from_dem(rough_tile(8), material=Lambertian(0.5))
     a = scene.render(sun=(100.0, 30.0), shape=(4, 4), spp=4, psf="box")
     assert np.array_equal(a, scene.render(sun=(100.0, 30.0), shape=(4, 4), spp=4))
     g1 = scene.render(sun=(100.0, 30.0), shape=(4, 4), spp=4, psf=("gaussian", 0.7), n_threads=1)
@@ -214,7 +199,7 @@ def plt():
 def test_plot_principal_plane_data(plt):
     from fractalgeo_rs.radiometry import plot_brf_principal_plane
 
-    scene = Scene.from_dem(_rough(8), material=Lambertian(0.5))
+    scene = Scene.from_dem(rough_tile(8), material=Lambertian(0.5))
     vz = [-60, -30, 0, 30, 60]
     ax = plot_brf_principal_plane(scene, sun=(135.0, 40.0), view_zenith=vz, spp=2000, seed=4)
     x, y = ax.lines[0].get_xdata(), ax.lines[0].get_ydata()
@@ -223,7 +208,7 @@ def test_plot_principal_plane_data(plt):
         view = (135.0 if xi >= 0 else 315.0, abs(xi))
         assert yi == scene.brf(sun=(135.0, 40.0), view=view, spp=2000, seed=4).value
     # the V-grooves' nadir point of the principal plane is rho cos(s)
-    g = Scene.from_dem(_grooves(), material=Lambertian(1.0))
+    g = Scene.from_dem(v_grooves(), material=Lambertian(1.0))
     ax = plot_brf_principal_plane(g, sun=(90.0, 20.0), view_zenith=[0], spp=20000, max_depth=1)
     assert abs(ax.lines[0].get_ydata()[0] - math.cos(math.radians(30))) < 0.01
 
@@ -231,7 +216,7 @@ def test_plot_principal_plane_data(plt):
 def test_plot_polar_data(plt):
     from fractalgeo_rs.radiometry import plot_brf_polar
 
-    scene = Scene.from_dem(_rough(8), material=Lambertian(0.5))
+    scene = Scene.from_dem(rough_tile(8), material=Lambertian(0.5))
     ax = plot_brf_polar(scene, sun=(45.0, 30.0), view_zenith=[0, 20, 40], view_azimuth=[0, 90, 180, 270],
                         spp=1000, seed=2)
     got = np.asarray(ax.collections[0].get_array()).reshape(3, 4)
@@ -246,7 +231,7 @@ def test_plot_polar_data(plt):
 def test_plot_incidence_series_data(plt):
     from fractalgeo_rs.radiometry import plot_incidence_series
 
-    scene = Scene.from_dem(_rough(8), material=Lambertian(0.5))
+    scene = Scene.from_dem(rough_tile(8), material=Lambertian(0.5))
     axes = plot_incidence_series(scene, sun_zenith=[0, 45, 89], shape=(8, 8), spp=2, seed=1)
     assert len(axes) == 3
     for a, z in zip(axes, (0, 45, 89)):
@@ -324,7 +309,7 @@ def test_perspective_flat_plane_horizon_and_sky():
 def test_perspective_sees_the_same_surface_as_the_orthographic_sensor():
     # a camera far away with a narrow field of view looking straight down sees
     # the tile almost orthographically: the image means agree within noise
-    scene = Scene.from_dem(_rough(16, amp=1.0), material=Lambertian(0.5))
+    scene = Scene.from_dem(rough_tile(16, amp=1.0), material=Lambertian(0.5))
     d = 4000.0
     fov = 2 * math.degrees(math.atan(8.0 / d))  # 16 m wide at the target
     img = scene.render_perspective(sun=(90.0, 40.0), view=(0.0, 0.0), distance=d, fov=fov, shape=(32, 32),

@@ -9,24 +9,9 @@ import pytest
 from fractalgeo_rs.canopy import disc_canopy
 from fractalgeo_rs.geometry import Mesh
 from fractalgeo_rs.radiometry import BiLambertian, Estimate, Lambertian, OrenNayar, ScatteringOrders, Scene
+from surfaces import rough_tile, v_grooves
 
 
-def _rough(n=16, amp=1.0, seed=3):
-    """A smooth periodic rough tile: a few random Fourier modes."""
-    rng = np.random.default_rng(seed)
-    y, x = np.mgrid[0:n, 0:n] * (2 * np.pi / n)
-    z = np.zeros((n, n))
-    for kx in range(-2, 3):
-        for ky in range(-2, 3):
-            if kx or ky:
-                z += amp * rng.normal() / math.hypot(kx, ky) * np.cos(kx * x + ky * y + rng.uniform(0, 2 * np.pi))
-    return z
-
-
-def _grooves(n=8, slope_deg=30.0):
-    """Periodic V-grooves along the north-south axis, constant slope."""
-    x = np.arange(n)
-    return np.where(x % 2 == 1, np.tan(np.radians(slope_deg)), 0.0)[None, :].repeat(n, 0)
 
 
 def _square():
@@ -41,7 +26,7 @@ SUN, VIEW = (10.0, 40.0), (200.0, 25.0)
 @pytest.mark.parametrize("sky", [0.0, 0.4])
 @pytest.mark.parametrize("material", [Lambertian(0.7), OrenNayar(0.6, 0.3)])
 def test_parts_are_the_separate_runs_exactly(material, sky):
-    s = Scene.from_dem(_rough(amp=1.5), material=material)
+    s = Scene.from_dem(rough_tile(amp=1.5), material=material)
     o = s.brf_orders(SUN, VIEW, spp=5000, max_depth=12, seed=4, sky=sky)
     assert isinstance(o, ScatteringOrders) and all(isinstance(e, Estimate) for e in (o.single, o.multiple, o.total))
     # bounce k draws the same random numbers whatever max_depth is
@@ -73,7 +58,7 @@ def test_orders_scale_as_powers_of_rho():
     # Lambertian paths do not depend on rho (cosine sampling, weight rho): order k
     # carries exactly rho^k, so single / rho is the same for every rho and
     # multiple / rho^2 tends to the second-order term as rho -> 0 (multiple is O(rho^2))
-    z = _rough(amp=1.5)
+    z = rough_tile(amp=1.5)
     res = {rho: Scene.from_dem(z, material=Lambertian(rho)).brf_orders(SUN, VIEW, spp=4000, max_depth=30, seed=6)
            for rho in (0.5, 1e-1, 1e-2, 1e-3)}
     base = res[0.5].single.value / 0.5
@@ -92,7 +77,7 @@ def test_conservative_v_grooves_single_is_the_closed_form():
     # white V-grooves of slope s seen at nadir: single scattering rho cos(s) for any
     # sun (the lit fraction of each face times its cosine), the rest is multiple
     s_deg = 30.0
-    s = Scene.from_dem(_grooves(8, s_deg), material=Lambertian(1.0))
+    s = Scene.from_dem(v_grooves(8, s_deg), material=Lambertian(1.0))
     for sun in [(90.0, 20.0), (270.0, 70.0), (0.0, 75.0)]:
         o = s.brf_orders(sun, "nadir", spp=50_000, max_depth=1000, seed=5)
         assert abs(o.single.value - math.cos(math.radians(s_deg))) < 4 * o.single.se + 1e-9, o
@@ -114,7 +99,7 @@ def test_conservative_canopy_splits_exactly():
 def test_standard_error_of_multiple_matches_the_spread_over_seeds():
     # se comes from each part's own per-path values; independent seeds scatter
     # the estimates by that much (40 seeds: the ratio is 1 within about 0.25)
-    s = Scene.from_dem(_rough(amp=1.5), material=Lambertian(0.8))
+    s = Scene.from_dem(rough_tile(amp=1.5), material=Lambertian(0.8))
     runs = [s.brf_orders(SUN, VIEW, spp=8192, max_depth=20, seed=k) for k in range(40)]
     for part in ("single", "multiple", "total"):
         vals = np.array([getattr(o, part).value for o in runs])
@@ -126,7 +111,7 @@ def test_standard_error_of_multiple_matches_the_spread_over_seeds():
 
 
 def test_thread_count_does_not_change_the_split():
-    s = Scene.from_dem(_rough(8), material=Lambertian(0.5))
+    s = Scene.from_dem(rough_tile(8), material=Lambertian(0.5))
     a = s.brf_orders(SUN, VIEW, spp=5000, seed=9, sky=0.2, n_threads=1)
     assert a == s.brf_orders(SUN, VIEW, spp=5000, seed=9, sky=0.2, n_threads=2)
 

@@ -173,22 +173,10 @@ def _run_discs(args: argparse.Namespace) -> int:
 
 def _read_dem(args: argparse.Namespace):
     """Heights and ``(dy, dx)`` in metres of ``--dem`` (``--cell-size`` replaces the file's)."""
-    import numpy as np
+    from fractalgeo_rs.dem._cli import read_dem_ground
 
-    from fractalgeo_rs.dem._cli import ground_cell_size
-    from fractalgeo_rs.io import read_raster
-
-    z, prof = read_raster(args.dem, band=args.band)
-    z = np.asarray(z, dtype=np.float64)
-    cell = None
-    if prof:
-        nodata = prof.get("nodata")
-        if nodata is not None and np.any(z == nodata):
-            raise ValueError(f"--dem: {int(np.sum(z == nodata))} nodata cell(s); fill them first "
-                             "(e.g. rasterio.fill.fillnodata)")
-        cell = ground_cell_size(prof, z.shape[0])
-    if args.cell_size is not None:
-        cell = (args.cell_size, args.cell_size)
+    side = args.cell_size
+    z, _, cell = read_dem_ground(args.dem, args.band, None if side is None else (side, side), "--dem")
     if cell is None:
         raise ValueError("--cell-size: the DEM has no georeferencing; pass --cell-size (metres)")
     return z, cell

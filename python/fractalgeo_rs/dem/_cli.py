@@ -199,6 +199,31 @@ def _run_hillshade(args: argparse.Namespace) -> int:
     return 0
 
 
+def read_dem_ground(path, band, cell_size, option: str = "dem"):
+    """Heights (float64), the rasterio profile and the ``(dy, dx)`` cell in
+    metres of a DEM file for the commands that need ground units (``render``,
+    ``brf``, ``canopy --plant``): nodata cells are refused (naming
+    ``option``), the cell comes from :func:`ground_cell_size` and
+    ``cell_size`` (a number or a pair, ``--cell-size``) replaces it; ``None``
+    when neither gives one (the caller names the missing option)."""
+    import numpy as np
+
+    from fractalgeo_rs.io import read_raster
+
+    z, prof = read_raster(path, band=band)
+    z = np.asarray(z, dtype=np.float64)
+    cell = None
+    if prof:
+        nodata = prof.get("nodata")
+        if nodata is not None and np.any(z == nodata):
+            raise ValueError(f"{option}: {int(np.sum(z == nodata))} nodata cell(s); fill them first "
+                             "(e.g. rasterio.fill.fillnodata)")
+        cell = ground_cell_size(prof, z.shape[0])
+    if cell_size is not None:
+        cell = cell_size
+    return z, prof, cell
+
+
 def ground_cell_size(prof, rows):
     """``(dy, dx)``, the cell of a raster read by ``read_raster`` in metres
     (map units of a projected grid; metres at the grid's middle latitude for

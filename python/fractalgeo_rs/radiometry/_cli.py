@@ -144,24 +144,10 @@ def _angle_list(text: str, name: str):
 
 
 def _scene(args: argparse.Namespace):
-    import numpy as np
-
-    from fractalgeo_rs.dem._cli import ground_cell_size
-    from fractalgeo_rs.io import read_raster
+    from fractalgeo_rs.dem._cli import read_dem_ground
     from fractalgeo_rs.radiometry import Scene
 
-    z, prof = read_raster(args.dem, band=args.band)
-    z = np.asarray(z, dtype=np.float64)
-    cell = None
-    if prof:
-        nodata = prof.get("nodata")
-        if nodata is not None and np.any(z == nodata):
-            raise ValueError(f"dem: {int(np.sum(z == nodata))} nodata cell(s); fill them first "
-                             "(e.g. rasterio.fill.fillnodata)")
-        ground = ground_cell_size(prof, z.shape[0])
-        cell = ground
-    if args.cell_size is not None:
-        cell = args.cell_size
+    z, prof, cell = read_dem_ground(args.dem, args.band, args.cell_size)
     if cell is None:
         raise ValueError("cell_size: the DEM has no georeferencing; pass --cell-size (in the unit of the heights)")
     return Scene.from_dem(z, cell_size=cell, periodic=not args.finite, material=_parse_material(args.material),
