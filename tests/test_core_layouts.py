@@ -151,19 +151,18 @@ CASES = {
     "radiometry_occluded": (IMG[:9, :7], lambda a: _core.radiometry_occluded(
         a, (1.0, 2.0), True, "ne-sw", np.array([[2.0, -3.0, -99.0], [1.5, -9.0, 99.0]]),
         np.array([[0.1, 0.2, 1.0], [0.0, 0.3, 1.0]]))),
-    "RadiometryScene.from_dem(...).render": (IMG[:9, :7], lambda a: _dem_scene(a, False, "nw-se").render(
-        (30.0, 40.0), (0.0, 0.0), (5, 4), 4, 3, 1)),
     "RadiometryScene.from_dem(...).brf_sky": (IMG[:9, :7], lambda a: _dem_scene(a, False, "ne-sw").brf_sky(
         (30.0, 40.0), (200.0, 20.0), 0.4, 500, 3, 1)),
     "RadiometryScene.from_dem(...).bhr": (IMG[:9, :7], lambda a: _dem_scene(a, False, "ne-sw").bhr(500, 3, 1)),
     "RadiometryScene.from_dem(...).render_perspective": (IMG[:9, :7], lambda a: _dem_scene(a, True, "ne-sw")
                                                          .render_perspective((30.0, 40.0), 0.2, (3.0, 4.0, 60.0),
                                                                              (3.0, -8.0, 0.0), 40.0, (5, 4), 2, 3, 1)),
-    "RadiometryScene.from_dem(...).render_psf": (IMG[:9, :7], lambda a: _dem_scene(a, False, "nw-se").render_psf(
-        (30.0, 40.0), (0.0, 0.0), 0.3, (5, 4), 4, 3, 1, "table", [0.5], np.abs(IMG[:3, :5]))),
+    "RadiometryScene.from_dem(...).render_series": (IMG[:9, :7], lambda a: _dem_scene(a, False, "nw-se").render_series(
+        [(30.0, 40.0), (100.0, 60.0)], (0.0, 0.0), 0.3, (5, 4), 4, 3, 1, "table", [0.5], np.abs(IMG[:3, :5]))),
     "RadiometryScene.from_dem": (IMG[:9, :7], lambda a: _core.RadiometryScene.from_dem(
         a, (1.0, 2.0), True, "ne-sw", [("lambertian", [0.2]), ("lambertian", [0.9])],
-        (np.arange(126) % 2).astype(np.uint32)).render((30.0, 40.0), (0.0, 0.0), (5, 4), 4, 3, 1)),
+        (np.arange(126) % 2).astype(np.uint32)).render_series([(30.0, 40.0)], (0.0, 0.0), 0.0, (5, 4), 4, 3, 1,
+                                                            "box", [])),
 }
 # functions whose array arguments are not data laid out by the caller
 NOT_LAYOUT = {

@@ -223,7 +223,13 @@ def test_the_kernel_checks_too():
     with pytest.raises(ValueError, match="^material"):
         scene("hapke")
     with pytest.raises(MemoryError, match="^shape"):
-        scene().render((0, 0), (0, 0), (10**5, 10**5), 1, 1, 0)
+        scene().render_series([(0, 0)], (0, 0), 0.0, (10**5, 10**5), 1, 1, 0, "box", [])
+    with pytest.raises(MemoryError, match="^shape"):
+        scene().render_series([(0, 0)] * 3, (0, 0), 0.0, (10**4, 10**4), 1, 1, 0, "box", [])
+    with pytest.raises(ValueError, match="^suns"):
+        scene().render_series([], (0, 0), 0.0, (2, 2), 1, 1, 0, "box", [])
+    with pytest.raises(ValueError, match="^sun: zenith"):
+        scene().render_series([(0, 0), (0, 90)], (0, 0), 0.0, (2, 2), 1, 1, 0, "box", [])
 
 
 def test_mismatched_periodic_edges_warn_and_mirroring_fixes_them():
@@ -412,6 +418,46 @@ def test_render_progress_does_not_change_the_image():
     a = s.render(sun=(135, 30), spp=4, progress=False)
     b = s.render(sun=(135, 30), spp=4, progress=True)
     np.testing.assert_array_equal(a, b)
+
+
+def test_render_series_equals_one_render_per_sun():
+    """The one-pass incidence series gives each sun's image bit for bit,
+    with a PSF and sky light, on DEM and mesh scenes, for any n_threads."""
+    from fractalgeo_rs.geometry import Mesh
+
+    z = periodic_surface(8)
+    suns = [(90.0, 0.0), (135.0, 30.0), (200.0, 75.0), (10.0, 89.0)]
+    dem = Scene.from_dem(z, material=Lambertian(0.6))
+    r, c = np.mgrid[0:9, 0:9]
+    v = np.stack([c, -r, np.pad(z, ((0, 1), (0, 1)), mode="wrap")], -1).reshape(-1, 3).astype(float)
+    idx = np.arange(81).reshape(9, 9)
+    nw, ne, sw, se = idx[:-1, :-1], idx[:-1, 1:], idx[1:, :-1], idx[1:, 1:]
+    f = np.stack([np.stack([nw, sw, ne], -1), np.stack([ne, sw, se], -1)], 2).reshape(-1, 3)
+    mesh = Scene.from_mesh(Mesh.from_triangles(v, f), materials=OrenNayar(0.5, 0.3), periodic=True,
+                           extent=(0.0, -8.0, 8.0, 8.0))
+    for s, kw in [(dem, {}), (dem, {"sky": 0.3, "psf": ("gaussian", 0.8), "view": (40.0, 25.0)}),
+                  (mesh, {"sky": 0.2})]:
+        series = s.render_series(suns, shape=(5, 6), spp=3, max_depth=4, seed=7, n_threads=2, **kw)
+        assert series.shape == (4, 5, 6) and series.dtype == np.float32
+        for k, sun in enumerate(suns):
+            one = s.render(sun=sun, shape=(5, 6), spp=3, max_depth=4, seed=7, n_threads=1, **kw)
+            np.testing.assert_array_equal(series[k], one)
+        # the sun at 89 degrees lights less than the sun at 0
+        assert series[3].mean() < series[0].mean()
+
+
+def test_render_series_bad_input():
+    s = Scene.from_dem(periodic_surface(4), material=Lambertian(0.5))
+    with pytest.raises(ValueError, match="^suns: .*at least one"):
+        s.render_series([])
+    with pytest.raises(TypeError, match="^suns: "):
+        s.render_series((0.0, 30.0))  # one pair, not a sequence of pairs
+    with pytest.raises(ValueError, match="^suns: zenith must be in"):
+        s.render_series([(0.0, 30.0), (0.0, 90.0)])
+    with pytest.raises(TypeError, match="^suns: "):
+        s.render_series("nadir")
+    with pytest.raises(MemoryError, match="shape"):
+        s.render_series([(0.0, 0.0)] * 4, shape=(1000, 1000), max_memory=10_000_000)
 
 
 def test_images_are_written_whole_with_georeferencing(tmp_path):

@@ -639,17 +639,6 @@ class RadiometryScene:
     def absorption(
         self, sun: Tuple[float, float], spp: int, max_depth: int, seed: int, n_threads: Optional[int] = None
     ) -> Tuple[List[Tuple[float, float]], Tuple[float, float], Tuple[float, float], int]: ...
-    def render(
-        self,
-        sun: Tuple[float, float],
-        view: Tuple[float, float],
-        shape: Tuple[int, int],
-        spp: int,
-        max_depth: int,
-        seed: int,
-        n_threads: Optional[int] = None,
-        progress: Optional[ProgressCounter] = None,
-    ) -> npt.NDArray[np.float32]: ...
     def brf_sky(
         self,
         sun: Tuple[float, float],
@@ -673,9 +662,9 @@ class RadiometryScene:
     def bhr(
         self, spp: int, max_depth: int, seed: int, n_threads: Optional[int] = None
     ) -> Tuple[float, float, int]: ...
-    def render_psf(
+    def render_series(
         self,
-        sun: Tuple[float, float],
+        suns: Sequence[Tuple[float, float]],
         view: Tuple[float, float],
         sky: float,
         shape: Tuple[int, int],

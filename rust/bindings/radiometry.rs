@@ -2,7 +2,7 @@
 //! ([`RadiometryScene`], built once from a DEM, a mesh or instances and kept
 //! between calls) with its BRF, albedo, images and canopy methods, and the
 //! ray-batch queries of a DEM heightfield.
-use super::convert::{array1, array2, c_order, run};
+use super::convert::{array1, array2, array3, c_order, run};
 use super::geometry::MeshIn;
 use super::progress::{counter, ProgressCounter};
 use crate::error::{CoreError, CoreResult};
@@ -11,7 +11,7 @@ use crate::radiometry::{
     direction, material, Heightfield, InstancedTracer, MeshTracer, Scene, Split,
 };
 use glam::{DAffine3, DMat3, DVec3};
-use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
+use numpy::{PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::prelude::*;
 
 fn build(
@@ -472,31 +472,6 @@ impl RadiometryScene {
         ))
     }
 
-    /// A float32 radiance image (orthographic sensor over the footprint).
-    #[pyo3(signature = (sun, view, shape, spp, max_depth, seed, n_threads=None, progress=None))]
-    #[allow(clippy::too_many_arguments)]
-    fn render<'py>(
-        &self,
-        py: Python<'py>,
-        sun: (f64, f64),
-        view: (f64, f64),
-        shape: (usize, usize),
-        spp: u64,
-        max_depth: u32,
-        seed: u64,
-        n_threads: Option<usize>,
-        progress: Option<&Bound<'py, ProgressCounter>>,
-    ) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        let pr = counter(progress);
-        let img = run(py, n_threads, || {
-            let (sun, view) = (direction(sun, "sun")?, direction(view, "view")?);
-            with_scene!(&self.kind, s => s.render_progress(
-                sun, view, shape, spp, max_depth, seed, pr.as_deref()
-            ))
-        })?;
-        array2(py, shape, img)
-    }
-
     /// `(value, se, n)` of the reflectance factor under the sun and an
     /// isotropic sky of horizontal irradiance `sky` (the HDRF).
     #[pyo3(signature = (sun, view, sky, spp, max_depth, seed, n_threads=None))]
@@ -561,16 +536,16 @@ impl RadiometryScene {
         Ok((e.value, e.se, e.n))
     }
 
-    /// A float32 radiance image with sky light and a point-spread function:
-    /// `psf` is "box", "gaussian" (`psf_params` = [sigma, truncate], pixels
-    /// and sigmas) or "table" (`psf_table` weights, `psf_params` = [cell size
-    /// in pixels]).
-    #[pyo3(signature = (sun, view, sky, shape, spp, max_depth, seed, psf, psf_params, psf_table=None, n_threads=None, progress=None))]
+    /// Float32 radiance images, one per sun of `suns` (`(n, rows, cols)`),
+    /// with sky light and a point-spread function: `psf` is "box",
+    /// "gaussian" (`psf_params` = [sigma, truncate], pixels and sigmas) or
+    /// "table" (`psf_table` weights, `psf_params` = [cell size in pixels]).
+    #[pyo3(signature = (suns, view, sky, shape, spp, max_depth, seed, psf, psf_params, psf_table=None, n_threads=None, progress=None))]
     #[allow(clippy::too_many_arguments)]
-    fn render_psf<'py>(
+    fn render_series<'py>(
         &self,
         py: Python<'py>,
-        sun: (f64, f64),
+        suns: Vec<(f64, f64)>,
         view: (f64, f64),
         sky: f64,
         shape: (usize, usize),
@@ -582,17 +557,22 @@ impl RadiometryScene {
         psf_table: Option<PyReadonlyArray2<'py, f64>>,
         n_threads: Option<usize>,
         progress: Option<&Bound<'py, ProgressCounter>>,
-    ) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    ) -> PyResult<Bound<'py, PyArray3<f32>>> {
         let table = psf_table.as_ref().map(c_order);
         let pr = counter(progress);
+        let ns = suns.len();
         let img = run(py, n_threads, || {
             let kernel = psf_of(psf, &psf_params, table.as_ref())?;
-            let (sun, view) = (direction(sun, "sun")?, direction(view, "view")?);
-            with_scene!(&self.kind, s => s.render_psf(
-                sun, view, sky, shape, spp, max_depth, seed, &kernel, pr.as_deref()
+            let suns = suns
+                .iter()
+                .map(|&s| direction(s, "sun"))
+                .collect::<CoreResult<Vec<_>>>()?;
+            let view = direction(view, "view")?;
+            with_scene!(&self.kind, s => s.render_series(
+                &suns, view, sky, shape, spp, max_depth, seed, &kernel, pr.as_deref()
             ))
         })?;
-        array2(py, shape, img)
+        array3(py, (ns, shape.0, shape.1), img)
     }
 
     /// A float32 radiance image seen by a pinhole camera at `eye` looking

@@ -90,6 +90,10 @@ pub struct Heightfield {
     pub zmean: f64,
     /// Height tolerance of the culling tests (metres).
     zeps: f64,
+    /// The largest squared gradient of a facet in grid coordinates,
+    /// `b^2 + c^2` of its plane `z = a + b fx + c fy` (a Lipschitz bound of
+    /// the surface: see [`Heightfield::escapes`]).
+    grad2: f64,
 }
 
 /// Upper bound on cells visited by one ray (guards near-horizontal rays in
@@ -278,7 +282,14 @@ impl Heightfield {
             zmax,
             zmean,
             zeps,
+            grad2: 0.0,
         };
+        hf.grad2 = hf
+            .cells
+            .iter()
+            .flat_map(|cell| [hf.plane(&cell.0, 0), hf.plane(&cell.0, 1)])
+            .map(|(_, b, c)| b * b + c * c)
+            .fold(0.0, fmax);
         if ncr * ncc >= BLOCK_MIN_CELLS {
             // periodic: blocks must tile the period
             let side = [16usize, 8, 4]
@@ -530,6 +541,9 @@ impl Heightfield {
         // grid coordinates: the same t
         let o = DVec3::new(o.x / self.dx, -o.y / self.dy, o.z);
         let d = DVec3::new(d.x / self.dx, -d.y / self.dy, d.z);
+        if d.z > 0.0 && self.escapes(o, d) {
+            return Walk::Stop;
+        }
         let mut t_start = 0.0f64;
         if !self.periodic {
             // clip to the patch's footprint [0, ncc] x [0, ncr]
@@ -672,6 +686,32 @@ impl Heightfield {
             t_enter = t_exit;
             z_enter = z_exit;
         }
+    }
+
+    /// Whether the upward ray `o + t d` (grid coordinates, `d.z > 0`) can
+    /// meet no facet: it rises faster than any facet and starts on or above
+    /// the surface. The surface is continuous and piecewise linear, so
+    /// between two points of the plane it rises by at most `sqrt(grad2)` per
+    /// unit of horizontal distance (grid coordinates) and stays below such a
+    /// ray. One cell lookup: rays leaving the surface steeper than its
+    /// steepest facet skip the traversal.
+    #[inline(always)]
+    fn escapes(&self, o: DVec3, d: DVec3) -> bool {
+        let h2 = d.x * d.x + d.y * d.y;
+        if d.z * d.z <= self.grad2 * h2 * (1.0 + 1e-9) {
+            return false;
+        }
+        let (ix, iy) = (ifloor(o.x), ifloor(o.y));
+        if !self.periodic && (ix < 0 || iy < 0 || ix >= self.ncc as i64 || iy >= self.ncr as i64) {
+            return false;
+        }
+        let (fx, fy) = (o.x - ix as f64, o.y - iy as f64);
+        let tri = match self.split {
+            Split::NeSw => u8::from(fx + fy > 1.0),
+            Split::NwSe => u8::from(fy > fx),
+        };
+        let (a, b, c) = self.plane(&self.cell(ix, iy), tri);
+        o.z >= a + b * fx + c * fy - self.zeps
     }
 
     /// Walk the cells from ray parameter `t0` while the cell indices stay

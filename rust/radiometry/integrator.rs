@@ -359,28 +359,52 @@ impl<G: Tracer> Scene<G> {
     #[allow(clippy::too_many_arguments)]
     fn radiance_orders<S: PathSampler>(
         &self,
-        mut o: DVec3,
+        o: DVec3,
         v: DVec3,
         s: DVec3,
         sky_l: f64,
         max_depth: u32,
         key: &mut S,
-        mut dim: u64,
+        dim: u64,
     ) -> (f64, f64) {
+        let (mut l, mut l1) = ([0.0], [0.0]);
+        self.radiance_suns(o, v, &[s], sky_l, max_depth, key, dim, &mut l, &mut l1);
+        (l[0], l1[0])
+    }
+
+    /// [`Scene::radiance_orders`] of one path for every sun of `suns` at
+    /// once: the path does not depend on the sun (only the next-event
+    /// estimates do), so it is traced once and `l[k]`, `l1[k]` are set bit
+    /// for bit to `radiance_orders(.., suns[k], ..)`.
+    #[allow(clippy::too_many_arguments)]
+    fn radiance_suns<S: PathSampler>(
+        &self,
+        mut o: DVec3,
+        v: DVec3,
+        suns: &[DVec3],
+        sky_l: f64,
+        max_depth: u32,
+        key: &mut S,
+        mut dim: u64,
+        l: &mut [f64],
+        l1: &mut [f64],
+    ) {
         let hf = &self.hf;
+        l.fill(0.0);
+        l1.fill(0.0);
         let mut d = -v;
         let mut skip: Option<G::Facet> = None;
         let mut throughput = 1.0;
-        let mut l = 0.0;
-        let mut l1 = 0.0;
         let mut depth = 0u32;
         loop {
             let Some(hit) = hf.trace(o, d, skip) else {
                 if depth > 0 && d.z > 0.0 {
                     let c = throughput * sky_l; // escaped into the sky
-                    l += c;
-                    if depth == 1 {
-                        l1 += c;
+                    for k in 0..suns.len() {
+                        l[k] += c;
+                        if depth == 1 {
+                            l1[k] += c;
+                        }
                     }
                 }
                 break;
@@ -397,13 +421,17 @@ impl<G: Tracer> Scene<G> {
             let (t, b) = basis(n);
             let wo = Self::local(n, t, b, -d);
             let m = self.bsdf(facet);
-            let cos_s = n.dot(s);
-            if (cos_s > 0.0 || (cos_s < 0.0 && m.transmits())) && !hf.occluded(p, s, Some(facet)) {
-                let wi = Self::local(n, t, b, s);
-                let c = throughput * m.eval(wi, wo) * cos_s.abs();
-                l += c;
-                if depth == 1 {
-                    l1 += c;
+            for (k, &s) in suns.iter().enumerate() {
+                let cos_s = n.dot(s);
+                if (cos_s > 0.0 || (cos_s < 0.0 && m.transmits()))
+                    && !hf.occluded(p, s, Some(facet))
+                {
+                    let wi = Self::local(n, t, b, s);
+                    let c = throughput * m.eval(wi, wo) * cos_s.abs();
+                    l[k] += c;
+                    if depth == 1 {
+                        l1[k] += c;
+                    }
                 }
             }
             if depth == max_depth && sky_l == 0.0 {
@@ -420,7 +448,6 @@ impl<G: Tracer> Scene<G> {
             o = p;
             skip = Some(facet);
         }
-        (l, l1)
     }
 
     /// The radiance of [`Scene::radiance_orders`] (all orders).
@@ -729,32 +756,102 @@ impl<G: Tracer> Scene<G> {
         psf: &Psf,
         progress: Option<&crate::progress::Progress>,
     ) -> CoreResult<Vec<f32>> {
+        self.render_series(
+            &[sun],
+            view,
+            sky,
+            shape,
+            spp,
+            max_depth,
+            seed,
+            psf,
+            progress,
+        )
+    }
+
+    /// One [`Scene::render_psf`] image per sun of `suns` (an `n x rows x
+    /// cols` stack, row-major), each bit for bit the image of its sun with
+    /// the same `seed`, in one pass: a path's geometry does not depend on
+    /// the sun, so it is traced once and the sun's next-event estimate made
+    /// for every sun (the paper's incidence series at little more than the
+    /// cost of one image plus the shadow rays).
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_series(
+        &self,
+        suns: &[DVec3],
+        view: DVec3,
+        sky: f64,
+        shape: (usize, usize),
+        spp: u64,
+        max_depth: u32,
+        seed: u64,
+        psf: &Psf,
+        progress: Option<&crate::progress::Progress>,
+    ) -> CoreResult<Vec<f32>> {
         check_sky(sky)?;
-        let mut img = image_buffer(shape, spp, max_depth, progress)?;
+        let ns = suns.len();
+        if ns == 0 {
+            return Err(CoreError::invalid(
+                "suns",
+                "expected at least one sun direction, got none",
+            ));
+        }
         let (rows, cols) = shape;
+        // one buffer of rows x (suns x cols): a row of every image per chunk
+        let mut buf = image_buffer((rows, cols.saturating_mul(ns)), spp, max_depth, progress)?;
         let (x0, y0, w, h) = self.hf.footprint();
         let ytop = y0 + h;
         let (pw, ph) = (w / cols as f64, h / rows as f64);
         let sky_l = sky / PI;
-        img.par_chunks_mut(cols).enumerate().for_each(|(i, line)| {
-            for (j, px) in line.iter_mut().enumerate() {
-                let pixel = (i * cols + j) as u64;
-                let mut s = 0.0;
-                for k in 0..spp {
-                    let key =
-                        StreamKey::new(seed, TAG_IMAGE ^ pixel.wrapping_mul(spp).wrapping_add(k));
-                    let (fx, fy) = psf.position([key.uniform(0), key.uniform(1)]);
-                    let x = x0 + (j as f64 + fx) * pw;
-                    let y = ytop - (i as f64 + fy) * ph;
-                    let o = self.sensor_ray(x, y, view);
-                    s += self.radiance(o, view, sun, sky_l, max_depth, &mut { key }, 2);
+        buf.par_chunks_mut(cols * ns)
+            .enumerate()
+            .for_each(|(i, line)| {
+                let (mut l, mut l1, mut acc) = (vec![0.0; ns], vec![0.0; ns], vec![0.0; ns]);
+                for j in 0..cols {
+                    let pixel = (i * cols + j) as u64;
+                    acc.fill(0.0);
+                    for k in 0..spp {
+                        let key = StreamKey::new(
+                            seed,
+                            TAG_IMAGE ^ pixel.wrapping_mul(spp).wrapping_add(k),
+                        );
+                        let (fx, fy) = psf.position([key.uniform(0), key.uniform(1)]);
+                        let x = x0 + (j as f64 + fx) * pw;
+                        let y = ytop - (i as f64 + fy) * ph;
+                        let o = self.sensor_ray(x, y, view);
+                        self.radiance_suns(
+                            o,
+                            view,
+                            suns,
+                            sky_l,
+                            max_depth,
+                            &mut { key },
+                            2,
+                            &mut l,
+                            &mut l1,
+                        );
+                        for (a, v) in acc.iter_mut().zip(&l) {
+                            *a += v;
+                        }
+                    }
+                    for (s, a) in acc.iter().enumerate() {
+                        line[s * cols + j] = (a / spp as f64) as f32;
+                    }
                 }
-                *px = (s / spp as f64) as f32;
+                if let Some(p) = progress {
+                    p.tick(1);
+                }
+            });
+        if ns == 1 {
+            return Ok(buf);
+        }
+        // rows x (suns x cols) to suns x rows x cols
+        let mut img: Vec<f32> = crate::buffers::try_filled(buf.len(), 0.0f32, "shape")?;
+        for (i, line) in buf.chunks(cols * ns).enumerate() {
+            for (s, part) in line.chunks(cols).enumerate() {
+                img[(s * rows + i) * cols..][..cols].copy_from_slice(part);
             }
-            if let Some(p) = progress {
-                p.tick(1);
-            }
-        });
+        }
         Ok(img)
     }
 

@@ -185,6 +185,58 @@ fn traversal_case(rows: usize, cols: usize, bside: usize) {
     }
 }
 
+/// Rays leaving the surface upwards, steep ones included (those the
+/// Lipschitz escape test ends at once), find the same hit as the brute
+/// force; so do steep rays starting below the surface (which must not be
+/// taken for escaping ones).
+#[test]
+fn steep_rays_from_and_below_the_surface_agree_with_brute_force() {
+    let (rows, cols) = (5, 7);
+    let z = rough(7, 3.0, 4)[..rows * cols].to_vec();
+    let key = StreamKey::new(12, 3);
+    for periodic in [true, false] {
+        let hf = Heightfield::new(&z, rows, cols, (1.0, 1.0), periodic, Split::NeSw).unwrap();
+        let (mut escaped, mut hits) = (0, 0);
+        for i in 0..4000u64 {
+            let u = |k: u64| key.uniform(10 * i + k);
+            let (x, y) = (0.05 + u(0) * 5.9, -0.05 - u(1) * 3.9);
+            let top = DVec3::new(x, y, hf.zmax + 1.0);
+            let probe = hf.intersect(top, -DVec3::Z, None).unwrap();
+            let below = i % 4 == 0;
+            let o = top - (probe.t + if below { 0.05 + u(2) } else { 0.0 }) * DVec3::Z;
+            let skip = (!below).then_some(probe.facet);
+            // elevation 20-90 degrees: most above the steepest facet's
+            let elev = (20.0 + 70.0 * u(3)).to_radians();
+            let az = std::f64::consts::TAU * u(4);
+            let d = DVec3::new(elev.cos() * az.cos(), elev.cos() * az.sin(), elev.sin());
+            let mine = hf.intersect(o, d, skip);
+            assert_eq!(hf.occluded(o, d, skip, f64::INFINITY), mine.is_some());
+            let theirs = brute(&z, rows, cols, periodic, o, d, 6)
+                .filter(|&(t, _)| below || t > 1e-7 * (1.0 + o.z.abs()));
+            match (mine, theirs) {
+                (Some(a), Some((t, n))) => {
+                    hits += 1;
+                    assert!((a.t - t).abs() < 1e-9 * (1.0 + t), "i={i} {} {t}", a.t);
+                    assert!((a.normal - n).length() < 1e-9);
+                }
+                (None, None) => escaped += 1,
+                (Some(a), None) if periodic && a.t > 6.0 * 5.0 => {}
+                (a, b) => {
+                    panic!("periodic={periodic} i={i} below={below}: {a:?} vs {b:?} o={o} d={d}")
+                }
+            }
+            if below && periodic {
+                // (a finite patch may be left through its side first)
+                assert!(
+                    mine.is_some(),
+                    "a ray from below the surface must hit it (i={i})"
+                );
+            }
+        }
+        assert!(escaped > 1000 && hits > 1000, "{escaped} {hits}");
+    }
+}
+
 /// On a grid large enough for the coarse level, every ray (long and
 /// shallow ones included) finds the same facet at the same `t` as the plain
 /// cell walk, and the shadow-ray test agrees.

@@ -229,7 +229,9 @@ def plot_incidence_series(scene: Scene, sun_zenith: Sequence[float] = PAPER_SUN_
     white : float, optional
         Radiance shown as white; default the largest pixel of the series.
     **kwargs
-        Passed to ``Scene.render`` (e.g. ``sky``, ``psf``).
+        Passed to ``Scene.render_series`` (e.g. ``sky``, ``psf``), which
+        renders the series in one pass (each image equals ``Scene.render``
+        at its sun).
 
     Returns
     -------
@@ -256,8 +258,8 @@ def plot_incidence_series(scene: Scene, sun_zenith: Sequence[float] = PAPER_SUN_
     plt = require("matplotlib.pyplot")
     _check_scene(scene)
     zs = _zeniths(sun_zenith, "sun_zenith", signed=False)
-    images = [scene.render(sun=(sun_azimuth, float(z)), view=view, shape=shape, spp=spp, max_depth=max_depth,
-                           seed=seed, n_threads=n_threads, **kwargs) for z in zs]
+    images = scene.render_series([(sun_azimuth, float(z)) for z in zs], view=view, shape=shape, spp=spp,
+                                 max_depth=max_depth, seed=seed, n_threads=n_threads, **kwargs)
     if axes is None:
         fig, axes = plt.subplots(1, zs.size, figsize=(2.0 * zs.size, 2.3), squeeze=False)
         axes = list(axes[0])

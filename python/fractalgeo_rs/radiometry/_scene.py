@@ -1630,6 +1630,60 @@ class Scene:
         M. Pharr, W. Jakob and G. Humphreys, *Physically Based Rendering*,
         3rd ed., 2016 (path tracing with next-event estimation).
         """
+        return self._render([_direction(sun, "sun")], view, shape, spp, max_depth, seed, n_threads, max_memory,
+                            progress, sky, psf, psf_step)[0]
+
+    def render_series(self, suns, view="nadir", shape: Optional[Tuple[int, int]] = None, spp: int = 16,
+                      max_depth: int = 10, seed: int = 0, n_threads: Optional[int] = None,
+                      max_memory=None, progress: Optional[bool] = None, sky: float = 0.0, psf="box",
+                      psf_step: float = 1.0) -> np.ndarray:
+        """Radiance images of the same scene under several suns, in one pass.
+
+        Image ``k`` equals ``render(sun=suns[k], ...)`` with the same
+        ``seed`` and other arguments bit for bit. The path a sensor ray
+        starts does not depend on the sun (only its next-event estimates
+        do), so each path is traced once and the sun's contribution at
+        every scattering event is estimated for every sun: the cost is
+        that of one image plus one shadow ray per sun and event. This is
+        how to render the paper's incidence series (figure 9); see
+        ``plot_incidence_series``.
+
+        Parameters
+        ----------
+        suns : sequence of (float, float)
+            Directions towards the sun, ``(azimuth, zenith)`` in degrees.
+        view, shape, spp, max_depth, seed, n_threads, progress, sky, psf, psf_step
+            As in ``render``.
+        max_memory : int, optional
+            Limit in bytes for the stack of images (default: the package's
+            limit); a larger stack raises ``MemoryError`` before allocating.
+
+        Returns
+        -------
+        numpy.ndarray of float32, shape ``(len(suns), rows, cols)``
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from fractalgeo_rs.radiometry import Lambertian, Scene
+        >>> s = Scene.from_dem(np.zeros((4, 4)), material=Lambertian(1.0))
+        >>> imgs = s.render_series([(0.0, 0.0), (0.0, 60.0)], shape=(2, 3), spp=4)
+        >>> imgs.shape, bool(np.allclose(imgs[1], 0.5 / np.pi))
+        ((2, 2, 3), True)
+        >>> bool(np.array_equal(imgs[1], s.render(sun=(0.0, 60.0), shape=(2, 3), spp=4)))
+        True
+        """
+        if isinstance(suns, (str, bytes)) or not hasattr(suns, "__len__"):
+            raise TypeError(f"suns: expected a sequence of (azimuth, zenith) pairs, got {suns!r}")
+        if len(suns) == 0:
+            raise ValueError("suns: expected at least one (azimuth, zenith) pair, got none")
+        return self._render([_direction(s, "suns") for s in suns], view, shape, spp, max_depth, seed, n_threads,
+                            max_memory, progress, sky, psf, psf_step)
+
+    def _render(self, suns, view, shape, spp, max_depth, seed, n_threads, max_memory, progress, sky, psf,
+                psf_step) -> np.ndarray:
+        """The orthographic images of ``render`` for the checked sun
+        directions ``suns``: ``(len(suns), rows, cols)``."""
         if shape is None:
             shape = self._default_shape()
         try:
@@ -1637,21 +1691,20 @@ class Scene:
         except (TypeError, ValueError):
             raise TypeError(f"shape: expected (rows, cols), got {shape!r}") from None
         rows, cols = check_positive_int(rows, "shape"), check_positive_int(cols, "shape")
-        check_memory(rows * cols * 4, "shape", max_memory=max_memory, what=f"a {rows} x {cols} float32 image")
+        n = len(suns)
+        what = f"a {rows} x {cols} float32 image" + (f" x {n} suns" if n > 1 else "")
+        check_memory(n * rows * cols * 4, "shape", max_memory=max_memory, what=what)
         from fractalgeo_rs import _progress
 
         sky = _sky(sky)
         kind, pparams, table = _psf(psf, psf_step)
-        sd = (_direction(sun, "sun"), _direction(view, "view"))
+        view = _direction(view, "view")
         rest = (check_positive_int(spp, "spp"), _depth(max_depth), _seed(seed))
         nt = check_n_threads(n_threads)
         core = self._scene_core()
         with _progress.Steps(rows, "render", _progress.resolve(progress)) as steps:
-            if sky == 0.0 and kind == "box":
-                return steps.counted(lambda counter: core.render(
-                    *sd, (rows, cols), *rest, nt, progress=counter), rows)
-            return steps.counted(lambda counter: core.render_psf(
-                *sd, sky, (rows, cols), *rest, kind, pparams, table, nt, progress=counter), rows)
+            return steps.counted(lambda counter: core.render_series(
+                suns, view, sky, (rows, cols), *rest, kind, pparams, table, nt, progress=counter), rows)
 
     def render_perspective(self, sun, view=(135.0, 60.0), distance: Optional[float] = None, eye=None,
                            target=None, fov: float = 40.0, shape: Tuple[int, int] = (240, 320), spp: int = 16,
