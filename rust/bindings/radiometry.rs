@@ -66,61 +66,65 @@ fn psf_of(
     })
 }
 
-/// Origins, directions and skipped facet indices of a batch of rays.
-type RayBatch = (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<i64>);
+/// Origins and directions (flat `[x, y, z, ...]`, borrowed when
+/// C-contiguous) and skipped facet indices of a batch of rays.
+struct RayBatch<'a> {
+    o: super::convert::CArray<'a, f64>,
+    d: super::convert::CArray<'a, f64>,
+    skip: Option<super::convert::CArray<'a, i64>>,
+}
 
 /// Rays of a batch: `(n, 3)` origins and directions, `(n,)` skipped facets.
-fn ray_batch(
-    origins: &PyReadonlyArray2<'_, f64>,
-    directions: &PyReadonlyArray2<'_, f64>,
-    skip: Option<&PyReadonlyArray1<'_, i64>>,
-) -> PyResult<RayBatch> {
-    let rows3 = |a: &PyReadonlyArray2<'_, f64>, name: &str| -> PyResult<Vec<[f64; 3]>> {
+fn ray_batch<'a>(
+    origins: &'a PyReadonlyArray2<'_, f64>,
+    directions: &'a PyReadonlyArray2<'_, f64>,
+    skip: Option<&'a PyReadonlyArray1<'_, i64>>,
+) -> PyResult<RayBatch<'a>> {
+    let rows3 = |a: &'a PyReadonlyArray2<'_, f64>, name: &str| {
         let c = c_order(a);
         if c.shape[1] != 3 {
             return Err(CoreError::invalid(
                 name,
                 format!("expected shape (n, 3), got {:?}", c.shape),
-            )
-            .into());
+            ));
         }
-        Ok(c.data.chunks_exact(3).map(|r| [r[0], r[1], r[2]]).collect())
+        Ok(c)
     };
     let o = rows3(origins, "origins")?;
     let d = rows3(directions, "directions")?;
-    if d.len() != o.len() {
+    let n = o.shape[0];
+    if d.shape[0] != n {
         return Err(CoreError::invalid(
             "directions",
-            format!("expected {} rows like origins, got {}", o.len(), d.len()),
+            format!("expected {n} rows like origins, got {}", d.shape[0]),
         )
         .into());
     }
-    let bad = |v: &[[f64; 3]]| v.iter().any(|r| r.iter().any(|x| !x.is_finite()));
-    if bad(&o) {
+    // scans without early exit (vectorised)
+    let finite = |v: &[f64]| v.iter().fold(true, |a, x| a & x.is_finite());
+    if !finite(&o.data) {
         return Err(CoreError::invalid("origins", "expected finite coordinates").into());
     }
-    if bad(&d) || d.iter().any(|r| r == &[0.0; 3]) {
+    let shortest = d.data.chunks_exact(3).fold(f64::INFINITY, |m, r| {
+        m.min(r[0].abs() + r[1].abs() + r[2].abs())
+    });
+    if !finite(&d.data) || shortest <= 0.0 {
         return Err(CoreError::invalid("directions", "expected finite non-zero directions").into());
     }
-    let k = match skip {
-        Some(s) => {
-            let v: Vec<i64> = s.as_array().iter().copied().collect();
-            if v.len() != o.len() {
-                return Err(CoreError::invalid(
-                    "skip",
-                    format!(
-                        "expected {} facet indices like origins, got {}",
-                        o.len(),
-                        v.len()
-                    ),
-                )
-                .into());
-            }
-            v
+    let skip = skip.map(c_order);
+    if let Some(s) = &skip {
+        if s.data.len() != n {
+            return Err(CoreError::invalid(
+                "skip",
+                format!(
+                    "expected {n} facet indices like origins, got {}",
+                    s.data.len()
+                ),
+            )
+            .into());
         }
-        None => vec![-1; o.len()],
-    };
-    Ok((o, d, k))
+    }
+    Ok(RayBatch { o, d, skip })
 }
 
 fn heightfield(
@@ -162,16 +166,16 @@ fn radiometry_intersect<'py>(
     Bound<'py, PyArray2<f64>>,
 )> {
     let z = c_order(&dem);
-    let (o, d, k) = ray_batch(&origins, &directions, skip.as_ref())?;
+    let b = ray_batch(&origins, &directions, skip.as_ref())?;
     let (t, f, n) = run(py, n_threads, || {
-        Ok(heightfield(&z, cell_size, periodic, split)?.intersect_many(&o, &d, &k))
+        Ok(heightfield(&z, cell_size, periodic, split)?.intersect_many(
+            &b.o.data,
+            &b.d.data,
+            b.skip.as_ref().map(|s| &*s.data),
+        ))
     })?;
-    let rows = n.len();
-    Ok((
-        array1(py, t),
-        array1(py, f),
-        array2(py, (rows, 3), n.into_iter().flatten().collect())?,
-    ))
+    let rows = t.len();
+    Ok((array1(py, t), array1(py, f), array2(py, (rows, 3), n)?))
 }
 
 /// Whether each ray hits a facet of the DEM (the shadow-ray test).
@@ -190,9 +194,13 @@ fn radiometry_occluded<'py>(
     n_threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray1<bool>>> {
     let z = c_order(&dem);
-    let (o, d, k) = ray_batch(&origins, &directions, skip.as_ref())?;
+    let b = ray_batch(&origins, &directions, skip.as_ref())?;
     let v = run(py, n_threads, || {
-        Ok(heightfield(&z, cell_size, periodic, split)?.occluded_many(&o, &d, &k))
+        Ok(heightfield(&z, cell_size, periodic, split)?.occluded_many(
+            &b.o.data,
+            &b.d.data,
+            b.skip.as_ref().map(|s| &*s.data),
+        ))
     })?;
     Ok(array1(py, v))
 }

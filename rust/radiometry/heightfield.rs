@@ -107,6 +107,16 @@ const EDGE_EPS: f64 = 1e-12;
 /// Grids with at least this many cells get the coarse (block) level.
 const BLOCK_MIN_CELLS: usize = 96 * 96;
 
+/// Rays per parallel task of the batch casts.
+const RAY_CHUNK: usize = 4096;
+
+/// Ray `k` of flat origin and direction slices.
+#[inline(always)]
+fn ray_at(origins: &[f64], dirs: &[f64], k: usize) -> (DVec3, DVec3) {
+    let (o, d) = (&origins[3 * k..3 * k + 3], &dirs[3 * k..3 * k + 3]);
+    (DVec3::new(o[0], o[1], o[2]), DVec3::new(d[0], d[1], d[2]))
+}
+
 /// `floor(v)` as an integer (no libm call on baseline x86-64).
 #[inline(always)]
 fn ifloor(v: f64) -> i64 {
@@ -473,58 +483,61 @@ impl Heightfield {
     }
 
     /// [`Heightfield::intersect`] of many rays in parallel (rayon): origins
-    /// and unit directions as `[x, y, z]` rows, the facet index each ray
-    /// ignores (negative: none). Returns per ray `t` (infinite for a miss),
-    /// the facet index hit (-1 for a miss) and the unit normal (zero for a miss).
+    /// and unit directions as flat `[x, y, z, x, y, z, ...]` slices, the
+    /// facet index each ray ignores (negative or `None`: none). Returns per
+    /// ray `t` (infinite for a miss), the facet index hit (-1 for a miss)
+    /// and the unit normal as a flat slice (zero for a miss).
     pub fn intersect_many(
         &self,
-        origins: &[[f64; 3]],
-        dirs: &[[f64; 3]],
-        skip: &[i64],
-    ) -> (Vec<f64>, Vec<i64>, Vec<[f64; 3]>) {
+        origins: &[f64],
+        dirs: &[f64],
+        skip: Option<&[i64]>,
+    ) -> (Vec<f64>, Vec<i64>, Vec<f64>) {
         use rayon::prelude::*;
-        let one = |i: usize| {
-            let o = DVec3::from_array(origins[i]);
-            let d = DVec3::from_array(dirs[i]);
-            match self.intersect(o, d, self.facet_at(skip[i])) {
-                Some(h) => (h.t, self.facet_index(h.facet), h.normal.to_array()),
-                None => (f64::INFINITY, -1, [0.0; 3]),
-            }
-        };
-        let out: Vec<(f64, i64, [f64; 3])> = (0..origins.len())
-            .into_par_iter()
-            .with_min_len(4096)
-            .map(one)
-            .collect();
-        let mut t = Vec::with_capacity(out.len());
-        let mut f = Vec::with_capacity(out.len());
-        let mut n = Vec::with_capacity(out.len());
-        for (a, b, c) in out {
-            t.push(a);
-            f.push(b);
-            n.push(c);
-        }
-        (t, f, n)
+        let n = origins.len() / 3;
+        let (mut t, mut f, mut nrm) = (vec![0.0; n], vec![0i64; n], vec![0.0; 3 * n]);
+        t.par_chunks_mut(RAY_CHUNK)
+            .zip(f.par_chunks_mut(RAY_CHUNK))
+            .zip(nrm.par_chunks_mut(3 * RAY_CHUNK))
+            .enumerate()
+            .for_each(|(c, ((t, f), nrm))| {
+                for (i, ((t, f), nrm)) in
+                    t.iter_mut().zip(f).zip(nrm.chunks_exact_mut(3)).enumerate()
+                {
+                    let k = c * RAY_CHUNK + i;
+                    let (o, d) = ray_at(origins, dirs, k);
+                    let sk = skip.and_then(|s| self.facet_at(s[k]));
+                    match self.intersect(o, d, sk) {
+                        Some(h) => {
+                            *t = h.t;
+                            *f = self.facet_index(h.facet);
+                            nrm.copy_from_slice(&h.normal.to_array());
+                        }
+                        None => {
+                            *t = f64::INFINITY;
+                            *f = -1;
+                        }
+                    }
+                }
+            });
+        (t, f, nrm)
     }
 
     /// [`Heightfield::occluded`] of many rays in parallel (rayon), with no
     /// distance limit; arguments as in [`Heightfield::intersect_many`].
-    pub fn occluded_many(
-        &self,
-        origins: &[[f64; 3]],
-        dirs: &[[f64; 3]],
-        skip: &[i64],
-    ) -> Vec<bool> {
+    pub fn occluded_many(&self, origins: &[f64], dirs: &[f64], skip: Option<&[i64]>) -> Vec<bool> {
         use rayon::prelude::*;
-        (0..origins.len())
-            .into_par_iter()
-            .with_min_len(4096)
-            .map(|i| {
-                let o = DVec3::from_array(origins[i]);
-                let d = DVec3::from_array(dirs[i]);
-                self.occluded(o, d, self.facet_at(skip[i]), f64::INFINITY)
-            })
-            .collect()
+        let mut out = vec![false; origins.len() / 3];
+        out.par_chunks_mut(RAY_CHUNK)
+            .enumerate()
+            .for_each(|(c, out)| {
+                for (i, v) in out.iter_mut().enumerate() {
+                    let k = c * RAY_CHUNK + i;
+                    let (o, d) = ray_at(origins, dirs, k);
+                    *v = self.occluded(o, d, skip.and_then(|s| self.facet_at(s[k])), f64::INFINITY);
+                }
+            });
+        out
     }
 
     /// The traversal: clip (non-periodic), then walk the blocks of the
