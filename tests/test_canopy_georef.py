@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 import pytest
-from meshfiles import absolute
+from meshfiles import absolute, read_obj
 
 from fractalgeo_rs import cli
 from fractalgeo_rs.canopy import plant_stand
@@ -45,6 +45,11 @@ def _bilinear(z, transform, x, y):
     fc, fr = c - c0, r - r0
     return ((1 - fr) * ((1 - fc) * z[r0, c0] + fc * z[r0, c0 + 1])
             + fr * ((1 - fc) * z[r0 + 1, c0] + fc * z[r0 + 1, c0 + 1]))
+
+
+def n_soil_tri(z):
+    """Triangles of a DEM's grid mesh: two per square of four cell centres."""
+    return 2 * (z.shape[0] - 1) * (z.shape[1] - 1)
 
 
 def _trunk_bases(v, f, kinds, bases_z):
@@ -94,8 +99,12 @@ def test_stand_mesh_is_in_the_dem_crs(tmp_path, capsys, ext, cell):
     left, bottom, right, top = rasterio.transform.array_bounds(z.shape[0], z.shape[1], t)  # W, S, E, N
     u = v[np.unique(f)]
     assert np.all((u[:, 0] > left - 1) & (u[:, 0] < right + 1) & (u[:, 1] > bottom - 1) & (u[:, 1] < top + 1))
-    if kinds is None:
-        return  # OBJ: geometry only
+    if kinds is None:  # OBJ: every triangle, grouped by material, the offset in the header too
+        _, _, groups, comments = read_obj(out)
+        assert len(groups) == meta["triangles"] and set(groups) == {"soil", "bark", "leaves"}
+        assert groups[:n_soil_tri(z)] == ["soil"] * n_soil_tri(z)
+        assert f"offset {meta['offset'][0]!r} {meta['offset'][1]!r} {meta['offset'][2]!r}" in comments
+        return
     # every trunk's base on the DEM's bilinear height at its UTM position
     st = plant_stand("herb", 0.1, z, cell_size=cell, seed=3)
     found = _trunk_bases(v, f, np.asarray(kinds), st.bases[:, 2])
@@ -162,7 +171,7 @@ def test_dem_without_georeferencing_and_disc_canopy_are_local(tmp_path, capsys):
     assert meta["crs_wkt"] is None and "local_frame" not in meta
     np.testing.assert_allclose(v[0, :2], [1.0, 11.0], atol=1e-6)  # the north-west cell centre, metres
     out = tmp_path / "d.obj"
-    assert cli.main(["canopy", "d.obj" if False else str(out), "--lai", "1", "--leaf-radius", "0.1", "--extent", "3",
+    assert cli.main(["canopy", str(out), "--lai", "1", "--leaf-radius", "0.1", "--extent", "3",
                      "2", "--height", "0.2", "1", "--seed", "1"]) == 0
     v, _, _, meta = absolute(out)
     assert meta["crs_wkt"] is None

@@ -8,7 +8,7 @@ import os
 
 import numpy as np
 import pytest
-from meshfiles import absolute, read_mesh, sidecar
+from meshfiles import absolute, read_mesh, read_obj, read_ply, sidecar
 
 from fractalgeo_rs.geometry import GeoGrid, Mesh
 from fractalgeo_rs.lsystem import plant_mesh, write_obj
@@ -53,6 +53,11 @@ def test_write_round_trip_restores_map_coordinates(tmp_path, ext):
     expected = np.asarray(m.vertices, dtype=np.float64) + np.asarray(m.origin)
     np.testing.assert_allclose(v, expected, rtol=0, atol=1e-6)
     np.testing.assert_array_equal(f, m.faces)
+    # the file's header records the same offset (exact reprs), as fractalgeo tin's files do
+    comments = read_obj(out)[3] if ext == "obj" else read_ply(out)[2]
+    offsets = [c.split()[1:] for c in comments if c.startswith("offset ")]
+    assert [[float(x) for x in o] for o in offsets] == [meta["offset"]]
+    assert any(c.startswith("crs PROJCS") or c.startswith("crs EPSG") for c in comments) or meta["crs_wkt"] is None
     # and those are the DEM's cell centres in UTM, within float32 rounding of offsets up to 240 m
     _same_points(v, _centres(z, X0, Y0, CELL, CELL), atol=1e-4)
     rasterio = pytest.importorskip("rasterio")

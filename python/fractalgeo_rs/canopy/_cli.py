@@ -16,6 +16,10 @@ _PLANT = (("density", "--density"), ("dem", "--dem"), ("bark", "--bark"), ("plan
           ("band", "--band"), ("cell_size", "--cell-size"))
 
 
+#: OBJ group names of a stand's triangle kinds (material ids 0, 1, 2).
+_STAND_GROUPS = ("soil", "bark", "leaves")
+
+
 def add_parsers(sub) -> None:
     p = sub.add_parser(
         "canopy", formatter_class=HelpFormatter,
@@ -156,7 +160,7 @@ def _run_discs(args: argparse.Namespace) -> int:
                            ("seed", "--seed"))) from None
     print(f"# canopy: {c.n_leaves} leaves, lai {c.lai:.6g}, lad {c.lad}, seed {c.seed}, {len(c.mesh)} triangles")
     if args.output:
-        write_mesh(c.mesh, args.output, _mesh_format(args.output))
+        write_mesh(c.mesh, args.output, _mesh_format(args.output), groups=("soil", "leaves"))
         print(f"# mesh -> {args.output} (one tile, metres from its south-west corner, no place on Earth; offset in "
               f"the .json sidecar)")
     if spp < 0:
@@ -230,13 +234,13 @@ def _write_stand_mesh(path: str, mesh, placement, rows: int) -> str:
 
     kind, where = placement
     if kind == "map":
-        write_mesh(mesh.placed_on(where, rows), path, _mesh_format(path))
+        write_mesh(mesh.placed_on(where, rows), path, _mesh_format(path), groups=_STAND_GROUPS)
         return f"map coordinates of the DEM's CRS ({where.crs or 'none given'}) = file + offset in the .json sidecar"
     if kind == "geographic":
-        write_mesh(mesh, path, _mesh_format(path), local_frame=where)
+        write_mesh(mesh, path, _mesh_format(path), local_frame=where, groups=_STAND_GROUPS)
         return ("a local metric frame (x east, y north, metres from the DEM's south-west corner); the corner's "
                 "lon/lat and metres per degree in the .json sidecar, no .prj")
-    write_mesh(mesh, path, _mesh_format(path))
+    write_mesh(mesh, path, _mesh_format(path), groups=_STAND_GROUPS)
     return "the DEM has no georeferencing: metres from its south-west corner, offset in the .json sidecar"
 
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import dataclasses
 import os
 from dataclasses import dataclass, fields
-from typing import Optional, Tuple, Union
+from typing import Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -410,21 +410,29 @@ class Mesh:
         return poly
 
 
-def write_mesh(mesh: Mesh, path: PathLike, fmt: str, *, crs=None,
-               local_frame: Optional[dict] = None) -> Tuple[str, ...]:
+def write_mesh(mesh: Mesh, path: PathLike, fmt: str, *, crs=None, local_frame: Optional[dict] = None,
+               groups: Sequence[str] = ()) -> Tuple[str, ...]:
     """Write ``mesh`` as ``fmt`` ("obj" or "ply"), atomically, in Rust, and
     its sidecars (``name.json``, ``name.prj`` with a CRS; see
-    :meth:`Mesh.write`); ``crs`` replaces ``mesh.crs``; ``local_frame`` (a
+    :meth:`Mesh.write`): the header records the offset and CRS too (OBJ
+    ``# offset X Y Z``, PLY ``comment offset X Y Z``, as ``fractalgeo
+    tin``'s files). ``crs`` replaces ``mesh.crs``; ``local_frame`` (a
     JSON-ready dict) is recorded for a mesh in a local metric frame of a
-    geographic DEM. Returns the paths written."""
-    from fractalgeo_rs.geometry._meshfile import crs_wkt, write_sidecars
+    geographic DEM; ``groups[k]`` names the OBJ group of the triangles of
+    kind ``k`` (default ``branches``, ``leaves``, ``kind<k>``). Returns the
+    paths written."""
+    from fractalgeo_rs.geometry._meshfile import crs_wkt, header_lines, write_sidecars
 
     if not isinstance(mesh, Mesh):
         raise TypeError(f"mesh: expected a Mesh, got {type(mesh).__name__}")
     m = mesh._arrays()
     wkt = crs_wkt(crs if crs is not None else m.crs)  # a bad CRS fails before any file is written
     p = os.fspath(path)
-    _core.write_mesh(p, fmt, m)
+    head = header_lines("fractalgeo_rs mesh", len(m.vertices), len(m), m.origin, wkt, "local")[1:]
+    if local_frame is not None:
+        head.append("local_frame: see the .json sidecar (lon, lat from x, y)")
+    _core.write_mesh(p, fmt, m, [line.encode("ascii", "replace").decode("ascii") for line in head],
+                     [str(g) for g in groups])
     return (p,) + write_sidecars(
         p, m.origin, wkt=wkt, n_vertices=len(m.vertices), n_triangles=len(m.faces), coordinates="local",
         description="fractalgeo_rs mesh (map x, y, z = file x, y, z + offset)", local_frame=local_frame)
