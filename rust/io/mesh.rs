@@ -131,7 +131,7 @@ pub fn write_obj_with(
     atomic(path, |w| {
         writeln!(
             w,
-            "# fractalgeo_rs L-system mesh: {} vertices, {} triangles",
+            "# fractalgeo_rs mesh: {} vertices, {} triangles",
             mesh.vertices.len(),
             mesh.faces.len()
         )?;
@@ -175,7 +175,7 @@ pub fn write_ply_with(mesh: &Mesh, path: &Path, comments: &[String]) -> CoreResu
     atomic(path, |w| {
         write!(
             w,
-            "ply\nformat binary_little_endian 1.0\ncomment fractalgeo_rs L-system mesh\n"
+            "ply\nformat binary_little_endian 1.0\ncomment fractalgeo_rs mesh\n"
         )?;
         for c in comments {
             writeln!(w, "comment {}", one_line(c))?;

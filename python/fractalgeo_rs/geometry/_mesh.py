@@ -350,13 +350,13 @@ class Mesh:
 
         Examples
         --------
-        >>> import json, os, tempfile
+        >>> import json, os, pathlib, tempfile
         >>> import numpy as np
         >>> from fractalgeo_rs.geometry import GeoGrid, Mesh
         >>> m = Mesh.from_grid(np.zeros((3, 4)), grid=GeoGrid((500000.0, 4000090.0), 30.0))
         >>> with tempfile.TemporaryDirectory() as d:
         ...     m.write(os.path.join(d, "grid.ply"))
-        ...     meta = json.load(open(os.path.join(d, "grid.json")))
+        ...     meta = json.loads(pathlib.Path(d, "grid.json").read_text())
         ...     files = sorted(os.listdir(d))
         >>> files, meta["offset"], meta["crs_wkt"]
         (['grid.json', 'grid.ply'], [500015.0, 4000015.0, 0.0], None)
