@@ -33,7 +33,11 @@ def add_parsers(sub) -> None:
         "placed on the DEM (fractalgeo_rs.canopy.plant_stand: bark on the branches, bi-Lambertian leaves, "
         "the DEM as soil, a finite scene over the DEM's cell centres); writes the mesh and prints the nadir "
         "BRF with the sun at each zenith (azimuth 0), split into single and multiple scattering "
-        "(Scene.brf_orders), as CSV.",
+        "(Scene.brf_orders), as CSV. Every mesh file gets a JSON sidecar (name.json: map x, y, z = file x, y, z + "
+        "offset, the CRS; name.prj with a CRS) and the offset in its header, as fractalgeo tin's: a stand on a "
+        "projected DEM is written in the DEM's CRS (x east, y north, z height); on a geographic DEM (degrees) in "
+        "a local metric frame from the DEM's south-west corner, whose lon/lat and metres per degree the sidecar "
+        "records (local_frame); a disc tile in metres from its corner.",
     )
     p.add_argument("output", nargs="?", default=None, help="output mesh, .ply or .obj (None: no file)")
     p.add_argument("--lai", type=float, default=None,
@@ -142,7 +146,6 @@ def _run_discs(args: argparse.Namespace) -> int:
     import math
 
     from fractalgeo_rs.canopy import disc_canopy, projection_g
-
     from fractalgeo_rs.geometry._mesh import write_mesh
 
     zen = _zeniths(args.zenith)

@@ -167,6 +167,11 @@ class Mesh:
             Height meaning "no data" (NaN always is).
         n_threads : int, optional
             Threads of the Rust kernel.
+
+        Returns
+        -------
+        Mesh
+            With the grid's CRS as ``crs`` (None without one).
         """
         from fractalgeo_rs._validation import check_n_threads, check_nodata
         from fractalgeo_rs.geometry._geogrid import GeoGrid
@@ -329,8 +334,11 @@ class Mesh:
         records ``offset`` = ``origin`` (map ``x, y, z`` = file ``x, y, z``
         + offset), the CRS as WKT (``crs_wkt``, null without one) and the
         counts, in the sidecar format of ``fractalgeo tin``; with a CRS its
-        WKT is also written to ``name.prj``. Each file appears whole or not
-        at all.
+        WKT is also written to ``name.prj``. The file's header repeats the
+        offset and CRS (OBJ ``# offset X Y Z`` and ``# crs WKT``, PLY
+        ``comment`` lines), and an OBJ puts each triangle kind in its own
+        group (``branches``, ``leaves``, ``kind<k>``). Each file appears
+        whole or not at all.
 
         Parameters
         ----------
