@@ -97,7 +97,7 @@ def test_obj_ply_svg_png_files(tmp_path):
     write_png(m, png, size=120)
     write_png(d, tmp_path / "d.png", size=120)
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert sorted(os.listdir(tmp_path)) == ["d.png", "p.obj", "p.ply", "p.png", "p.svg"]  # no temp files left
+    assert sorted(os.listdir(tmp_path)) == ["d.png", "p.json", "p.obj", "p.ply", "p.png", "p.svg"]  # the sidecar, no temp files
     with pytest.raises(OSError):
         write_obj(m, tmp_path / "missing" / "p.obj")
 

@@ -267,13 +267,21 @@ fn turtle_mesh<'py>(
     Ok(MeshOut(m))
 }
 
-/// Write a mesh as OBJ (`format="obj"`) or binary PLY (`format="ply"`), atomically.
+/// Write a mesh as OBJ (`format="obj"`) or binary PLY (`format="ply"`), atomically,
+/// with extra header lines `comments` and the OBJ group name of each kind `groups`.
 #[pyfunction]
-#[pyo3(signature = (path, format, mesh))]
-fn write_mesh(py: Python<'_>, path: PathBuf, format: MeshFormat, mesh: MeshIn<'_>) -> PyResult<()> {
+#[pyo3(signature = (path, format, mesh, comments=Vec::new(), groups=Vec::new()))]
+fn write_mesh(
+    py: Python<'_>,
+    path: PathBuf,
+    format: MeshFormat,
+    mesh: MeshIn<'_>,
+    comments: Vec<String>,
+    groups: Vec<String>,
+) -> PyResult<()> {
     let m = mesh.into_mesh()?;
     run(py, Some(1), || {
-        crate::io::mesh::write_mesh(&m, &path, format)
+        crate::io::mesh::write_mesh_with(&m, &path, format, &comments, &groups)
     })
 }
 

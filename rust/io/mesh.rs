@@ -70,23 +70,74 @@ impl MeshFormat {
 
 /// Write `mesh` to `path` as `format`, atomically.
 pub fn write_mesh(mesh: &Mesh, path: &Path, format: MeshFormat) -> CoreResult<()> {
+    write_mesh_with(mesh, path, format, &[], &[])
+}
+
+/// Write `mesh` to `path` as `format`, atomically, with extra header lines
+/// `comments` (OBJ `#` comments, PLY `comment` lines; line breaks become
+/// spaces) and the OBJ group name of each kind (`groups[k]` for kind `k`;
+/// see [`write_obj_with`]).
+pub fn write_mesh_with(
+    mesh: &Mesh,
+    path: &Path,
+    format: MeshFormat,
+    comments: &[String],
+    groups: &[String],
+) -> CoreResult<()> {
     match format {
-        MeshFormat::Obj => write_obj(mesh, path),
-        MeshFormat::Ply => write_ply(mesh, path),
+        MeshFormat::Obj => write_obj_with(mesh, path, comments, groups),
+        MeshFormat::Ply => write_ply_with(mesh, path, comments),
+    }
+}
+
+/// One header line: line breaks become spaces.
+fn one_line(s: &str) -> String {
+    s.replace(['\n', '\r'], " ")
+}
+
+/// The OBJ group name of triangles of `kind`: `groups[kind]` (whitespace
+/// as `_`), else `branches` (0), `leaves` (1), `kind<k>`.
+fn group_name(kind: u8, groups: &[String]) -> String {
+    match groups.get(kind as usize) {
+        Some(g) if !g.trim().is_empty() => g.split_whitespace().collect::<Vec<_>>().join("_"),
+        _ => match kind {
+            0 => "branches".to_string(),
+            1 => "leaves".to_string(),
+            k => format!("kind{k}"),
+        },
     }
 }
 
 /// Write `mesh` as Wavefront OBJ (1-based `f v/vt/vn` faces; branches and
 /// leaves in groups `branches` and `leaves`).
 pub fn write_obj(mesh: &Mesh, path: &Path) -> CoreResult<()> {
+    write_obj_with(mesh, path, &[], &[])
+}
+
+/// Write `mesh` as Wavefront OBJ with extra `#` header lines `comments`:
+/// 1-based `f v/vt/vn` faces, every triangle in the group of its kind, the
+/// kinds in increasing order (names from [`group_name`]).
+pub fn write_obj_with(
+    mesh: &Mesh,
+    path: &Path,
+    comments: &[String],
+    groups: &[String],
+) -> CoreResult<()> {
     mesh.check_layout()?;
+    let mut present = [false; 256];
+    for &k in &mesh.kinds {
+        present[k as usize] = true;
+    }
     atomic(path, |w| {
         writeln!(
             w,
-            "# fractalgeo_rs L-system mesh: {} vertices, {} triangles",
+            "# fractalgeo_rs mesh: {} vertices, {} triangles",
             mesh.vertices.len(),
             mesh.faces.len()
         )?;
+        for c in comments {
+            writeln!(w, "# {}", one_line(c))?;
+        }
         for v in &mesh.vertices {
             writeln!(w, "v {} {} {}", v[0], v[1], v[2])?;
         }
@@ -96,11 +147,8 @@ pub fn write_obj(mesh: &Mesh, path: &Path) -> CoreResult<()> {
         for n in &mesh.normals {
             writeln!(w, "vn {} {} {}", n[0], n[1], n[2])?;
         }
-        for (kind, name) in [(0u8, "branches"), (1u8, "leaves")] {
-            if !mesh.kinds.contains(&kind) {
-                continue;
-            }
-            writeln!(w, "g {name}")?;
+        for kind in (0..=255u8).filter(|&k| present[k as usize]) {
+            writeln!(w, "g {}", group_name(kind, groups))?;
             for (f, _) in mesh
                 .faces
                 .iter()
@@ -117,12 +165,24 @@ pub fn write_obj(mesh: &Mesh, path: &Path) -> CoreResult<()> {
 
 /// Write `mesh` as binary little-endian PLY.
 pub fn write_ply(mesh: &Mesh, path: &Path) -> CoreResult<()> {
+    write_ply_with(mesh, path, &[])
+}
+
+/// Write `mesh` as binary little-endian PLY with extra `comment` header
+/// lines `comments`.
+pub fn write_ply_with(mesh: &Mesh, path: &Path, comments: &[String]) -> CoreResult<()> {
     mesh.check_layout()?;
     atomic(path, |w| {
         write!(
             w,
-            "ply\nformat binary_little_endian 1.0\ncomment fractalgeo_rs L-system mesh\n\
-             element vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+            "ply\nformat binary_little_endian 1.0\ncomment fractalgeo_rs mesh\n"
+        )?;
+        for c in comments {
+            writeln!(w, "comment {}", one_line(c))?;
+        }
+        write!(
+            w,
+            "element vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
              property float nx\nproperty float ny\nproperty float nz\nproperty float s\nproperty float t\n\
              element face {}\nproperty list uchar uint vertex_indices\nproperty uint part_id\n\
              property uchar kind\nproperty uint color\nproperty uint instance\nend_header\n",
@@ -200,6 +260,47 @@ mod tests {
         // no temporary file is left behind
         assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 2);
         assert!(write_obj(&m, &dir.join("missing/a.obj")).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn every_kind_is_written_with_its_group_and_the_comments() {
+        let s = parse_module_string("F[+F]{.f.+f.+f.}", "axiom").unwrap();
+        let mut m = build_mesh(&s, &TurtleParams::spatial(60.0, 1.0), 5).unwrap();
+        // kinds 0, 1, 2 and 7 as a plant stand's soil, bark, leaves and more
+        for (i, k) in m.kinds.iter_mut().enumerate() {
+            *k = [0u8, 1, 2, 7][i % 4];
+        }
+        let dir = std::env::temp_dir().join(format!("fgrs-kinds-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let obj = dir.join("k.obj");
+        let comments = ["offset 1.5 2 0".to_string(), "two\nlines".to_string()];
+        let groups = [
+            "soil".to_string(),
+            "bark".to_string(),
+            "leaf blades".to_string(),
+        ];
+        write_obj_with(&m, &obj, &comments, &groups).unwrap();
+        let text = std::fs::read_to_string(&obj).unwrap();
+        assert_eq!(
+            text.lines().filter(|l| l.starts_with("f ")).count(),
+            m.faces.len()
+        );
+        let g: Vec<&str> = text.lines().filter(|l| l.starts_with("g ")).collect();
+        assert_eq!(g, ["g soil", "g bark", "g leaf_blades", "g kind7"]);
+        assert!(text.lines().any(|l| l == "# offset 1.5 2 0"));
+        assert!(text.lines().any(|l| l == "# two lines"));
+        let ply = dir.join("k.ply");
+        write_ply_with(&m, &ply, &comments).unwrap();
+        let bytes = std::fs::read(&ply).unwrap();
+        let head = b"end_header\n";
+        let pos = bytes.windows(head.len()).position(|w| w == head).unwrap() + head.len();
+        let header = String::from_utf8(bytes[..pos].to_vec()).unwrap();
+        assert!(header.lines().any(|l| l == "comment offset 1.5 2 0"));
+        assert_eq!(
+            bytes.len() - pos,
+            m.vertices.len() * 32 + m.faces.len() * (1 + 12 + 4 + 1 + 4 + 4)
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

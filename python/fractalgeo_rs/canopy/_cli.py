@@ -16,6 +16,10 @@ _PLANT = (("density", "--density"), ("dem", "--dem"), ("bark", "--bark"), ("plan
           ("band", "--band"), ("cell_size", "--cell-size"))
 
 
+#: OBJ group names of a stand's triangle kinds (material ids 0, 1, 2).
+_STAND_GROUPS = ("soil", "bark", "leaves")
+
+
 def add_parsers(sub) -> None:
     p = sub.add_parser(
         "canopy", formatter_class=HelpFormatter,
@@ -29,7 +33,11 @@ def add_parsers(sub) -> None:
         "placed on the DEM (fractalgeo_rs.canopy.plant_stand: bark on the branches, bi-Lambertian leaves, "
         "the DEM as soil, a finite scene over the DEM's cell centres); writes the mesh and prints the nadir "
         "BRF with the sun at each zenith (azimuth 0), split into single and multiple scattering "
-        "(Scene.brf_orders), as CSV.",
+        "(Scene.brf_orders), as CSV. Every mesh file gets a JSON sidecar (name.json: map x, y, z = file x, y, z + "
+        "offset, the CRS; name.prj with a CRS) and the offset in its header, as fractalgeo tin's: a stand on a "
+        "projected DEM is written in the DEM's CRS (x east, y north, z height); on a geographic DEM (degrees) in "
+        "a local metric frame from the DEM's south-west corner, whose lon/lat and metres per degree the sidecar "
+        "records (local_frame); a disc tile in metres from its corner.",
     )
     p.add_argument("output", nargs="?", default=None, help="output mesh, .ply or .obj (None: no file)")
     p.add_argument("--lai", type=float, default=None,
@@ -138,10 +146,13 @@ def _run_discs(args: argparse.Namespace) -> int:
     import math
 
     from fractalgeo_rs.canopy import disc_canopy, projection_g
+    from fractalgeo_rs.geometry._mesh import write_mesh
 
     zen = _zeniths(args.zenith)
     leaf, soil = _leaf(args.leaf), _lambertian(args.soil, "--soil")
     spp = 0 if args.spp is None else args.spp
+    if args.output:
+        _mesh_format(args.output)
     try:
         c = disc_canopy(lai=args.lai, leaf_radius=args.leaf_radius, extent=tuple(args.extent),
                         height=tuple(args.height), lad=_lad(args.lad), overlap=not args.no_overlap,
@@ -152,8 +163,9 @@ def _run_discs(args: argparse.Namespace) -> int:
                            ("seed", "--seed"))) from None
     print(f"# canopy: {c.n_leaves} leaves, lai {c.lai:.6g}, lad {c.lad}, seed {c.seed}, {len(c.mesh)} triangles")
     if args.output:
-        c.mesh.write(args.output)
-        print(f"# mesh -> {args.output}")
+        write_mesh(c.mesh, args.output, _mesh_format(args.output), groups=("soil", "leaves"))
+        print(f"# mesh -> {args.output} (one tile, metres from its south-west corner, no place on Earth; offset in "
+              f"the .json sidecar)")
     if spp < 0:
         raise ValueError(f"--spp: expected 0 (no tracing) or a positive number of rays, got {spp}")
     scene = c.scene() if spp else None
@@ -172,14 +184,74 @@ def _run_discs(args: argparse.Namespace) -> int:
 
 
 def _read_dem(args: argparse.Namespace):
-    """Heights and ``(dy, dx)`` in metres of ``--dem`` (``--cell-size`` replaces the file's)."""
+    """Heights, the rasterio profile and ``(dy, dx)`` in metres of ``--dem``
+    (``--cell-size`` replaces the file's)."""
     from fractalgeo_rs.dem._cli import read_dem_ground
 
     side = args.cell_size
-    z, _, cell = read_dem_ground(args.dem, args.band, None if side is None else (side, side), "--dem")
+    z, prof, cell = read_dem_ground(args.dem, args.band, None if side is None else (side, side), "--dem")
     if cell is None:
         raise ValueError("--cell-size: the DEM has no georeferencing; pass --cell-size (metres)")
-    return z, cell
+    return z, prof, cell
+
+
+def _stand_placement(args: argparse.Namespace, prof, shape, cell):
+    """Where the stand's mesh goes, checked before anything is built:
+    ``("map", GeoGrid)`` for a projected (or CRS-less) georeferenced DEM,
+    ``("geographic", local_frame dict)`` for a DEM in degrees, ``("local",
+    None)`` without georeferencing."""
+    from fractalgeo_rs._cli_common import input_georef, is_geographic
+    from fractalgeo_rs.geometry import GeoGrid
+    from fractalgeo_rs.geometry._meshfile import crs_wkt
+
+    prof = prof or {}
+    t, crs = prof.get("transform"), prof.get("crs")
+    if t is None or (crs is None and tuple(t)[:6] == (1.0, 0.0, 0.0, 0.0, 1.0, 0.0)):
+        return "local", None
+    a, b, c, d, e, f = (float(v) for v in tuple(t)[:6])
+    if is_geographic(crs):
+        if b != 0 or d != 0 or not (a > 0 and e < 0):
+            raise ValueError(f"--dem: a geographic DEM must be north up (no rotation) to anchor the stand's metric "
+                             f"frame, got transform {(a, b, c, d, e, f)}")
+        dy, dx = cell
+        rows = shape[0]
+        return "geographic", {
+            "frame": "local metric frame of a geographic DEM: x east, y north, z the DEM's height, metres",
+            "corner_lonlat": [c, f + e * rows],
+            "metres_per_degree": [dx / a, dy / -e],
+            "crs_wkt": crs_wkt(crs),
+            "rule": "lon = corner_lonlat[0] + (file x + offset x) / metres_per_degree[0]; "
+                    "lat = corner_lonlat[1] + (file y + offset y) / metres_per_degree[1]",
+        }
+    geo = input_georef(args, prof, shape, name="dem", announce=False)
+    try:
+        return "map", GeoGrid.from_affine(tuple(geo["transform"])[:6], crs)
+    except ValueError as exc:
+        raise ValueError(f"--dem: the stand is built on a north-up grid and cannot be placed on this DEM's "
+                         f"grid ({str(exc).split(': ', 1)[1]}); give a north-up DEM") from None
+
+
+def _write_stand_mesh(path: str, mesh, placement, rows: int) -> str:
+    """Write the stand's mesh where ``placement`` says; the words saying where."""
+    from fractalgeo_rs.geometry._mesh import write_mesh
+
+    kind, where = placement
+    if kind == "map":
+        write_mesh(mesh.placed_on(where, rows), path, _mesh_format(path), groups=_STAND_GROUPS)
+        return f"map coordinates of the DEM's CRS ({where.crs or 'none given'}) = file + offset in the .json sidecar"
+    if kind == "geographic":
+        write_mesh(mesh, path, _mesh_format(path), local_frame=where, groups=_STAND_GROUPS)
+        return ("a local metric frame (x east, y north, metres from the DEM's south-west corner); the corner's "
+                "lon/lat and metres per degree in the .json sidecar, no .prj")
+    write_mesh(mesh, path, _mesh_format(path), groups=_STAND_GROUPS)
+    return "the DEM has no georeferencing: metres from its south-west corner, offset in the .json sidecar"
+
+
+def _mesh_format(path: str) -> str:
+    ext = str(path).lower().rsplit(".", 1)[-1]
+    if ext not in ("obj", "ply"):
+        raise ValueError(f"output: expected a .ply or .obj file, got {path!r}")
+    return ext
 
 
 def _run_plant(args: argparse.Namespace) -> int:
@@ -202,7 +274,10 @@ def _run_plant(args: argparse.Namespace) -> int:
         raise ValueError(f"--max-depth: expected 1 to 100000 scattering events, got {args.max_depth}")
     leaf, soil = _leaf(args.leaf), _lambertian(args.soil, "--soil")
     bark = None if args.bark is None else _lambertian(args.bark, "--bark")
-    z, cell = _read_dem(args)
+    if args.output:
+        _mesh_format(args.output)
+    z, prof, cell = _read_dem(args)
+    placement = _stand_placement(args, prof, z.shape, cell) if args.output else None
     try:
         st = plant_stand(args.plant, args.density, z, cell_size=cell, bark=bark, leaf=leaf, soil=soil,
                          scale=args.plant_scale, seed=args.seed)
@@ -214,8 +289,8 @@ def _run_plant(args: argparse.Namespace) -> int:
           f"ground {st.extent[2]:.6g} m x {st.extent[3]:.6g} m (cells {cell[0]:.6g} m x {cell[1]:.6g} m), "
           f"seed {st.seed}, {len(st.mesh)} triangles")
     if args.output:
-        st.mesh.write(args.output)
-        print(f"# mesh -> {args.output} (triangle kinds = material ids: 0 soil, 1 bark, 2 leaf)")
+        where = _write_stand_mesh(args.output, st.mesh, placement, z.shape[0])
+        print(f"# mesh -> {args.output} (triangle kinds = material ids: 0 soil, 1 bark, 2 leaf; {where})")
     print("sun_zenith,brf,se,single,single_se,multiple,multiple_se")
     sys.stdout.flush()
     scene = st.scene()

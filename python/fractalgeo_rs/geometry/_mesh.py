@@ -3,9 +3,10 @@ TINs and DEM grids all become a :class:`Mesh`, written to OBJ/PLY in Rust
 and handed to trimesh or PyVista."""
 from __future__ import annotations
 
+import dataclasses
 import os
 from dataclasses import dataclass, fields
-from typing import Optional, Tuple, Union
+from typing import Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -51,6 +52,10 @@ class Mesh:
         Object number in a scene (0 for a single plant).
     origin : (float, float, float)
         Map coordinates the vertices are relative to (0 for plants).
+    crs : str or None
+        The coordinate reference system of the map coordinates when the
+        mesh knows it (:meth:`from_grid` of a grid with a CRS,
+        ``TIN.to_mesh``, :meth:`placed_on`); written by :meth:`write`.
 
     References
     ----------
@@ -90,17 +95,19 @@ class Mesh:
     colors: np.ndarray
     instances: np.ndarray
     origin: Tuple[float, float, float] = (0.0, 0.0, 0.0)
+    crs: Optional[str] = None
 
     def __len__(self) -> int:
         return int(len(self.faces))
 
     @classmethod
-    def _from_core(cls, d) -> "Mesh":
+    def _from_core(cls, d, crs=None) -> "Mesh":
         if isinstance(d, dict):
             d = dict(d)
             d["origin"] = tuple(float(v) for v in d["origin"])
+            d["crs"] = crs
             return cls(**d)
-        return cls(*d)
+        return dataclasses.replace(cls(*d), crs=crs)
 
     # ------------------------------------------------------------ builders
     @classmethod
@@ -160,6 +167,11 @@ class Mesh:
             Height meaning "no data" (NaN always is).
         n_threads : int, optional
             Threads of the Rust kernel.
+
+        Returns
+        -------
+        Mesh
+            With the grid's CRS as ``crs`` (None without one).
         """
         from fractalgeo_rs._validation import check_n_threads, check_nodata
         from fractalgeo_rs.geometry._geogrid import GeoGrid
@@ -180,14 +192,14 @@ class Mesh:
             z[z == nd] = np.nan
         if not isinstance(split, str):
             raise TypeError(f"split: expected 'ne-sw', 'nw-se' or 'alternating', got {split!r}")
-        return cls._from_core(_core.mesh_from_grid(z, g, split, check_n_threads(n_threads)))
+        return cls._from_core(_core.mesh_from_grid(z, g, split, check_n_threads(n_threads)), crs=g.crs)
 
     # ------------------------------------------------------------ queries
     def _arrays(self) -> "Mesh":
         """The mesh with every field in its exact dtype (any strides)."""
         conv = {}
         for f in fields(self):
-            if f.name == "origin":
+            if f.name in ("origin", "crs"):
                 continue
             a = np.asarray(getattr(self, f.name))
             want = np.dtype(_DTYPES[f.name])
@@ -201,7 +213,7 @@ class Mesh:
         origin = np.asarray(self.origin, dtype=np.float64)
         if origin.shape != (3,):
             raise ValueError(f"origin: expected 3 numbers, got shape {origin.shape}")
-        return Mesh(**conv, origin=(float(origin[0]), float(origin[1]), float(origin[2])))
+        return Mesh(**conv, origin=(float(origin[0]), float(origin[1]), float(origin[2])), crs=self.crs)
 
     def validate(self) -> "Mesh":
         """Check the mesh and return it: one normal and uv per vertex, one
@@ -236,25 +248,143 @@ class Mesh:
         return len(self) > 0 and self.edges() == {"boundary": 0, "non_manifold": 0, "inconsistent": 0}
 
     # ------------------------------------------------------------ output
-    def write(self, path: PathLike, format: Optional[str] = None) -> None:
+    def placed_on(self, grid, rows: int) -> "Mesh":
+        r"""The mesh moved from a grid's local metric frame to the grid's
+        map coordinates, with the grid's CRS.
+
+        The local frame is the one of a DEM without georeference
+        (:meth:`GeoGrid.from_cell_size`, ``Mesh.from_grid(dem,
+        cell_size=)``, :func:`fractalgeo_rs.canopy.plant_stand`): the
+        south-west (lower-left) corner of the grid's ``rows`` rows at
+        ``(0, 0)``, x along the rows (east for a north-up grid), y up the
+        columns (north), z up, in the grid's cell units. A local point
+        ``(x, y, z)`` goes to
+
+        .. math::
+
+            X = x_s + x\cos\theta - y\sin\theta,\qquad
+            Y = y_s + x\sin\theta + y\cos\theta,\qquad Z = z,
+
+        with ``(x_s, y_s) = (x_0 + r\,\Delta y \sin\theta, y_0 - r\,\Delta y
+        \cos\theta)`` the grid's corner of row ``r = rows``, column 0
+        (:class:`GeoGrid`'s formula). A north-up grid only moves ``origin``
+        (the float32 vertices are kept bit for bit); a rotated grid also
+        rotates the vertices and normals (float32 rounding of the offsets).
+
+        Parameters
+        ----------
+        grid : GeoGrid
+            The grid, projected: x, y and z need one unit (a geographic grid
+            is a ``ValueError`` naming ``grid``).
+        rows : int
+            Rows of the grid (>= 1): the local frame starts at its south
+            edge.
+
+        Returns
+        -------
+        Mesh
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from fractalgeo_rs.geometry import GeoGrid, Mesh
+        >>> local = Mesh.from_grid(np.zeros((3, 4)), cell_size=30.0)       # lower-left corner at (0, 0)
+        >>> local.origin
+        (15.0, 15.0, 0.0)
+        >>> utm = GeoGrid((500000.0, 4000090.0), 30.0, crs="EPSG:32633")   # 3 rows: south edge 4000000
+        >>> m = local.placed_on(utm, 3)
+        >>> m.origin, m.crs
+        ((500015.0, 4000015.0, 0.0), 'EPSG:32633')
+        """
+        import math
+        import numbers
+
+        from fractalgeo_rs.geometry._geogrid import GeoGrid
+
+        if not isinstance(grid, GeoGrid):
+            raise TypeError(f"grid: expected a GeoGrid, got {type(grid).__name__}")
+        grid.require_projected("grid")
+        if isinstance(rows, bool) or not isinstance(rows, numbers.Integral):
+            raise TypeError(f"rows: expected an int, got {rows!r}")
+        if rows < 1:
+            raise ValueError(f"rows: expected at least 1 row, got {rows}")
+        m = self._arrays()
+        t = math.radians(grid.rotation)
+        cos, sin = (1.0, 0.0) if grid.rotation == 0 else (math.cos(t), math.sin(t))
+        xs = grid.x0 + int(rows) * grid.dy * sin
+        ys = grid.y0 - int(rows) * grid.dy * cos
+        ox, oy, oz = m.origin
+        origin = (xs + ox * cos - oy * sin, ys + ox * sin + oy * cos, oz)
+        if grid.rotation == 0:
+            return dataclasses.replace(m, origin=origin, crs=grid.crs)
+        rot = np.array([[cos, -sin, 0.0], [sin, cos, 0.0], [0.0, 0.0, 1.0]])
+        return dataclasses.replace(
+            m, origin=origin, crs=grid.crs,
+            vertices=(np.asarray(m.vertices, dtype=np.float64) @ rot.T).astype(np.float32),
+            normals=(np.asarray(m.normals, dtype=np.float64) @ rot.T).astype(np.float32))
+
+    # ------------------------------------------------------------ output
+    def write(self, path: PathLike, format: Optional[str] = None, *, crs=None) -> None:
         """Write the mesh as ``format`` ("obj" or "ply"; default: from the
-        file name's extension), atomically, in Rust. Vertices are written
-        relative to ``origin`` (float32), as :meth:`write_obj` and
-        :meth:`write_ply` do."""
+        file name's extension), atomically, in Rust, with its place on Earth
+        in a JSON sidecar.
+
+        The file holds the float32 vertices relative to ``origin`` (as
+        :meth:`write_obj` and :meth:`write_ply` do); ``name.json`` beside it
+        records ``offset`` = ``origin`` (map ``x, y, z`` = file ``x, y, z``
+        + offset), the CRS as WKT (``crs_wkt``, null without one) and the
+        counts, in the sidecar format of ``fractalgeo tin``; with a CRS its
+        WKT is also written to ``name.prj``. The file's header repeats the
+        offset and CRS (OBJ ``# offset X Y Z`` and ``# crs WKT``, PLY
+        ``comment`` lines), and an OBJ puts each triangle kind in its own
+        group (``branches``, ``leaves``, ``kind<k>``). Each file appears
+        whole or not at all.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The mesh file (``.obj`` or ``.ply`` unless ``format`` is given);
+            the sidecars take its name with ``.json`` and ``.prj``.
+        format : {"obj", "ply"}, optional
+        crs : optional
+            CRS of the map coordinates (``"EPSG:32633"``, WKT, a rasterio or
+            pyproj CRS); default the mesh's own :attr:`crs`.
+
+        Raises
+        ------
+        ValueError
+            A name without ``.obj``/``.ply`` and no ``format`` (``path``), a
+            CRS rasterio does not read (``crs``), a bad layout (the field).
+
+        Examples
+        --------
+        >>> import json, os, pathlib, tempfile
+        >>> import numpy as np
+        >>> from fractalgeo_rs.geometry import GeoGrid, Mesh
+        >>> m = Mesh.from_grid(np.zeros((3, 4)), grid=GeoGrid((500000.0, 4000090.0), 30.0))
+        >>> with tempfile.TemporaryDirectory() as d:
+        ...     m.write(os.path.join(d, "grid.ply"))
+        ...     meta = json.loads(pathlib.Path(d, "grid.json").read_text())
+        ...     files = sorted(os.listdir(d))
+        >>> files, meta["offset"], meta["crs_wkt"]
+        (['grid.json', 'grid.ply'], [500015.0, 4000015.0, 0.0], None)
+        """
         if format is None:
             ext = os.fspath(path).lower().rsplit(".", 1)[-1]
             if ext not in ("obj", "ply"):
                 raise ValueError(f"path: expected a .obj or .ply file (or pass format=), got {os.fspath(path)!r}")
             format = ext
-        write_mesh(self, path, format)
+        write_mesh(self, path, format, crs=crs)
 
-    def write_obj(self, path: PathLike) -> None:
-        """Write a Wavefront OBJ file (see :func:`fractalgeo_rs.lsystem.write_obj`)."""
-        write_mesh(self, path, "obj")
+    def write_obj(self, path: PathLike, *, crs=None) -> None:
+        """Write a Wavefront OBJ file (see :func:`fractalgeo_rs.lsystem.write_obj`)
+        and its sidecars (see :meth:`write`)."""
+        write_mesh(self, path, "obj", crs=crs)
 
-    def write_ply(self, path: PathLike) -> None:
-        """Write a binary PLY file (see :func:`fractalgeo_rs.lsystem.write_ply`)."""
-        write_mesh(self, path, "ply")
+    def write_ply(self, path: PathLike, *, crs=None) -> None:
+        """Write a binary PLY file (see :func:`fractalgeo_rs.lsystem.write_ply`)
+        and its sidecars (see :meth:`write`)."""
+        write_mesh(self, path, "ply", crs=crs)
 
     def to_trimesh(self):
         """The mesh as a ``trimesh.Trimesh`` in map coordinates (float64),
@@ -288,8 +418,29 @@ class Mesh:
         return poly
 
 
-def write_mesh(mesh: Mesh, path: PathLike, fmt: str) -> None:
-    """Write ``mesh`` as ``fmt`` ("obj" or "ply"), atomically, in Rust."""
+def write_mesh(mesh: Mesh, path: PathLike, fmt: str, *, crs=None, local_frame: Optional[dict] = None,
+               groups: Sequence[str] = ()) -> Tuple[str, ...]:
+    """Write ``mesh`` as ``fmt`` ("obj" or "ply"), atomically, in Rust, and
+    its sidecars (``name.json``, ``name.prj`` with a CRS; see
+    :meth:`Mesh.write`): the header records the offset and CRS too (OBJ
+    ``# offset X Y Z``, PLY ``comment offset X Y Z``, as ``fractalgeo
+    tin``'s files). ``crs`` replaces ``mesh.crs``; ``local_frame`` (a
+    JSON-ready dict) is recorded for a mesh in a local metric frame of a
+    geographic DEM; ``groups[k]`` names the OBJ group of the triangles of
+    kind ``k`` (default ``branches``, ``leaves``, ``kind<k>``). Returns the
+    paths written."""
+    from fractalgeo_rs.geometry._meshfile import crs_wkt, header_lines, write_sidecars
+
     if not isinstance(mesh, Mesh):
         raise TypeError(f"mesh: expected a Mesh, got {type(mesh).__name__}")
-    _core.write_mesh(os.fspath(path), fmt, mesh._arrays())
+    m = mesh._arrays()
+    wkt = crs_wkt(crs if crs is not None else m.crs)  # a bad CRS fails before any file is written
+    p = os.fspath(path)
+    head = header_lines("fractalgeo_rs mesh", len(m.vertices), len(m), m.origin, wkt, "local")[1:]
+    if local_frame is not None:
+        head.append("local_frame: see the .json sidecar (lon, lat from x, y)")
+    _core.write_mesh(p, fmt, m, [line.encode("ascii", "replace").decode("ascii") for line in head],
+                     [str(g) for g in groups])
+    return (p,) + write_sidecars(
+        p, m.origin, wkt=wkt, n_vertices=len(m.vertices), n_triangles=len(m.faces), coordinates="local",
+        description="fractalgeo_rs mesh (map x, y, z = file x, y, z + offset)", local_frame=local_frame)

@@ -24,8 +24,10 @@ def write_obj(mesh: Mesh, path: PathLike) -> None:
 
     Vertices ``v``, texture coordinates ``vt``, normals ``vn`` and faces
     ``f v/vt/vn`` (1-based), branches and leaves in groups ``branches`` and
-    ``leaves``. The file is written atomically (under a temporary name,
-    then renamed).
+    ``leaves`` (other kinds in ``kind<k>``). The file is written atomically
+    (under a temporary name, then renamed), with the JSON sidecar of
+    :meth:`fractalgeo_rs.geometry.Mesh.write` (``name.json``: the offset
+    ``mesh.origin``, the CRS) and the offset in a ``# offset X Y Z`` line.
 
     Parameters
     ----------
@@ -65,7 +67,9 @@ def write_ply(mesh: Mesh, path: PathLike) -> None:
     Vertex properties ``x y z nx ny nz s t`` (float32); face properties
     ``vertex_indices`` (uchar count, uint32 indices), ``part_id``, ``kind``
     (uchar), ``color`` and ``instance`` (uint32): 32 bytes per vertex and
-    26 per triangle after the text header. The file is written atomically.
+    26 per triangle after the text header. The file is written atomically,
+    with the JSON sidecar of :meth:`fractalgeo_rs.geometry.Mesh.write`
+    (``name.json``) and the offset in a ``comment offset X Y Z`` line.
 
     Parameters
     ----------

@@ -12,30 +12,15 @@ transform, units); the CRS is also written as WKT in ``name.prj``.
 """
 from __future__ import annotations
 
-import json
 import os
-from typing import Optional, Tuple
+from typing import Tuple
 
 import numpy as np
 
 from fractalgeo_rs._validation import atomic_write_path
+from fractalgeo_rs.geometry._meshfile import crs_wkt, header_lines, write_sidecars
 
 COORDINATES = ("local", "map")
-
-
-def _crs_wkt(crs) -> Optional[str]:
-    if crs is None:
-        return None
-    if hasattr(crs, "to_wkt"):
-        return crs.to_wkt()
-    try:
-        from rasterio.crs import CRS
-    except ImportError:  # no rasterio: the CRS as given
-        return str(crs)
-    try:
-        return CRS.from_user_input(crs).to_wkt()
-    except Exception as exc:  # rasterio's CRSError
-        raise ValueError(f"crs: not a CRS rasterio understands: {crs!r} ({exc})") from None
 
 
 def offset_of(vertices: np.ndarray, coordinates: str) -> np.ndarray:
@@ -47,42 +32,6 @@ def offset_of(vertices: np.ndarray, coordinates: str) -> np.ndarray:
     if coordinates == "local" and len(vertices):
         off[:2] = vertices[:, :2].min(axis=0)
     return off
-
-
-def _sidecars(path: str, offset: np.ndarray, crs, transform, n_vertices: int, n_triangles: int,
-              coordinates: str) -> Tuple[str, ...]:
-    stem = os.path.splitext(path)[0]
-    wkt = _crs_wkt(crs)
-    meta = {
-        "description": "fractalgeo_rs terrain TIN (map x, y, z = file x, y, z + offset)",
-        "coordinates": coordinates,
-        "offset": [float(v) for v in offset],
-        "crs_wkt": wkt,
-        "dem_transform": None if transform is None else [float(v) for v in tuple(transform)[:6]],
-        "vertices": int(n_vertices),
-        "triangles": int(n_triangles),
-    }
-    written = [stem + ".json"]
-    with atomic_write_path(stem + ".json") as tmp:
-        with open(tmp, "w") as fh:
-            json.dump(meta, fh, indent=1)
-            fh.write("\n")
-    if wkt is not None:
-        with atomic_write_path(stem + ".prj") as tmp:
-            with open(tmp, "w") as fh:
-                fh.write(wkt)
-        written.append(stem + ".prj")
-    return tuple(written)
-
-
-def _header_lines(n_v: int, n_t: int, offset: np.ndarray, crs, coordinates: str) -> list:
-    lines = [f"fractalgeo_rs terrain TIN: {n_v} vertices, {n_t} triangles",
-             f"coordinates {coordinates}: map x y z = file x y z + offset",
-             "offset " + " ".join(repr(float(v)) for v in offset)]
-    wkt = _crs_wkt(crs)
-    if wkt is not None:
-        lines.append("crs " + " ".join(wkt.split()))
-    return lines
 
 
 def write_tin(tin, path, *, coordinates: str = "local", crs=None) -> Tuple[str, ...]:
@@ -97,7 +46,8 @@ def write_tin(tin, path, *, coordinates: str = "local", crs=None) -> Tuple[str, 
     t = np.asarray(tin.triangles, dtype=np.uint32)
     off = offset_of(v, coordinates)
     rel = v - off
-    head = _header_lines(len(v), len(t), off, crs, coordinates)
+    wkt = crs_wkt(crs)
+    head = header_lines("fractalgeo_rs terrain TIN", len(v), len(t), off, wkt, coordinates)
     if ext == ".obj":
         with atomic_write_path(p) as tmp:
             with open(tmp, "w") as fh:
@@ -116,7 +66,9 @@ def write_tin(tin, path, *, coordinates: str = "local", crs=None) -> Tuple[str, 
                 fh.write(("\n".join(header) + "\n").encode("ascii", "replace"))
                 fh.write(np.ascontiguousarray(rel, dtype="<f8").tobytes())
                 fh.write(faces.tobytes())
-    return (p,) + _sidecars(p, off, crs, getattr(tin, "transform", None), len(v), len(t), coordinates)
+    return (p,) + write_sidecars(p, off, wkt=wkt, transform=getattr(tin, "transform", None), n_vertices=len(v),
+                                 n_triangles=len(t), coordinates=coordinates,
+                                 description="fractalgeo_rs terrain TIN (map x, y, z = file x, y, z + offset)")
 
 
 def read_tin(path) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:

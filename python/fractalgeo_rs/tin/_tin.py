@@ -226,9 +226,10 @@ class TIN:
         vertex (map ``x, y`` minima, z = 0), so that float32 keeps
         millimetres in UTM; per-vertex area-weighted normals (:meth:`normals`);
         UVs = map ``x, y`` scaled to [0, 1] over the mesh's bounding box;
-        ``part_ids`` = triangle number."""
+        ``part_ids`` = triangle number; ``crs`` the TIN's."""
         return Mesh._from_core(_core.mesh_from_tin(np.ascontiguousarray(self.vertices, dtype=np.float64),
-                                                   np.ascontiguousarray(self.triangles, dtype=np.int64)))
+                                                   np.ascontiguousarray(self.triangles, dtype=np.int64)),
+                               crs=self.crs)
 
     def write_obj(self, path, *, coordinates: str = "local", crs=None) -> None:
         """Write the mesh as Wavefront OBJ, georeferenced.
