@@ -615,7 +615,7 @@ impl Heightfield {
             } else {
                 ((0, 0), (self.ncc as i64 - 1, self.ncr as i64 - 1))
             };
-            return match self.walk_cells::<ANY>(&ray, t_start, lo, hi, &mut steps) {
+            return match self.walk_cells::<ANY>(&ray, t_start, lo, hi, self.zmax, &mut steps) {
                 Walk::Next => Walk::Stop,
                 w => w,
             };
@@ -640,13 +640,14 @@ impl Heightfield {
         loop {
             let t_exit = tmx.min(tmy);
             let z_exit = o.z + t_exit * d.z;
-            if fmin(z_enter, z_exit) <= self.bmax[byw * self.nbc + bxw] {
+            let cap = self.bmax[byw * self.nbc + bxw];
+            if fmin(z_enter, z_exit) <= cap {
                 let lo = (bx * bs, by * bs);
                 let mut hi = (lo.0 + bs - 1, lo.1 + bs - 1);
                 if !self.periodic {
                     hi = (hi.0.min(self.ncc as i64 - 1), hi.1.min(self.ncr as i64 - 1));
                 }
-                match self.walk_cells::<ANY>(&ray, t_enter, lo, hi, &mut steps) {
+                match self.walk_cells::<ANY>(&ray, t_enter, lo, hi, cap, &mut steps) {
                     Walk::Next => {}
                     w => return w,
                 }
@@ -729,7 +730,9 @@ impl Heightfield {
 
     /// Walk the cells from ray parameter `t0` while the cell indices stay
     /// within `lo..=hi` (a block, or the patch), testing the facets of every
-    /// cell whose highest corner the ray segment does not pass above.
+    /// cell whose highest corner the ray segment does not pass above; a
+    /// rising ray leaves as soon as it is above `cap`, the highest corner of
+    /// the block (it can meet nothing more there).
     #[inline(always)]
     fn walk_cells<const ANY: bool>(
         &self,
@@ -737,6 +740,7 @@ impl Heightfield {
         t0: f64,
         lo: (i64, i64),
         hi: (i64, i64),
+        cap: f64,
         steps: &mut usize,
     ) -> Walk {
         let (o, d) = (ray.o, ray.d);
@@ -765,6 +769,9 @@ impl Heightfield {
                 || t_exit > ray.t_max
             {
                 return Walk::Stop;
+            }
+            if d.z >= 0.0 && z_exit > cap {
+                return Walk::Next; // above the block for the rest of it
             }
             *steps += 1;
             if *steps > MAX_STEPS {
