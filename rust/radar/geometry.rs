@@ -1240,6 +1240,66 @@ mod tests {
     }
 
     #[test]
+    fn vector_paths_equal_the_baseline_code() {
+        // the row kernels as dispatched (AVX2 where the CPU has it) against
+        // the same code compiled for the baseline target: the same bits, on
+        // relief with shadow, layover and a missing height
+        let (rows, cols) = (5, 203);
+        let z: Vec<f64> = (0..rows * cols)
+            .map(|i| {
+                let (r, c) = ((i / cols) as f64, (i % cols) as f64);
+                let spike = if i % 37 == 5 { 9.0 } else { 0.0 };
+                30.0 * (0.21 * c).sin() * (0.4 * r).cos()
+                    + spike
+                    + if i == 420 { f64::NAN } else { 0.0 }
+            })
+            .collect();
+        let table: Vec<f64> = (0..900).map(|i| (-(i as f64) / 300.0).exp()).collect();
+        let prm = Params::new(1.0, 1.0, 30.0, &table, 0.1);
+        let (lo, n_bins) = slant_axis(&z, cols, &prm).unwrap();
+        let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        for r in 0..rows {
+            let mut a = (
+                vec![0.0; cols],
+                vec![0.0; cols],
+                vec![0.0; cols],
+                vec![0u8; cols],
+            );
+            let mut b = a.clone();
+            let mut scr = RowScratch::new(cols);
+            geometry_row(
+                &z, rows, cols, r, &prm, lo, &mut a.0, &mut a.1, &mut a.2, &mut a.3, &mut scr,
+            );
+            geometry_row_impl(
+                &z, rows, cols, r, &prm, lo, &mut b.0, &mut b.1, &mut b.2, &mut b.3, &mut scr,
+            );
+            assert_eq!(bits(&a.0), bits(&b.0));
+            assert_eq!(bits(&a.1), bits(&b.1));
+            assert_eq!(bits(&a.2), bits(&b.2));
+            assert_eq!(a.3, b.3);
+            assert!(
+                a.3.iter().any(|&f| f & SHADOW != 0)
+                    && a.3.iter().any(|&f| f & ACTIVE_LAYOVER != 0)
+            );
+            let (mut ha, mut hb) = (Halves::new(cols), Halves::new(cols));
+            #[cfg(target_arch = "x86_64")]
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU has AVX2 (checked just above).
+                unsafe { prepare_line_avx2(&a.2, &a.1, &a.3, n_bins, &mut ha) };
+            } else {
+                prepare_line_impl(&a.2, &a.1, &a.3, n_bins, &mut ha);
+            }
+            prepare_line_impl(&a.2, &a.1, &a.3, n_bins, &mut hb);
+            for side in 0..2 {
+                assert_eq!(ha.ka[side], hb.ka[side]);
+                assert_eq!(bits(&ha.va[side]), bits(&hb.va[side]));
+                assert_eq!(bits(&ha.vb[side]), bits(&hb.vb[side]));
+                assert_eq!(ha.code[side], hb.code[side]);
+            }
+        }
+    }
+
+    #[test]
     fn fused_scene_equals_the_composed_steps() {
         let (rows, cols) = (9, 31);
         let z: Vec<f64> = (0..rows * cols)

@@ -356,6 +356,21 @@ mod tests {
                 }
             }
         }
+        // the baseline code: the same bits
+        for looks in [1u32, 3, 4, 9] {
+            let mut a = vec![0.0; 77];
+            let mut b = vec![0.0; 77];
+            fill_products(&mut a, key, 99, looks);
+            fill_products_impl(&mut b, key, 99, looks);
+            assert_eq!(a, b);
+            let v: Vec<f64> = (0..77)
+                .map(|i| if i == 7 { f64::NAN } else { i as f64 })
+                .collect();
+            let mut c = a.clone();
+            apply_products(&mut a, &v, looks);
+            apply_products_impl(&mut c, &v, looks);
+            assert!(a.iter().zip(&c).all(|(x, y)| x.to_bits() == y.to_bits()));
+        }
         // the conversion at the ends of its range
         for bits in [0u64, 1 << 11, u64::MAX, u64::MAX >> 1, 0xffff_ffff << 11] {
             assert_eq!(
