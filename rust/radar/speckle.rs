@@ -243,7 +243,7 @@ pub fn speckle(
         ));
     }
     let key = StreamKey::new(seed, STREAM);
-    let mut out = vec![0.0; intensity.len()];
+    let mut out = crate::buffers::zeroed(intensity.len());
     if cols == 0 {
         return Ok(out);
     }
@@ -255,6 +255,12 @@ pub fn speckle(
             let start = grow
                 .wrapping_mul(place.global_cols)
                 .wrapping_add(place.origin.1);
+            if looks <= 16 {
+                // vectorised, the same bits (see `apply_products`)
+                fill_products(o, key, start, looks);
+                apply_products(o, x, looks);
+                return;
+            }
             for (c, (o, &v)) in o.iter_mut().zip(x).enumerate() {
                 *o = if v.is_nan() {
                     f64::NAN
