@@ -551,6 +551,9 @@ const H_GENERAL: u8 = 16;
 /// its right edge. In the common case, the first bin `ka` and the power
 /// `va`, `vb` that go to it and to the next bin (as [`deposit`] splits it).
 struct Halves {
+    /// The bin of each pixel's centre ([`slant_bin`]; any value where the
+    /// position is missing).
+    kc: Vec<u32>,
     ka: [Vec<u32>; 2],
     va: [Vec<f64>; 2],
     vb: [Vec<f64>; 2],
@@ -561,6 +564,7 @@ impl Halves {
     fn new(cols: usize) -> Self {
         let f = || [vec![0.0; cols], vec![0.0; cols]];
         Halves {
+            kc: vec![0; cols],
             ka: [vec![0; cols], vec![0; cols]],
             va: f(),
             vb: f(),
@@ -613,7 +617,8 @@ fn prepare_half(
 }
 
 /// The footprint of a pixel at `pj` between neighbours at `pl` and `pr`
-/// (NaN: missing), as [`footprint`], and its two halves prepared.
+/// (NaN: missing), as [`footprint`], its two halves prepared, and the bin
+/// of its centre.
 #[inline(always)]
 #[allow(clippy::type_complexity)]
 fn prepare_pixel(
@@ -623,7 +628,7 @@ fn prepare_pixel(
     w: f64,
     flag: u8,
     n_bins: usize,
-) -> [(u32, f64, f64, u8); 2] {
+) -> ([(u32, f64, f64, u8); 2], u32) {
     let (lf, rf) = (pl.is_finite(), pr.is_finite());
     let (hl, hr) = ((pj + pl) / 2.0, (pj + pr) / 2.0);
     let l = if lf {
@@ -641,10 +646,21 @@ fn prepare_pixel(
         pj + 0.5
     };
     let (v, lit, ok) = (0.5 * w, flag & SHADOW == 0, pj.is_finite());
-    [
-        prepare_half(l, pj, v, lit, ok, n_bins),
-        prepare_half(pj, r, v, lit, ok, n_bins),
-    ]
+    // `slant_bin` with the clamp before the cast (see `prepare_half`)
+    // SAFETY: `max` maps NaN to 0 and the value lies in [0, 2^31 - 1]
+    let kc = unsafe {
+        (pj + 0.5)
+            .max(0.0)
+            .min((n_bins - 1) as f64)
+            .to_int_unchecked::<i32>()
+    };
+    (
+        [
+            prepare_half(l, pj, v, lit, ok, n_bins),
+            prepare_half(pj, r, v, lit, ok, n_bins),
+        ],
+        kc as u32,
+    )
 }
 
 /// Fill `h` for the line `p`, `w`, `l` ([`prepare_pixel`] for each pixel).
@@ -655,9 +671,11 @@ fn prepare_line_impl(p: &[f64], w: &[f64], l: &[u8], n_bins: usize, h: &mut Halv
     let [va0, va1] = &mut h.va;
     let [vb0, vb1] = &mut h.vb;
     let [c0, c1] = &mut h.code;
-    let mut put = |j: usize, x: [(u32, f64, f64, u8); 2]| {
+    let kc = &mut h.kc;
+    let mut put = |j: usize, (x, k): ([(u32, f64, f64, u8); 2], u32)| {
         (ka0[j], va0[j], vb0[j], c0[j]) = x[0];
         (ka1[j], va1[j], vb1[j], c1[j]) = x[1];
+        kc[j] = k;
     };
     if n == 1 {
         put(
@@ -676,12 +694,14 @@ fn prepare_line_impl(p: &[f64], w: &[f64], l: &[u8], n_bins: usize, h: &mut Halv
     let (va0, va1) = (&mut va0[1..n - 1], &mut va1[1..n - 1]);
     let (vb0, vb1) = (&mut vb0[1..n - 1], &mut vb1[1..n - 1]);
     let (c0, c1) = (&mut c0[1..n - 1], &mut c1[1..n - 1]);
+    let kc = &mut h.kc[1..n - 1];
     let (pl, pj, pr) = (&p[..n - 2], &p[1..n - 1], &p[2..]);
     let (w, l) = (&w[1..n - 1], &l[1..n - 1]);
     for j in 0..n - 2 {
-        let x = prepare_pixel(pl[j], pj[j], pr[j], w[j], l[j], n_bins);
+        let (x, k) = prepare_pixel(pl[j], pj[j], pr[j], w[j], l[j], n_bins);
         (ka0[j], va0[j], vb0[j], c0[j]) = x[0];
         (ka1[j], va1[j], vb1[j], c1[j]) = x[1];
+        kc[j] = k;
     }
 }
 
@@ -757,7 +777,7 @@ fn project_row<const LIT: bool>(
     // pixels that fall in it (its geocoded value is defined)
     for j in 0..n {
         if p[j].is_finite() {
-            let k = slant_bin(p[j], n_bins);
+            let k = h.kc[j] as usize;
             if cnt[k] == 0 {
                 cnt[k] = 1;
                 if LIT {
@@ -1026,7 +1046,6 @@ pub fn scene_block(
     let mut sigma0 = buffers::zeroed(n);
     let mut layover = buffers::zeroed_bytes(n);
     let mut shadow = buffers::zeroed_bytes(n);
-    let bin = |p: f64| slant_bin(p, n_bins);
     theta
         .par_chunks_mut(cols)
         .zip(image.par_chunks_mut(cols))
@@ -1072,9 +1091,9 @@ pub fn scene_block(
                     None => spk.copy_from_slice(img),
                 }
                 for j in 0..cols {
-                    let p = ps[j];
-                    if p.is_finite() {
-                        let k = bin(p);
+                    if ps[j].is_finite() {
+                        // the bin of the pixel's centre (`slant_bin`)
+                        let k = hv.kc[j] as usize;
                         im[j] = spk[k];
                         s0[j] = img[k];
                         lay[j] = u8::from(in_layover(cnt[k], fl[j]));
@@ -1290,6 +1309,12 @@ mod tests {
                 prepare_line_impl(&a.2, &a.1, &a.3, n_bins, &mut ha);
             }
             prepare_line_impl(&a.2, &a.1, &a.3, n_bins, &mut hb);
+            assert_eq!(ha.kc, hb.kc);
+            for (j, &p) in a.2.iter().enumerate() {
+                if p.is_finite() {
+                    assert_eq!(ha.kc[j] as usize, slant_bin(p, n_bins));
+                }
+            }
             for side in 0..2 {
                 assert_eq!(ha.ka[side], hb.ka[side]);
                 assert_eq!(bits(&ha.va[side]), bits(&hb.va[side]));
