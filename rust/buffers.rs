@@ -25,6 +25,14 @@ pub fn zeroed(n: usize) -> Vec<f64> {
     v
 }
 
+/// `vec![0u8; n]` with transparent huge pages advised when the buffer is
+/// large, as [`zeroed`].
+pub fn zeroed_bytes(n: usize) -> Vec<u8> {
+    let mut v = vec![0u8; n];
+    advise_huge_pages(&mut v);
+    v
+}
+
 /// `n` zeros as [`zeroed`] does, or [`CoreError::OutOfMemory`] naming
 /// `param` when the buffer cannot be allocated. Zeroed pages come from the
 /// allocator (`calloc`-like: not touched here), as with `vec![0.0; n]`.
@@ -76,7 +84,7 @@ pub fn checked_len(a: usize, b: usize, param: &str) -> CoreResult<usize> {
 }
 
 #[cfg(target_os = "linux")]
-fn advise_huge_pages(v: &mut [f64]) {
+fn advise_huge_pages<T>(v: &mut [T]) {
     const HUGE: usize = 2 << 20;
     let bytes = std::mem::size_of_val(v);
     if bytes < HUGE_FROM {
@@ -98,7 +106,7 @@ fn advise_huge_pages(v: &mut [f64]) {
 }
 
 #[cfg(not(target_os = "linux"))]
-fn advise_huge_pages(_v: &mut [f64]) {}
+fn advise_huge_pages<T>(_v: &mut [T]) {}
 
 #[cfg(test)]
 mod tests {
