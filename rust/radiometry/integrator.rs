@@ -712,37 +712,12 @@ impl<G: Tracer> Scene<G> {
         self.render_psf(sun, view, 0.0, shape, spp, max_depth, seed, &Psf::Box, None)
     }
 
-    /// [`Scene::render`], ticking `progress` once per image row (the image
-    /// does not depend on it).
-    #[allow(clippy::too_many_arguments)]
-    pub fn render_progress(
-        &self,
-        sun: DVec3,
-        view: DVec3,
-        shape: (usize, usize),
-        spp: u64,
-        max_depth: u32,
-        seed: u64,
-        progress: Option<&crate::progress::Progress>,
-    ) -> CoreResult<Vec<f32>> {
-        self.render_psf(
-            sun,
-            view,
-            0.0,
-            shape,
-            spp,
-            max_depth,
-            seed,
-            &Psf::Box,
-            progress,
-        )
-    }
-
-    /// [`Scene::render_progress`] with an isotropic sky of horizontal
+    /// [`Scene::render`] with an isotropic sky of horizontal
     /// irradiance `sky` and the point-spread function `psf`: each path's
     /// footprint point is drawn from the PSF around the pixel's centre
     /// (it may fall outside the pixel, and outside a finite patch, where
-    /// nothing is seen). `Psf::Box` and `sky = 0` is [`Scene::render`].
+    /// nothing is seen), ticking `progress` once per image row (the image does
+    /// not depend on it). `Psf::Box` and `sky = 0` is [`Scene::render`].
     #[allow(clippy::too_many_arguments)]
     pub fn render_psf(
         &self,
