@@ -301,10 +301,32 @@ def test_dask_refuses_what_would_not_be_exact():
     d = da.zeros((16, 16), chunks=8)
     with pytest.raises(ValueError, match="look_azimuth: with a Dask DEM, expected a multiple of 90"):
         fg.radar.simulate(d, 1.0, look_azimuth=33, incidence=35, looks=None, **SURF)
-    with pytest.raises(ValueError, match="multilook: with a Dask DEM"):
-        fg.radar.simulate(d, 1.0, look_azimuth=90, incidence=35, looks=None, multilook=2, **SURF)
-    with pytest.raises(ValueError, match="ground_range: with a Dask DEM"):
-        fg.radar.simulate(d, 1.0, look_azimuth=90, incidence=35, looks=None, ground_range=False, **SURF)
+
+
+@pytest.mark.parametrize("look,multilook,ground", [(90, None, False), (270, (3, 2), False), (0, (4, 1), True),
+                                                   (180, (2, 3), True), (90, (5, 4), False)])
+def test_dask_slant_range_and_multilook_equal_numpy(look, multilook, ground):
+    """Slant-range images and multilooked scenes of a Dask DEM: strips of whole blocks of lines on the
+    whole scene's slant axis give the numpy scene bit for bit, for two chunkings and a tight
+    chunk-size budget (strips of a few blocks), with shadow and layover across strip borders."""
+    da = pytest.importorskip("dask.array")
+    import dask
+
+    dem = fg.fbm_surface(61, 0.5, seed=6, sigma=30.0)[:, :58]
+    dem[10, 20] = np.nan
+    kw = dict(look_azimuth=look, incidence=25, looks=3, seed=4, multilook=multilook, ground_range=ground, **SURF)
+    ref = fg.radar.simulate(dem, (3.0, 2.0), **kw)
+    assert ref.geometry == ("ground" if ground else "slant")
+    assert ref.layover.any()
+    for chunks, budget in (((17, 58), None), ((25, 30), None), ((40, 58), "3KiB")):
+        with dask.config.set({"array.chunk-size": budget or "128MiB"}):
+            s = fg.radar.simulate(da.from_array(dem, chunks=chunks), (3.0, 2.0), **kw)
+        assert isinstance(s.image, da.Array) and s.geometry == ref.geometry
+        assert s.slant_range_spacing == ref.slant_range_spacing
+        for a, b in ((s.image, ref.image), (s.sigma0, ref.sigma0), (s.local_incidence, ref.local_incidence),
+                     (s.layover, ref.layover), (s.shadow, ref.shadow)):
+            assert a.shape == b.shape
+            np.testing.assert_array_equal(a.compute(), b)
 
 
 @pytest.mark.parametrize("look", [90, 180, 33.0])

@@ -530,6 +530,7 @@ def radar_geometry(
     table: Sequence[float],
     table_step: float,
     n_threads: Optional[int] = None,
+    slant: Optional[Tuple[float, int]] = None,
 ) -> Tuple[
     npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.uint8], int
 ]: ...

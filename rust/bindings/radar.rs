@@ -37,10 +37,11 @@ fn speckle_f64<'py>(
 }
 
 /// Geometry of a DEM in the range frame (columns = ground range), with the
-/// facet sigma0 `table` sampled every `table_step` degrees:
+/// facet sigma0 `table` sampled every `table_step` degrees, on the slant
+/// axis `slant = (lo, n_bins)` when given (a strip of a larger scene):
 /// `(theta_local, power, position, flags, n_bins)`.
 #[pyfunction]
-#[pyo3(signature = (dem, dx, dy, incidence, table, table_step, n_threads=None))]
+#[pyo3(signature = (dem, dx, dy, incidence, table, table_step, n_threads=None, slant=None))]
 #[allow(clippy::type_complexity, clippy::too_many_arguments)]
 fn radar_geometry<'py>(
     py: Python<'py>,
@@ -51,6 +52,7 @@ fn radar_geometry<'py>(
     table: Vec<f64>,
     table_step: f64,
     n_threads: Option<usize>,
+    slant: Option<(f64, usize)>,
 ) -> PyResult<(
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<f64>>,
@@ -61,7 +63,9 @@ fn radar_geometry<'py>(
     let a = c_order(&dem);
     let (rows, cols) = a.rows_cols();
     let g = run(py, n_threads, || {
-        geometry::geometry(&a.data, rows, cols, dx, dy, incidence, &table, table_step)
+        geometry::geometry_on_axis(
+            &a.data, rows, cols, dx, dy, incidence, &table, table_step, slant,
+        )
     })?;
     Ok((
         array2(py, (rows, cols), g.theta_local)?,

@@ -359,6 +359,26 @@ pub fn geometry(
     table: &[f64],
     table_step: f64,
 ) -> CoreResult<Geometry> {
+    geometry_on_axis(z, rows, cols, dx, dy, incidence, table, table_step, None)
+}
+
+/// [`geometry`] with the slant-range axis fixed to `slant = Some((lo,
+/// n_bins))` (as [`scene_block`]: positions are bins from `lo`; `None`: the
+/// grid's own axis). Lines computed on the whole scene's axis, with one line
+/// more on each side where the scene has them, equal the same lines of the
+/// whole scene.
+#[allow(clippy::too_many_arguments)]
+pub fn geometry_on_axis(
+    z: &[f64],
+    rows: usize,
+    cols: usize,
+    dx: f64,
+    dy: f64,
+    incidence: f64,
+    table: &[f64],
+    table_step: f64,
+    slant: Option<(f64, usize)>,
+) -> CoreResult<Geometry> {
     check(z, rows, cols, dx, dy, incidence)?;
     if table.is_empty() || !(table_step.is_finite() && table_step > 0.0) {
         return Err(CoreError::invalid(
@@ -367,7 +387,7 @@ pub fn geometry(
         ));
     }
     let prm = Params::new(dx, dy, incidence, table, table_step);
-    let (lo, n_bins) = slant_axis(z, cols, &prm)?;
+    let (lo, n_bins) = given_or_own_axis(slant, z, cols, &prm)?;
     let n = rows * cols;
     let mut theta = vec![0.0; n];
     let mut power = vec![0.0; n];
@@ -911,6 +931,28 @@ pub struct Scene {
 
 /// The slant-range axis of a scene, as in [`geometry`]: `(lo, n_bins)`, the
 /// smallest unshifted position and the number of bins from it.
+/// The slant-range axis `slant` fixed by the caller (checked), or the
+/// grid's own ([`slant_axis`]).
+fn given_or_own_axis(
+    slant: Option<(f64, usize)>,
+    z: &[f64],
+    cols: usize,
+    prm: &Params,
+) -> CoreResult<(f64, usize)> {
+    match slant {
+        Some((lo, n_bins)) => {
+            if !lo.is_finite() || n_bins == 0 || n_bins > 1 << 31 {
+                return Err(CoreError::invalid(
+                    "slant",
+                    format!("expected a finite origin and 1..2^31 bins, got ({lo}, {n_bins})"),
+                ));
+            }
+            Ok((lo, n_bins))
+        }
+        None => slant_axis(z, cols, prm),
+    }
+}
+
 fn slant_axis(z: &[f64], cols: usize, prm: &Params) -> CoreResult<(f64, usize)> {
     let (lo, hi) = slant_extent(z, cols, prm.dx, prm.cot);
     let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (0.0, 0.0) };
@@ -1024,18 +1066,7 @@ pub fn scene_block(
         return Err(CoreError::invalid("looks", "expected an integer >= 1"));
     }
     let prm = Params::new(dx, dy, incidence, table, table_step);
-    let (lo, n_bins) = match slant {
-        Some((lo, n_bins)) => {
-            if !lo.is_finite() || n_bins == 0 || n_bins > 1 << 31 {
-                return Err(CoreError::invalid(
-                    "slant",
-                    format!("expected a finite origin and 1..2^31 bins, got ({lo}, {n_bins})"),
-                ));
-            }
-            (lo, n_bins)
-        }
-        None => slant_axis(z, cols, &prm)?,
-    };
+    let (lo, n_bins) = given_or_own_axis(slant, z, cols, &prm)?;
     let key = crate::rng::StreamKey::new(seed, speckle::STREAM);
     progress::add_total(progress, rows as u64);
     let n = rows * cols;

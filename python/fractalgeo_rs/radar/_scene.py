@@ -41,10 +41,6 @@ _DASK_ROTATED = (
     "look_azimuth: with a Dask DEM, expected a multiple of 90 degrees (range lines along the grid's rows "
     "or columns, so that strips of whole range lines are exact), got {!r}. Other azimuths resample the "
     "whole scene onto a rotated grid: pass a numpy array (dem.compute()), or rotate the DEM yourself.")
-_DASK_SLANT = (
-    "{}: with a Dask DEM, simulate returns the terrain-geocoded scene only (ground_range=True, "
-    "multilook=None): the slant-range image and its block averages span the slant axis of the whole "
-    "scene. Pass a numpy array (dem.compute()) for them.")
 
 
 @dataclass(frozen=True)
@@ -259,9 +255,10 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
     dem : array_like, dask.array.Array or xarray.DataArray, shape (rows, cols)
         Heights in metres, row 0 to the north. NaN = missing. Not modified.
         A Dask array (or a DataArray of one) gives Dask outputs computed in
-        strips of whole range lines, equal to the numpy result bit for bit;
-        it needs a ``look_azimuth`` that is a multiple of 90, ``multilook=None``
-        and ``ground_range=True`` (else a ValueError saying why).
+        strips of whole range lines (of whole multilook blocks), equal to the
+        numpy result bit for bit, in ground or slant range; it needs a
+        ``look_azimuth`` that is a multiple of 90 (else a ValueError saying
+        why).
     cell_size : float, (float, float) or None
         Cell size (or (row, column) spacing) in metres; ``None`` reads it
         from a DataArray's coords, else a ValueError.
@@ -386,12 +383,9 @@ def simulate(dem, cell_size=None, *, look_azimuth, incidence, wavelength, model=
     if lazy:
         if look is None:
             raise ValueError(_DASK_ROTATED.format(look_azimuth))
-        if ml is not None:
-            raise ValueError(_DASK_SLANT.format("multilook"))
-        if not ground_range:
-            raise ValueError(_DASK_SLANT.format("ground_range"))
         with _progress.dask_bar(show):
-            return _simulate_dask(z, dem, kind, dy, dx, look, inc, table, step, looks, seed, n_threads)
+            return _simulate_dask(z, dem, kind, dy, dx, look, inc, table, step, looks, seed, ml, ground_range,
+                                  n_threads)
     z64 = np.asarray(z, dtype=np.float64)
     frame = None
     fused = ground_range and ml is None
@@ -428,31 +422,51 @@ def _simulate_numpy(z64, dem, kind, dy, dx, look, frame, inc, table, step, looks
         spacing = d_range * math.sin(math.radians(inc))
         return _to_ground(g_img, g_s0, g_lay.view(bool), g_shd.view(bool), theta_l, z64, dem, kind, look,
                           frame, dy, dx, spacing)
-    theta_l, power, pos, flags, n_bins = _core.radar_geometry(zr, d_range, d_az, inc, table.tolist(), step,
-                                                              n_threads)
-    steps.step(zr.size)
-    slant, count, nlit = _core.radar_project(power, pos, flags, n_bins, n_threads)
-    steps.step(zr.size)
-    speckled = slant if looks is None else _core.speckle_f64(slant, looks, seed, (0, 0), 0, n_threads)
-    steps.step(zr.size)
     spacing = d_range * math.sin(math.radians(inc))
+    out = _range_lines(zr, 0, zr.shape[0], 0, d_range, d_az, inc, table.tolist(), step, looks, seed, ml,
+                       ground_range, n_threads, None, steps)
+    if not ground_range:
+        return SARScene(*out, spacing * (1 if ml is None else ml[1]), "slant")
+    return _to_ground(*out, z64, dem, kind, look, frame, dy, dx, spacing)
+
+
+def _range_lines(zr, lo_row, hi_row, row0, d_range, d_az, inc, table, step, looks, seed, ml, ground_range,
+                 n_threads, slant, steps=None):
+    """The scene's steps one by one (geometry, projection, speckle, multilook, geocoding) for the range
+    lines ``[lo_row, hi_row)`` of ``zr`` (whole range lines, with the neighbouring line on each side
+    where the scene has one), the first at global line ``row0``, on the slant axis ``slant = (lo,
+    n_bins)`` (``None``: the lines' own). Returns ``(image, sigma0, layover, shadow, theta_local)``:
+    slant-range arrays (block averages with ``ml``) when not ``ground_range``, range-frame ground
+    arrays otherwise. Multilook blocks start at line ``row0``, which must be a multiple of ``ml[0]``.
+    ``steps`` (a :class:`_progress.Steps`) advances by the lines' cells per stage."""
+    def done():
+        if steps is not None:
+            steps.step((hi_row - lo_row) * zr.shape[1])
+
+    theta_l, power, pos, flags, n_bins = (
+        a[lo_row:hi_row] if isinstance(a, np.ndarray) else a
+        for a in _core.radar_geometry(zr, d_range, d_az, inc, table, step, n_threads, slant))
+    done()
+    slant_img, count, nlit = _core.radar_project(power, pos, flags, n_bins, n_threads)
+    done()
+    speckled = slant_img if looks is None else _core.speckle_f64(slant_img, looks, seed, (row0, 0), n_bins,
+                                                                 n_threads)
+    done()
     if ml is not None:
         az, rg = ml
-        ml_img, ml_s0 = _block_mean(speckled, az, rg), _block_mean(slant, az, rg)
+        ml_img, ml_s0 = _block_mean(speckled, az, rg), _block_mean(slant_img, az, rg)
         if not ground_range:
             lay_n, _ = _block_sums((count > 1).astype(np.float64), az, rg)
             shd_n, cov_n = _block_sums(np.where(count > 0, (nlit == 0).astype(np.float64), np.nan), az, rg)
-            return SARScene(ml_img, ml_s0, lay_n > 0, (cov_n > 0) & (shd_n == cov_n), theta_l, spacing * rg,
-                            "slant")
-        r, c = slant.shape
+            return ml_img, ml_s0, lay_n > 0, (cov_n > 0) & (shd_n == cov_n), theta_l
+        r, c = slant_img.shape
         speckled = np.ascontiguousarray(np.repeat(np.repeat(ml_img, az, axis=0), rg, axis=1)[:r, :c])
-        slant = np.ascontiguousarray(np.repeat(np.repeat(ml_s0, az, axis=0), rg, axis=1)[:r, :c])
+        slant_img = np.ascontiguousarray(np.repeat(np.repeat(ml_s0, az, axis=0), rg, axis=1)[:r, :c])
     if not ground_range:
-        return SARScene(speckled, slant, count > 1, (count > 0) & (nlit == 0), theta_l, spacing, "slant")
-    g_img, g_s0, g_lay = _core.radar_geocode(speckled, slant, count, pos, flags, n_threads)
-    steps.step(zr.size)
-    return _to_ground(g_img, g_s0, g_lay.view(bool), (flags & 1).view(bool), theta_l, z64, dem, kind, look,
-                      frame, dy, dx, spacing)
+        return speckled, slant_img, count > 1, (count > 0) & (nlit == 0), theta_l
+    g_img, g_s0, g_lay = _core.radar_geocode(speckled, slant_img, count, pos, flags, n_threads)
+    done()
+    return g_img, g_s0, g_lay.view(bool), (flags & 1).view(bool), theta_l
 
 
 def _strip(block, lo_row, hi_row, row0, d_range, d_az, inc, table, step, looks, seed, slant, n_threads):
@@ -470,11 +484,21 @@ def _extent(block, d_range, inc, n_threads):
                                     d_range, inc, n_threads)
 
 
-def _simulate_dask(z, dem, kind, dy, dx, look, inc, table, step, looks, seed, n_threads):
+def _lines_strip(block, lo_row, hi_row, row0, d_range, d_az, inc, table, step, looks, seed, ml, ground_range,
+                 slant, n_threads):
+    """:func:`_range_lines` of a Dask strip (``block``: its lines with their neighbours)."""
+    zb = np.ascontiguousarray(check_real_array(block, "dem"), dtype=np.float64)
+    return _range_lines(zb, lo_row, hi_row, row0, d_range, d_az, inc, table, step, looks, seed, ml, ground_range,
+                        n_threads, slant)
+
+
+def _simulate_dask(z, dem, kind, dy, dx, look, inc, table, step, looks, seed, ml, ground_range, n_threads):
     """:func:`simulate` of a Dask DEM: strips of whole range lines (the range axis rechunked to one
     chunk, the azimuth chunks kept), each with one neighbouring line on each side for the derivative
     across lines, on the slant axis of the whole scene (one pass over the DEM for its extent) and
-    with the speckle placed by the global line: the numpy result, bit for bit."""
+    with the speckle placed by the global line: the numpy result, bit for bit. With ``multilook``,
+    strips hold whole blocks of ``az`` lines; without it and in ground range, each strip runs the
+    fused kernel."""
     import dask
     import dask.array as da
     import dask.utils
@@ -483,9 +507,12 @@ def _simulate_dask(z, dem, kind, dy, dx, look, inc, table, step, looks, seed, n_
     d_range, d_az = (dx, dy) if look in (90, 270) else (dy, dx)
     rows, cols = zr.shape
     # strips no taller than dask's chunk-size budget allows for float64 lines (the user's azimuth
-    # chunks otherwise; the result does not depend on them)
+    # chunks otherwise; the result does not depend on them), whole multilook blocks
     max_rows = max(1, dask.utils.parse_bytes(dask.config.get("array.chunk-size")) // (8 * cols))
-    if max(zr.chunks[0]) > max_rows:
+    if ml is not None:
+        az = ml[0]
+        zr = zr.rechunk({0: max(az, min(max(zr.chunks[0]), max_rows) // az * az)})
+    elif max(zr.chunks[0]) > max_rows:
         zr = zr.rechunk({0: max_rows})
     bounds = np.concatenate([[0], np.cumsum(zr.chunks[0])]).astype(int)
     ext = dask.compute(*(dask.delayed(_extent)(b, d_range, inc, n_threads) for b in zr.to_delayed().ravel()))
@@ -498,18 +525,34 @@ def _simulate_dask(z, dem, kind, dy, dx, look, inc, table, step, looks, seed, n_
                          "same units?")
     slant = (lo, math.ceil(span) + 1)
     table_l = table.tolist()
-    n_lk = 0 if looks is None else looks
-    dtypes = (np.float64, np.float64, np.float64, bool, bool)
+    fused = ground_range and ml is None
+    spacing = d_range * math.sin(math.radians(inc))
+    if ground_range:
+        shapes = [lambda n: (n, cols)] * 5
+        dtypes = (np.float64, np.float64, bool, bool, np.float64)
+    elif ml is None:
+        shapes = [lambda n: (n, slant[1])] * 4 + [lambda n: (n, cols)]
+        dtypes = (np.float64, np.float64, bool, bool, np.float64)
+    else:
+        nb = -(-slant[1] // ml[1])
+        shapes = [lambda n: (-(-n // ml[0]), nb)] * 4 + [lambda n: (n, cols)]
+        dtypes = (np.float64, np.float64, bool, bool, np.float64)
     tasks = []
     for a, b in zip(bounds[:-1], bounds[1:]):
         h0, h1 = max(a - 1, 0), min(b + 1, rows)
-        tasks.append((dask.delayed(_strip, nout=5)(zr[h0:h1], a - h0, b - h0, h0, d_range, d_az, inc, table_l,
-                                                   step, n_lk, seed, slant, n_threads), b - a))
-    theta_l, g_img, g_s0, g_lay, g_shd = (
-        da.concatenate([da.from_delayed(d[k], shape=(n, cols), dtype=dtypes[k]) for d, n in tasks], axis=0)
-        for k in range(5))
-    spacing = d_range * math.sin(math.radians(inc))
-    return _to_ground(g_img, g_s0, g_lay, g_shd, theta_l, None, dem, kind, look, None, dy, dx, spacing)
+        if fused:
+            d = dask.delayed(_strip, nout=5)(zr[h0:h1], a - h0, b - h0, h0, d_range, d_az, inc, table_l, step,
+                                             0 if looks is None else looks, seed, slant, n_threads)
+            d = (d[1], d[2], d[3], d[4], d[0])  # as _range_lines: image, sigma0, layover, shadow, theta
+        else:
+            d = dask.delayed(_lines_strip, nout=5)(zr[h0:h1], a - h0, b - h0, a, d_range, d_az, inc, table_l,
+                                                   step, looks, seed, ml, ground_range, slant, n_threads)
+        tasks.append((d, b - a))
+    out = tuple(da.concatenate([da.from_delayed(d[k], shape=shapes[k](n), dtype=dtypes[k]) for d, n in tasks],
+                               axis=0) for k in range(5))
+    if not ground_range:
+        return SARScene(*out, spacing * (1 if ml is None else ml[1]), "slant")
+    return _to_ground(*out, None, dem, kind, look, None, dy, dx, spacing)
 
 
 def _to_ground(g_img, g_s0, g_lay, g_shd, theta_l, z64, dem, kind, look, frame, dy, dx, spacing):
