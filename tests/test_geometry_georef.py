@@ -146,3 +146,17 @@ def test_placed_on_errors_name_the_parameter():
         m.placed_on(GeoGrid((X0, Y0), 1.0), 7.0)
     with pytest.raises(ValueError, match="^rows:"):
         m.placed_on(GeoGrid((X0, Y0), 1.0), 0)
+
+
+@pytest.mark.parametrize("ext", ["obj", "ply"])
+def test_rewriting_without_a_crs_removes_the_old_prj(tmp_path, ext):
+    """A mesh written again without a CRS leaves no ``.prj`` of the old
+    write behind (GIS tools read it and would place the file in that CRS
+    while the sidecar says ``crs_wkt: null``)."""
+    z = _dem()
+    out = tmp_path / f"grid.{ext}"
+    Mesh.from_grid(z, grid=GeoGrid((X0, Y0), CELL, crs="EPSG:32633")).write(out)
+    assert (tmp_path / "grid.prj").exists()
+    Mesh.from_grid(z, grid=GeoGrid((X0, Y0), CELL)).write(out)
+    assert sidecar(out)["crs_wkt"] is None
+    assert not (tmp_path / "grid.prj").exists()

@@ -9,7 +9,8 @@ file ``x, y, z`` + offset). Beside ``name.obj`` or ``name.ply`` the writers
   ``crs_wkt`` (WKT or null), ``dem_transform`` (rasterio's ``a..f`` or
   null), ``vertices``, ``triangles`` and, for a mesh in a local metric frame
   of a geographic DEM, ``local_frame`` (see ``docs/geometry.md``);
-* ``name.prj``: the CRS as WKT, when there is one.
+* ``name.prj``: the CRS as WKT, when there is one (without one, an old
+  ``name.prj`` is removed).
 
 Each file is written atomically (whole or not at all).
 """
@@ -88,4 +89,6 @@ def write_sidecars(path, offset: ArrayLike, *, wkt: Optional[str], transform=Non
             with open(tmp, "w") as fh:
                 fh.write(wkt)
         written.append(stem + ".prj")
+    elif os.path.exists(stem + ".prj"):
+        os.remove(stem + ".prj")  # a stale CRS of an earlier write would contradict crs_wkt: null
     return tuple(written)
