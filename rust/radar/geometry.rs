@@ -1332,10 +1332,17 @@ mod tests {
                     && a.3.iter().any(|&f| f & ACTIVE_LAYOVER != 0)
             );
             let (mut ha, mut hb) = (Halves::new(cols), Halves::new(cols));
+            // (the cfg must not take the baseline branch away on other targets)
             #[cfg(target_arch = "x86_64")]
-            if std::arch::is_x86_feature_detected!("avx2") {
+            let avx2 = std::arch::is_x86_feature_detected!("avx2");
+            #[cfg(not(target_arch = "x86_64"))]
+            let avx2 = false;
+            if avx2 {
                 // SAFETY: the CPU has AVX2 (checked just above).
-                unsafe { prepare_line_avx2(&a.2, &a.1, &a.3, n_bins, &mut ha) };
+                #[cfg(target_arch = "x86_64")]
+                unsafe {
+                    prepare_line_avx2(&a.2, &a.1, &a.3, n_bins, &mut ha)
+                };
             } else {
                 prepare_line_impl(&a.2, &a.1, &a.3, n_bins, &mut ha);
             }
