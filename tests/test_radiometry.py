@@ -458,12 +458,11 @@ def test_render_series_bad_input():
         s.render_series("nadir")
     with pytest.raises(MemoryError, match="shape"):
         s.render_series([(0.0, 0.0)] * 4, shape=(1000, 1000), max_memory=10_000_000)
-    # several suns: the kernel fills a rows x (suns x cols) buffer, then reorders it into the
-    # returned stack (two stacks at once); a limit between one and two stacks is too small
+    # the limit is the stack itself: the kernel writes it in place (no second buffer)
     stack = 2 * 100 * 100 * 4
     with pytest.raises(MemoryError, match="shape"):
-        s.render_series([(0.0, 0.0)] * 2, shape=(100, 100), max_memory=stack + stack // 2)
-    assert s.render(sun=(0.0, 0.0), shape=(100, 100), spp=1, max_memory=100 * 100 * 4).shape == (100, 100)
+        s.render_series([(0.0, 0.0)] * 2, shape=(100, 100), max_memory=stack - 1)
+    assert s.render_series([(0.0, 0.0)] * 2, shape=(100, 100), spp=1, max_memory=stack).shape == (2, 100, 100)
 
 
 def test_images_are_written_whole_with_georeferencing(tmp_path):

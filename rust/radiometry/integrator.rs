@@ -772,61 +772,53 @@ impl<G: Tracer> Scene<G> {
             ));
         }
         let (rows, cols) = shape;
-        // one buffer of rows x (suns x cols): a row of every image per chunk
-        let mut buf = image_buffer((rows, cols.saturating_mul(ns)), spp, max_depth, progress)?;
+        let mut img = image_buffer((rows.saturating_mul(ns), cols), spp, max_depth, None)?;
+        if let Some(p) = progress {
+            p.add_total(rows as u64);
+        }
         let (x0, y0, w, h) = self.hf.footprint();
         let ytop = y0 + h;
         let (pw, ph) = (w / cols as f64, h / rows as f64);
         let sky_l = sky / PI;
-        buf.par_chunks_mut(cols * ns)
-            .enumerate()
-            .for_each(|(i, line)| {
-                let (mut l, mut l1, mut acc) = (vec![0.0; ns], vec![0.0; ns], vec![0.0; ns]);
-                for j in 0..cols {
-                    let pixel = (i * cols + j) as u64;
-                    acc.fill(0.0);
-                    for k in 0..spp {
-                        let key = StreamKey::new(
-                            seed,
-                            TAG_IMAGE ^ pixel.wrapping_mul(spp).wrapping_add(k),
-                        );
-                        let (fx, fy) = psf.position([key.uniform(0), key.uniform(1)]);
-                        let x = x0 + (j as f64 + fx) * pw;
-                        let y = ytop - (i as f64 + fy) * ph;
-                        let o = self.sensor_ray(x, y, view);
-                        self.radiance_suns(
-                            o,
-                            view,
-                            suns,
-                            sky_l,
-                            max_depth,
-                            &mut { key },
-                            2,
-                            &mut l,
-                            &mut l1,
-                        );
-                        for (a, v) in acc.iter_mut().zip(&l) {
-                            *a += v;
-                        }
-                    }
-                    for (s, a) in acc.iter().enumerate() {
-                        line[s * cols + j] = (a / spp as f64) as f32;
+        let out = crate::parallel::SharedMut::new(&mut img);
+        (0..rows).into_par_iter().for_each(|i| {
+            let (mut l, mut l1, mut acc) = (vec![0.0; ns], vec![0.0; ns], vec![0.0; ns]);
+            for j in 0..cols {
+                let pixel = (i * cols + j) as u64;
+                acc.fill(0.0);
+                for k in 0..spp {
+                    let key =
+                        StreamKey::new(seed, TAG_IMAGE ^ pixel.wrapping_mul(spp).wrapping_add(k));
+                    let (fx, fy) = psf.position([key.uniform(0), key.uniform(1)]);
+                    let x = x0 + (j as f64 + fx) * pw;
+                    let y = ytop - (i as f64 + fy) * ph;
+                    let o = self.sensor_ray(x, y, view);
+                    self.radiance_suns(
+                        o,
+                        view,
+                        suns,
+                        sky_l,
+                        max_depth,
+                        &mut { key },
+                        2,
+                        &mut l,
+                        &mut l1,
+                    );
+                    for (a, v) in acc.iter_mut().zip(&l) {
+                        *a += v;
                     }
                 }
-                if let Some(p) = progress {
-                    p.tick(1);
+                for (s, a) in acc.iter().enumerate() {
+                    // SAFETY: pixel (s, i, j) is inside the ns x rows x cols
+                    // buffer, which outlives the loop, and only the task of
+                    // row i writes it.
+                    unsafe { *out.get().add((s * rows + i) * cols + j) = (a / spp as f64) as f32 };
                 }
-            });
-        if ns == 1 {
-            return Ok(buf);
-        }
-        // rows x (suns x cols) to suns x rows x cols
-        let mut img: Vec<f32> = crate::buffers::try_filled(buf.len(), 0.0f32, "shape")?;
-        for (i, line) in buf.chunks(cols * ns).enumerate() {
-            for (s, part) in line.chunks(cols).enumerate() {
-                img[(s * rows + i) * cols..][..cols].copy_from_slice(part);
             }
-        }
+            if let Some(p) = progress {
+                p.tick(1);
+            }
+        });
         Ok(img)
     }
 

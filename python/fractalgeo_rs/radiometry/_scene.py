@@ -1655,10 +1655,9 @@ class Scene:
         view, shape, spp, max_depth, seed, n_threads, progress, sky, psf, psf_step
             As in ``render``.
         max_memory : int, optional
-            Limit in bytes of working memory (default: the package's limit):
-            twice the stack of images with several suns (the kernel's
-            buffer and the stack it is reordered into); more raises
-            ``MemoryError`` before allocating.
+            Limit in bytes for the stack of images (default: the package's
+            limit; the kernel writes the stack in place); a larger stack
+            raises ``MemoryError`` before allocating.
 
         Returns
         -------
@@ -1694,9 +1693,8 @@ class Scene:
             raise TypeError(f"shape: expected (rows, cols), got {shape!r}") from None
         rows, cols = check_positive_int(rows, "shape"), check_positive_int(cols, "shape")
         n = len(suns)
-        what = f"a {rows} x {cols} float32 image" + (f" x {n} suns, twice while reordered" if n > 1 else "")
-        # several suns: the kernel's rows x (suns x cols) buffer and the stack it is reordered into
-        check_memory((1 if n == 1 else 2) * n * rows * cols * 4, "shape", max_memory=max_memory, what=what)
+        what = f"a {rows} x {cols} float32 image" + (f" x {n} suns" if n > 1 else "")
+        check_memory(n * rows * cols * 4, "shape", max_memory=max_memory, what=what)
         from fractalgeo_rs import _progress
 
         sky = _sky(sky)
