@@ -160,3 +160,15 @@ def test_rewriting_without_a_crs_removes_the_old_prj(tmp_path, ext):
     Mesh.from_grid(z, grid=GeoGrid((X0, Y0), CELL)).write(out)
     assert sidecar(out)["crs_wkt"] is None
     assert not (tmp_path / "grid.prj").exists()
+
+
+@pytest.mark.parametrize("name", ["grid.json", "grid.PRJ"])
+def test_a_mesh_file_named_like_its_sidecar_is_refused(tmp_path, name):
+    """``Mesh.write("x.json", format="ply")`` would write the mesh and then
+    its sidecar over it: refused before anything is written."""
+    m = Mesh.from_grid(_dem(), grid=GeoGrid((X0, Y0), CELL))
+    with pytest.raises(ValueError, match=r"^path: .*sidecar"):
+        m.write(tmp_path / name, format="ply")
+    with pytest.raises(ValueError, match=r"^path: .*sidecar"):
+        m.write_obj(tmp_path / name)
+    assert list(tmp_path.iterdir()) == []

@@ -353,7 +353,8 @@ class Mesh:
         Raises
         ------
         ValueError
-            A name without ``.obj``/``.ply`` and no ``format`` (``path``), a
+            A name without ``.obj``/``.ply`` and no ``format``, or a name
+            ending in ``.json``/``.prj`` (the sidecars' names) (``path``), a
             CRS rasterio does not read (``crs``), a bad layout (the field).
 
         Examples
@@ -433,9 +434,11 @@ def write_mesh(mesh: Mesh, path: PathLike, fmt: str, *, crs=None, local_frame: O
 
     if not isinstance(mesh, Mesh):
         raise TypeError(f"mesh: expected a Mesh, got {type(mesh).__name__}")
+    p = os.fspath(path)
+    if os.path.splitext(p)[1].lower() in (".json", ".prj"):
+        raise ValueError(f"path: a mesh file cannot be named like its own sidecar (.json, .prj), got {p!r}")
     m = mesh._arrays()
     wkt = crs_wkt(crs if crs is not None else m.crs)  # a bad CRS fails before any file is written
-    p = os.fspath(path)
     head = header_lines("fractalgeo_rs mesh", len(m.vertices), len(m), m.origin, wkt, "local")[1:]
     if local_frame is not None:
         head.append("local_frame: see the .json sidecar (lon, lat from x, y)")
