@@ -158,6 +158,26 @@ fn fast_acos(x: f64) -> f64 {
 }
 
 /// Scratch lines of one thread for [`geometry_row`].
+/// The grid of range lines a geometry row reads, with the scene's
+/// parameters and slant-axis origin `lo`.
+#[derive(Clone, Copy)]
+struct Lines<'a> {
+    z: &'a [f64],
+    rows: usize,
+    cols: usize,
+    p: &'a Params<'a>,
+    lo: f64,
+}
+
+/// The outputs of one geometry row: local incidence, power, slant
+/// position and flags per sample.
+struct RowOut<'a> {
+    th: &'a mut [f64],
+    pw: &'a mut [f64],
+    ps: &'a mut [f64],
+    fl: &'a mut [u8],
+}
+
 struct RowScratch {
     /// `cos theta_loc` (first the range derivative `z_x`).
     c: Vec<f64>,
@@ -183,66 +203,35 @@ impl RowScratch {
 /// lookup of sigma0, sequentially. On x86-64 CPUs with AVX2 the same code is
 /// compiled for AVX2 and chosen at run time (four samples per instruction;
 /// the same operations in the same order, so the same bits).
-#[allow(clippy::too_many_arguments)]
 #[inline]
-fn geometry_row(
-    z: &[f64],
-    rows: usize,
-    cols: usize,
-    r: usize,
-    p: &Params,
-    lo: f64,
-    th: &mut [f64],
-    pw: &mut [f64],
-    ps: &mut [f64],
-    fl: &mut [u8],
-    scr: &mut RowScratch,
-) {
+fn geometry_row(g: &Lines<'_>, r: usize, out: RowOut<'_>, scr: &mut RowScratch) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2 (checked just above).
-        unsafe { geometry_row_avx2(z, rows, cols, r, p, lo, th, pw, ps, fl, scr) };
+        unsafe { geometry_row_avx2(g, r, out, scr) };
         return;
     }
-    geometry_row_impl(z, rows, cols, r, p, lo, th, pw, ps, fl, scr);
+    geometry_row_impl(g, r, out, scr);
 }
 
 /// [`geometry_row_impl`] compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-#[allow(clippy::too_many_arguments)]
-unsafe fn geometry_row_avx2(
-    z: &[f64],
-    rows: usize,
-    cols: usize,
-    r: usize,
-    p: &Params,
-    lo: f64,
-    th: &mut [f64],
-    pw: &mut [f64],
-    ps: &mut [f64],
-    fl: &mut [u8],
-    scr: &mut RowScratch,
-) {
-    geometry_row_impl(z, rows, cols, r, p, lo, th, pw, ps, fl, scr);
+unsafe fn geometry_row_avx2(g: &Lines<'_>, r: usize, out: RowOut<'_>, scr: &mut RowScratch) {
+    geometry_row_impl(g, r, out, scr);
 }
 
 /// The body of [`geometry_row`].
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn geometry_row_impl(
-    z: &[f64],
-    rows: usize,
-    cols: usize,
-    r: usize,
-    p: &Params,
-    lo: f64,
-    th: &mut [f64],
-    pw: &mut [f64],
-    ps: &mut [f64],
-    fl: &mut [u8],
-    scr: &mut RowScratch,
-) {
+fn geometry_row_impl(g: &Lines<'_>, r: usize, out: RowOut<'_>, scr: &mut RowScratch) {
+    let Lines {
+        z,
+        rows,
+        cols,
+        p,
+        lo,
+    } = *g;
+    let RowOut { th, pw, ps, fl } = out;
     let (st, ct, cot, dx) = (p.st, p.ct, p.cot, p.dx);
     let line = &z[r * cols..(r + 1) * cols];
     let up = if r > 0 {
@@ -388,6 +377,13 @@ pub fn geometry_on_axis(
     }
     let prm = Params::new(dx, dy, incidence, table, table_step);
     let (lo, n_bins) = given_or_own_axis(slant, z, cols, &prm)?;
+    let lines = Lines {
+        z,
+        rows,
+        cols,
+        p: &prm,
+        lo,
+    };
     let n = rows * cols;
     let mut theta = vec![0.0; n];
     let mut power = vec![0.0; n];
@@ -402,7 +398,7 @@ pub fn geometry_on_axis(
         .for_each_init(
             || RowScratch::new(cols),
             |scr, (r, (((th, pw), ps), fl))| {
-                geometry_row(z, rows, cols, r, &prm, lo, th, pw, ps, fl, scr);
+                geometry_row(&lines, r, RowOut { th, pw, ps, fl }, scr);
             },
         );
     Ok(Geometry {
@@ -1067,6 +1063,13 @@ pub fn scene_block(
     }
     let prm = Params::new(dx, dy, incidence, table, table_step);
     let (lo, n_bins) = given_or_own_axis(slant, z, cols, &prm)?;
+    let lines = Lines {
+        z,
+        rows,
+        cols,
+        p: &prm,
+        lo,
+    };
     let key = crate::rng::StreamKey::new(seed, speckle::STREAM);
     progress::add_total(progress, rows as u64);
     let n = rows * cols;
@@ -1097,7 +1100,7 @@ pub fn scene_block(
                 )
             },
             |((scr, hv), pw, ps, fl, img, cnt, spk), (r, ((((th, im), s0), lay), shd))| {
-                geometry_row(z, rows, cols, r, &prm, lo, th, pw, ps, fl, scr);
+                geometry_row(&lines, r, RowOut { th, pw, ps, fl }, scr);
                 img.fill(0.0);
                 cnt.fill(0);
                 project_row::<false>(ps, pw, fl, img, cnt, &mut [], hv);
@@ -1317,12 +1320,29 @@ mod tests {
             );
             let mut b = a.clone();
             let mut scr = RowScratch::new(cols);
-            geometry_row(
-                &z, rows, cols, r, &prm, lo, &mut a.0, &mut a.1, &mut a.2, &mut a.3, &mut scr,
-            );
-            geometry_row_impl(
-                &z, rows, cols, r, &prm, lo, &mut b.0, &mut b.1, &mut b.2, &mut b.3, &mut scr,
-            );
+            let lines = Lines {
+                z: &z,
+                rows,
+                cols,
+                p: &prm,
+                lo,
+            };
+            let (a0, a1, a2, a3) = &mut a;
+            let out_a = RowOut {
+                th: a0,
+                pw: a1,
+                ps: a2,
+                fl: a3,
+            };
+            geometry_row(&lines, r, out_a, &mut scr);
+            let (b0, b1, b2, b3) = &mut b;
+            let out_b = RowOut {
+                th: b0,
+                pw: b1,
+                ps: b2,
+                fl: b3,
+            };
+            geometry_row_impl(&lines, r, out_b, &mut scr);
             assert_eq!(bits(&a.0), bits(&b.0));
             assert_eq!(bits(&a.1), bits(&b.1));
             assert_eq!(bits(&a.2), bits(&b.2));
